@@ -1,0 +1,1 @@
+"""brainstorm stage."""
