@@ -1,0 +1,368 @@
+"""Command-line interface: one subcommand per stage plus assets, schema, config and llm tools.
+
+Heavy imports (torch, MuJoCo, sentence-transformers) happen inside commands, so ``--help`` is instant.
+User mistakes end as one red line and exit code 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+import sys
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.console import Console
+
+from anomalygen.errors import AnomalygenError, NotImplementedYet, UserError
+
+app = typer.Typer(
+    name="anomalygen",
+    help="Generate household hazards, build them in MuJoCo, detect and resolve them with a robot, and measure it.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    add_completion=False,
+)
+config_app = typer.Typer(help="Inspect the effective configuration.", no_args_is_help=True)
+app.add_typer(config_app, name="config")
+
+out = Console()
+err = Console(stderr=True)
+
+# ----------------------------------------------------------------------------- shared options
+
+ConfigOpt = Annotated[Path | None, typer.Option("--config", "-c", help="TOML config file.")]
+RunOpt = Annotated[Path, typer.Option("--run", "--out", "-r", help="Run folder.")]
+SeedOpt = Annotated[int | None, typer.Option(help="Master seed.")]
+ForceOpt = Annotated[bool, typer.Option("--force", help="Redo items whose outputs already exist.")]
+QuietOpt = Annotated[bool, typer.Option("--quiet", "-q", help="No progress bars.")]
+JsonOpt = Annotated[bool, typer.Option("--json", help="Print a machine-readable JSON summary.")]
+OnlyOpt = Annotated[list[str] | None, typer.Option("--only", help="Only these task ids (repeatable).")]
+WorkersOpt = Annotated[int | None, typer.Option("--workers", "-j", help="Parallel worker processes.")]
+ExecutorOpt = Annotated[str | None, typer.Option("--executor", help="local or ray.")]
+AddressOpt = Annotated[str | None, typer.Option("--address", help="Ray cluster address.")]
+NoCacheOpt = Annotated[bool, typer.Option("--no-cache", help="Bypass the LLM response cache.")]
+BackendOpt = Annotated[str | None, typer.Option("--backend", help="LLM backend: openai, anthropic, llamacpp.")]
+ModelOpt = Annotated[str | None, typer.Option("--model", help="LLM model name (or GGUF path for llamacpp).")]
+
+
+def _settings(config: Path | None, **overrides: Any):
+    from anomalygen.config import load_settings
+
+    return load_settings(config, overrides)
+
+
+def _common(
+    config, seed=None, quiet=False, workers=None, executor=None, address=None, no_cache=False, backend=None, model=None, **more
+):
+    overrides = {
+        "seed": seed,
+        "quiet": quiet or None,
+        "workers": workers,
+        "executor": executor,
+        "ray_address": address,
+        "llm.cache": False if no_cache else None,
+        "llm.backend": backend,
+    }
+    if model is not None:
+        overrides["llm.model_path" if (backend == "llamacpp" or model.endswith(".gguf")) else "llm.model"] = model
+    overrides.update(more)
+    return _settings(config, **overrides)
+
+
+def _stage(module: str, func: str = "run_stage"):
+    """Import a stage entry point, or explain that the stage has not landed yet."""
+    try:
+        mod = importlib.import_module(module)
+    except ModuleNotFoundError as exc:
+        if exc.name and exc.name.startswith("anomalygen"):
+            raise NotImplementedYet(f"this stage is not implemented yet ({module})") from exc
+        raise
+    if not hasattr(mod, func):
+        raise NotImplementedYet(f"this stage is not implemented yet ({module}.{func})")
+    return getattr(mod, func)
+
+
+def _finish(summary, as_json: bool) -> None:
+    if as_json:
+        payload = {
+            "stage": summary.stage,
+            "done": summary.done,
+            "skipped": summary.skipped,
+            "failed": summary.failed,
+            "wall_s": round(summary.wall_s, 3),
+            "errors": summary.errors,
+        }
+        print(json.dumps(payload, indent=2))
+    else:
+        err.print(summary.line())
+        for item_id, reason in list(summary.errors.items())[:10]:
+            err.print(f"  [red]✗[/red] {item_id}: {reason}", highlight=False)
+        if len(summary.errors) > 10:
+            err.print(f"  ... {len(summary.errors) - 10} more in errors/{summary.stage}/")
+    if summary.failed and not summary.done and not summary.skipped:
+        raise typer.Exit(1)
+
+
+def _open_run(path: Path, *, create: bool = False, settings=None):
+    from anomalygen.runfolder import RunFolder
+
+    return RunFolder.create(path, settings=settings) if create else RunFolder.open(path)
+
+
+# ----------------------------------------------------------------------------- stages
+
+
+@app.command()
+def brainstorm(
+    run: RunOpt = Path("runs/default"),
+    engine: Annotated[str | None, typer.Option(help="knowledge or llm.")] = None,
+    mode: Annotated[str | None, typer.Option(help="plain, roleplay or brainstorm.")] = None,
+    n: Annotated[int | None, typer.Option("--n", help="Number of proposals.")] = None,
+    agents: Annotated[int | None, typer.Option(help="Number of role-playing agents.")] = None,
+    rounds: Annotated[int | None, typer.Option(help="Brainstorming rounds.")] = None,
+    tasks: Annotated[Path | None, typer.Option("--tasks", help="Bring your own tasks.jsonl instead.")] = None,
+    config: ConfigOpt = None,
+    seed: SeedOpt = None,
+    force: ForceOpt = False,
+    quiet: QuietOpt = False,
+    as_json: JsonOpt = False,
+    backend: BackendOpt = None,
+    model: ModelOpt = None,
+    no_cache: NoCacheOpt = False,
+):
+    """Stage 1: propose anomaly tasks (writes tasks.jsonl)."""
+    settings = _common(
+        config, seed, quiet, backend=backend, model=model, no_cache=no_cache,
+        **{"brainstorm.engine": engine, "brainstorm.mode": mode, "brainstorm.n": n, "brainstorm.agents": agents,
+           "brainstorm.rounds": rounds, "brainstorm.tasks_file": str(tasks) if tasks else None},
+    )
+    fn = _stage("anomalygen.brainstorm.stage")
+    _finish(fn(_open_run(run, create=True, settings=settings), settings, force=force), as_json)
+
+
+@app.command()
+def build(
+    run: RunOpt = Path("runs/default"),
+    only: OnlyOpt = None,
+    workers: WorkersOpt = None,
+    clutter: Annotated[int | None, typer.Option(help="Unrelated objects added per scene.")] = None,
+    config: ConfigOpt = None,
+    seed: SeedOpt = None,
+    force: ForceOpt = False,
+    quiet: QuietOpt = False,
+    as_json: JsonOpt = False,
+    executor: ExecutorOpt = None,
+    address: AddressOpt = None,
+):
+    """Stage 2: build each task as a validated MuJoCo scene (writes scenes/<task_id>/)."""
+    settings = _common(config, seed, quiet, workers, executor, address, **{"build.clutter": clutter})
+    fn = _stage("anomalygen.scene.stage")
+    _finish(fn(_open_run(run), settings, force=force, only=only), as_json)
+
+
+@app.command()
+def detect(
+    run: RunOpt = Path("runs/default"),
+    detector: Annotated[str | None, typer.Option(help="rules, llm or hybrid.")] = None,
+    k: Annotated[int | None, typer.Option("--k", help="Hypotheses per scene.")] = None,
+    only: OnlyOpt = None,
+    config: ConfigOpt = None,
+    force: ForceOpt = False,
+    quiet: QuietOpt = False,
+    as_json: JsonOpt = False,
+    backend: BackendOpt = None,
+    model: ModelOpt = None,
+    no_cache: NoCacheOpt = False,
+):
+    """Stage 3: find the hazard in each scene without being told the task (writes detections.jsonl)."""
+    settings = _common(config, None, quiet, backend=backend, model=model, no_cache=no_cache,
+                       **{"detect.detector": detector, "detect.k": k})
+    fn = _stage("anomalygen.detect.stage")
+    _finish(fn(_open_run(run), settings, force=force, only=only), as_json)
+
+
+@app.command()
+def plan(
+    run: RunOpt = Path("runs/default"),
+    source: Annotated[str | None, typer.Option(help="ground_truth or detected.")] = None,
+    engine: Annotated[str | None, typer.Option(help="knowledge or llm.")] = None,
+    only: OnlyOpt = None,
+    config: ConfigOpt = None,
+    force: ForceOpt = False,
+    quiet: QuietOpt = False,
+    as_json: JsonOpt = False,
+    backend: BackendOpt = None,
+    model: ModelOpt = None,
+):
+    """Stage 4a: decompose each fix into sub-tasks with rewards and success checks (writes plans/)."""
+    settings = _common(config, None, quiet, backend=backend, model=model,
+                       **{"learn.plan_source": source, "learn.engine": engine})
+    fn = _stage("anomalygen.learn.plan_stage")
+    _finish(fn(_open_run(run), settings, force=force, only=only), as_json)
+
+
+@app.command()
+def learn(
+    run: RunOpt = Path("runs/default"),
+    sac_steps: Annotated[int | None, typer.Option("--sac-steps", help="SAC environment steps per sub-task.")] = None,
+    seeds: Annotated[int | None, typer.Option("--seeds", help="Seeds per task.")] = None,
+    only: OnlyOpt = None,
+    workers: WorkersOpt = None,
+    config: ConfigOpt = None,
+    seed: SeedOpt = None,
+    force: ForceOpt = False,
+    quiet: QuietOpt = False,
+    as_json: JsonOpt = False,
+    executor: ExecutorOpt = None,
+    address: AddressOpt = None,
+):
+    """Stage 4b: execute each plan (primitives, SAC, CEM) and check success (writes skills/)."""
+    settings = _common(config, seed, quiet, workers, executor, address,
+                       **{"learn.sac_steps": sac_steps, "learn.seeds": seeds})
+    fn = _stage("anomalygen.learn.stage")
+    _finish(fn(_open_run(run), settings, force=force, only=only), as_json)
+
+
+@app.command()
+def evaluate(
+    run: RunOpt = Path("runs/default"),
+    config: ConfigOpt = None,
+    quiet: QuietOpt = False,
+    as_json: JsonOpt = False,
+    no_images: Annotated[bool, typer.Option("--no-images", help="Skip image-embedding metrics.")] = False,
+):
+    """Measure diversity, detection hit@k and success; print the diversity table with baselines."""
+    settings = _common(config, None, quiet, **{"evaluate.image_metrics": False if no_images else None})
+    fn = _stage("anomalygen.evaluate.stage")
+    _finish(fn(_open_run(run), settings), as_json)
+
+
+@app.command()
+def report(
+    run: RunOpt = Path("runs/default"),
+    config: ConfigOpt = None,
+    quiet: QuietOpt = False,
+    as_json: JsonOpt = False,
+):
+    """Write report/index.html, report.json and summary.md for a run."""
+    settings = _common(config, None, quiet)
+    fn = _stage("anomalygen.evaluate.report")
+    _finish(fn(_open_run(run), settings), as_json)
+
+
+@app.command("run")
+def run_all(
+    run: RunOpt = Path("runs/demo"),
+    config: ConfigOpt = None,
+    seed: SeedOpt = None,
+    n: Annotated[int | None, typer.Option("--n", help="Number of tasks.")] = None,
+    workers: WorkersOpt = None,
+    executor: ExecutorOpt = None,
+    address: AddressOpt = None,
+    force: ForceOpt = False,
+    quiet: QuietOpt = False,
+    as_json: JsonOpt = False,
+):
+    """Run every stage end to end (resumable). Without a config: the embedded offline defaults."""
+    from anomalygen.pipeline import run_pipeline
+
+    settings = _common(config, seed, quiet, workers, executor, address, **{"brainstorm.n": n})
+    result = run_pipeline(_open_run(run, create=True, settings=settings), settings, force=force)
+    if as_json:
+        print(json.dumps(result, indent=2, default=str))
+
+
+# ----------------------------------------------------------------------------- tools
+
+
+@app.command()
+def schema(name: Annotated[str, typer.Argument(help="Artefact class, e.g. TaskProposal.")]):
+    """Print the JSON Schema of an artefact."""
+    from anomalygen.schema import ARTEFACTS
+
+    matches = {k.lower(): v for k, v in ARTEFACTS.items()}
+    cls = matches.get(name.lower())
+    if cls is None:
+        raise UserError(f"unknown artefact '{name}'; choose from: {', '.join(sorted(ARTEFACTS))}")
+    print(json.dumps(cls.model_json_schema(), indent=2))
+
+
+@config_app.command("show")
+def config_show(config: ConfigOpt = None, as_json: JsonOpt = False):
+    """Print the effective configuration (TOML < env < flags), secrets masked."""
+    settings = _settings(config)
+    data = settings.masked_dump()
+    if as_json:
+        print(json.dumps(data, indent=2))
+    else:
+        import tomli_w
+
+        print(tomli_w.dumps(_drop_none(data)))
+
+
+def _drop_none(d):
+    if isinstance(d, dict):
+        return {k: _drop_none(v) for k, v in d.items() if v is not None}
+    return d
+
+
+def _register_subapps() -> None:
+    """Sub-apps owned by their packages; a missing one becomes a stub that explains itself."""
+    for name, module, help_text in (
+        ("assets", "anomalygen.assets.cli", "Asset library: list, show, render, validate, search, gallery."),
+        ("llm", "anomalygen.llm.cli", "Talk to the configured LLM: ping, ask."),
+    ):
+        try:
+            sub = importlib.import_module(module).app
+        except ModuleNotFoundError as exc:
+            if not (exc.name or "").startswith("anomalygen"):
+                raise
+            sub = typer.Typer(help=help_text)
+
+            @sub.callback(invoke_without_command=True)
+            def _missing(_name=name):
+                raise NotImplementedYet(f"'anomalygen {_name}' is not implemented yet")
+
+        app.add_typer(sub, name=name, help=help_text)
+
+
+_register_subapps()
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point: map expected errors to one line on stderr and a non-zero exit code."""
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
+    os.environ.setdefault("HF_HUB_OFFLINE", "1")
+    os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
+    os.environ.setdefault("TOKENIZERS_PARALLELISM", "false")
+    from pydantic import ValidationError
+
+    from anomalygen.schema import format_validation_error
+
+    try:
+        app(args=argv, standalone_mode=False)
+    except NotImplementedYet as exc:
+        err.print(f"[yellow]not implemented yet:[/yellow] {exc}", highlight=False)
+        sys.exit(3)
+    except (AnomalygenError, ValidationError) as exc:
+        msg = format_validation_error(exc) if isinstance(exc, ValidationError) else str(exc)
+        err.print(f"[red]error:[/red] {msg}", highlight=False)
+        sys.exit(2)
+    except typer.Exit as exc:
+        sys.exit(exc.exit_code)
+    except typer.Abort:
+        err.print("[red]aborted[/red]")
+        sys.exit(130)
+    except Exception as exc:  # click usage errors (typer vendors click) arrive here in non-standalone mode
+        if hasattr(exc, "show") and hasattr(exc, "exit_code"):
+            exc.show()
+            sys.exit(exc.exit_code)
+        raise
+
+
+if __name__ == "__main__":
+    main()

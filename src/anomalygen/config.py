@@ -1,0 +1,186 @@
+"""Effective configuration: TOML file < ``ANOMALYGEN_*`` environment < CLI flags.
+
+One settings model for the whole pipeline, so a run's manifest can record exactly what produced it.
+Nested sections map to env vars with a double underscore: ``ANOMALYGEN_LLM__BACKEND=openai``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, SecretStr
+from pydantic_settings import BaseSettings, PydanticBaseSettingsSource, SettingsConfigDict, TomlConfigSettingsSource
+
+from anomalygen.schema import BrainstormMode, Engine
+
+
+class Section(BaseModel):
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+
+class LLMConfig(Section):
+    backend: Literal["none", "openai", "anthropic", "llamacpp"] = "none"
+    model: str | None = Field(None, description="model name for HTTP backends")
+    base_url: str | None = Field(None, description="OpenAI-compatible endpoint, e.g. http://localhost:8000/v1")
+    api_key: SecretStr | None = None
+    model_path: str | None = Field(None, description="GGUF file for llamacpp; default: the bundled SmolLM2")
+    temperature: float = Field(0.7, ge=0.0, le=2.0)
+    max_tokens: int = Field(1024, ge=1)
+    repair_retries: int = Field(3, ge=0, description="times an invalid reply goes back to the model")
+    http_retries: int = Field(4, ge=0, description="retries on 429/5xx/timeouts, exponential backoff")
+    timeout_s: float = Field(60.0, gt=0)
+    concurrency: int = Field(4, ge=1)
+    cache: bool = True
+    cache_path: str | None = Field(None, description="SQLite cache file; default ~/.cache/anomalygen/llm.sqlite")
+    price_prompt_per_mtok: float | None = Field(None, ge=0, description="USD per million prompt tokens")
+    price_completion_per_mtok: float | None = Field(None, ge=0)
+    vision: bool = Field(False, description="the endpoint accepts images (scene verification)")
+    n_ctx: int = Field(4096, ge=256, description="llamacpp context size")
+
+    @property
+    def configured(self) -> bool:
+        return self.backend != "none"
+
+
+class BrainstormConfig(Section):
+    engine: Engine | None = Field(None, description="knowledge or llm; default knowledge unless an LLM is set")
+    mode: BrainstormMode = BrainstormMode.BRAINSTORM
+    n: int = Field(111, ge=1, description="number of proposals to keep")
+    agents: int = Field(10, ge=1)
+    rounds: int = Field(3, ge=1)
+    novelty_threshold: float = Field(0.92, gt=0, le=1, description="SBERT cosine above which a proposal is a duplicate")
+    tasks_file: str | None = Field(None, description="bring your own tasks.jsonl instead of brainstorming")
+
+
+class BuildConfig(Section):
+    engine: Engine | None = None
+    clutter: int = Field(2, ge=0, description="unrelated everyday objects added per scene")
+    settle_s: float = Field(1.0, gt=0)
+    render_width: int = Field(320, ge=32)
+    render_height: int = Field(240, ge=32)
+    repair_attempts: int = Field(3, ge=0)
+    relevant_in_unit_cube: bool = Field(True, description="task assets inside (0..1)^3, unrelated ones outside")
+
+
+class DetectConfig(Section):
+    detector: Literal["rules", "llm", "hybrid"] = "rules"
+    k: int = Field(3, ge=1, le=10)
+
+
+class LearnConfig(Section):
+    engine: Engine | None = None
+    plan_source: Literal["ground_truth", "detected"] = "ground_truth"
+    seeds: int = Field(1, ge=1)
+    sac_steps: int = Field(2000, ge=0)
+    cem_iterations: int = Field(5, ge=1)
+    video: bool = True
+    reward_mode: Literal["spec", "code"] = "spec"
+
+
+class EvaluateConfig(Section):
+    image_metrics: bool = True
+    vit_weights: str | None = Field(None, description="optional path to ViT/CLIP weights for image similarity")
+
+
+class Settings(BaseSettings):
+    """Everything a run needs. CLI flags arrive as init kwargs and win over env and TOML."""
+
+    model_config = SettingsConfigDict(
+        env_prefix="ANOMALYGEN_",
+        env_nested_delimiter="__",
+        extra="forbid",
+        validate_assignment=True,
+    )
+
+    seed: int = 0
+    executor: Literal["local", "ray"] = "local"
+    workers: int = Field(2, ge=1)
+    ray_address: str | None = None
+    quiet: bool = False
+    llm: LLMConfig = Field(default_factory=LLMConfig)
+    brainstorm: BrainstormConfig = Field(default_factory=BrainstormConfig)
+    build: BuildConfig = Field(default_factory=BuildConfig)
+    detect: DetectConfig = Field(default_factory=DetectConfig)
+    learn: LearnConfig = Field(default_factory=LearnConfig)
+    evaluate: EvaluateConfig = Field(default_factory=EvaluateConfig)
+
+    # Set per load by ``load_settings``; pydantic-settings reads it in ``settings_customise_sources``.
+    _toml_path: Path | None = None
+
+    @classmethod
+    def settings_customise_sources(
+        cls,
+        settings_cls: type[BaseSettings],
+        init_settings: PydanticBaseSettingsSource,
+        env_settings: PydanticBaseSettingsSource,
+        dotenv_settings: PydanticBaseSettingsSource,
+        file_secret_settings: PydanticBaseSettingsSource,
+    ) -> tuple[PydanticBaseSettingsSource, ...]:
+        sources: list[PydanticBaseSettingsSource] = [init_settings, env_settings]
+        toml_path = _CURRENT_TOML.get("path")
+        if toml_path is not None:
+            sources.append(TomlConfigSettingsSource(settings_cls, toml_file=toml_path))
+        return tuple(sources)
+
+    def engine_for(self, stage: Literal["brainstorm", "build", "learn"]) -> Engine:
+        """The explicit per-stage engine, else ``llm`` exactly when an LLM is configured."""
+        chosen = getattr(self, stage).engine
+        if chosen is not None:
+            return chosen
+        return Engine.LLM if self.llm.configured else Engine.KNOWLEDGE
+
+    def masked_dump(self) -> dict[str, Any]:
+        """JSON-safe dump with every secret replaced, for manifests, logs and ``config show``."""
+        data = self.model_dump(mode="json")
+        if self.llm.api_key is not None:
+            data["llm"]["api_key"] = "***"
+        return data
+
+
+_CURRENT_TOML: dict[str, Path | None] = {"path": None}
+
+
+def load_settings(config_file: str | Path | None = None, overrides: dict[str, Any] | None = None) -> Settings:
+    """Build settings from an optional TOML file, the environment and explicit overrides (highest).
+
+    ``overrides`` may use dotted keys (``{"llm.backend": "openai"}``); ``None`` values are ignored so
+    CLI options that were not given do not mask lower layers.
+    """
+    from anomalygen.errors import UserError
+
+    path = Path(config_file) if config_file else None
+    if path is not None and not path.is_file():
+        raise UserError(f"config file not found: {path}")
+    nested = _nest({k: v for k, v in (overrides or {}).items() if v is not None})
+    _CURRENT_TOML["path"] = path
+    try:
+        if path is not None:
+            _check_toml_readable(path)
+        return Settings(**nested)  # pydantic-settings deep-merges the sources
+    finally:
+        _CURRENT_TOML["path"] = None
+
+
+def _check_toml_readable(path: Path) -> None:
+    import tomllib
+
+    from anomalygen.errors import UserError
+
+    try:
+        tomllib.loads(path.read_text())
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UserError(f"cannot read config file {path}: {exc}") from exc
+    except tomllib.TOMLDecodeError as exc:
+        raise UserError(f"invalid TOML in {path}: {exc}") from exc
+
+
+def _nest(flat: dict[str, Any]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, value in flat.items():
+        parts = key.split(".")
+        node = out
+        for part in parts[:-1]:
+            node = node.setdefault(part, {})
+        node[parts[-1]] = value
+    return out
