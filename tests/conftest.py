@@ -1,0 +1,15 @@
+"""Test-wide environment: offline models, headless rendering, temp folders for tools that write $HOME."""
+
+import os
+import tempfile
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+os.environ.setdefault("HF_HUB_OFFLINE", "1")
+os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
+os.environ.setdefault("TOKENIZERS_PARALLELISM", "false")
+os.environ.setdefault("RAY_AUTH_MODE", "disabled")
+os.environ.setdefault("MPLCONFIGDIR", tempfile.mkdtemp(prefix="mpl-"))
+# Tests must not read a developer's own configuration.
+for key in [k for k in os.environ if k.startswith("ANOMALYGEN_")]:
+    del os.environ[key]
