@@ -159,8 +159,9 @@ def build(
 ):
     """Stage 2: build each task as a validated MuJoCo scene (writes scenes/<task_id>/)."""
     settings = _common(config, seed, quiet, workers, executor, address, **{"build.clutter": clutter})
+    folder = _open_run(run)
     fn = _stage("anomalygen.scene.stage")
-    _finish(fn(_open_run(run), settings, force=force, only=only), as_json)
+    _finish(fn(folder, settings, force=force, only=only), as_json)
 
 
 @app.command()
@@ -180,8 +181,9 @@ def detect(
     """Stage 3: find the hazard in each scene without being told the task (writes detections.jsonl)."""
     settings = _common(config, None, quiet, backend=backend, model=model, no_cache=no_cache,
                        **{"detect.detector": detector, "detect.k": k})
+    folder = _open_run(run)
     fn = _stage("anomalygen.detect.stage")
-    _finish(fn(_open_run(run), settings, force=force, only=only), as_json)
+    _finish(fn(folder, settings, force=force, only=only), as_json)
 
 
 @app.command()
@@ -200,8 +202,9 @@ def plan(
     """Stage 4a: decompose each fix into sub-tasks with rewards and success checks (writes plans/)."""
     settings = _common(config, None, quiet, backend=backend, model=model,
                        **{"learn.plan_source": source, "learn.engine": engine})
+    folder = _open_run(run)
     fn = _stage("anomalygen.learn.plan_stage")
-    _finish(fn(_open_run(run), settings, force=force, only=only), as_json)
+    _finish(fn(folder, settings, force=force, only=only), as_json)
 
 
 @app.command()
@@ -222,8 +225,9 @@ def learn(
     """Stage 4b: execute each plan (primitives, SAC, CEM) and check success (writes skills/)."""
     settings = _common(config, seed, quiet, workers, executor, address,
                        **{"learn.sac_steps": sac_steps, "learn.seeds": seeds})
+    folder = _open_run(run)
     fn = _stage("anomalygen.learn.stage")
-    _finish(fn(_open_run(run), settings, force=force, only=only), as_json)
+    _finish(fn(folder, settings, force=force, only=only), as_json)
 
 
 @app.command()
@@ -236,8 +240,9 @@ def evaluate(
 ):
     """Measure diversity, detection hit@k and success; print the diversity table with baselines."""
     settings = _common(config, None, quiet, **{"evaluate.image_metrics": False if no_images else None})
+    folder = _open_run(run)
     fn = _stage("anomalygen.evaluate.stage")
-    _finish(fn(_open_run(run), settings), as_json)
+    _finish(fn(folder, settings), as_json)
 
 
 @app.command()
@@ -249,8 +254,9 @@ def report(
 ):
     """Write report/index.html, report.json and summary.md for a run."""
     settings = _common(config, None, quiet)
+    folder = _open_run(run)
     fn = _stage("anomalygen.evaluate.report")
-    _finish(fn(_open_run(run), settings), as_json)
+    _finish(fn(folder, settings), as_json)
 
 
 @app.command("run")

@@ -128,6 +128,7 @@ class RunFolder:
     def create(cls, root: str | Path, *, settings=None) -> RunFolder:
         run = cls(root)
         run.root.mkdir(parents=True, exist_ok=True)
+        run.sweep_temp_files()
         if not run.manifest_path.exists():
             run.save_manifest(run._new_manifest(settings))
         elif settings is not None:
@@ -143,7 +144,17 @@ class RunFolder:
         run = cls(root)
         if not run.root.is_dir():
             raise UserError(f"run folder not found: {run.root} (create one with 'anomalygen brainstorm --out {run.root}')")
+        run.sweep_temp_files()
         return run
+
+    def sweep_temp_files(self) -> int:
+        """Delete temp files left by a process killed mid-write; they were never visible as outputs."""
+        removed = 0
+        for tmp in self.root.rglob(".*.tmp"):
+            with contextlib.suppress(OSError):
+                tmp.unlink()
+                removed += 1
+        return removed
 
     def _new_manifest(self, settings) -> RunManifest:
         from anomalygen import __version__

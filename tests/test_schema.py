@@ -1,0 +1,103 @@
+"""The data model: strict, versioned, round-trippable, with errors that name the field."""
+
+import json
+
+import pytest
+from pydantic import ValidationError
+
+from anomalygen import schema as S
+
+
+def _proposal(**over):
+    data = dict(
+        id="t0001-knife-edge",
+        name="Knife on the counter edge",
+        explanation="A blade near the edge can fall on someone's foot.",
+        description="A kitchen knife lies with its handle over the counter edge.",
+        category="household_hazard",
+        hazard_class="store_sharp_objects",
+        target_asset="Knife",
+        scenario={"hazard_object": "Knife", "room": "kitchen", "placement": "counter_edge", "container": "StorageFurniture"},
+        provenance={"engine": "knowledge", "mode": "brainstorm", "agent_role": "homemaker", "round": 2, "builds_on": ["t0000"]},
+    )
+    data.update(over)
+    return data
+
+
+def _example(cls):
+    """A minimal valid instance of every artefact class."""
+    joint = S.JointState(name="door", label="door", value=1.2, range=(0.0, 1.6), closed_value=0.0)
+    ref = S.AssetRef(asset_id="Refrigerator/3", category="Refrigerator", seed=3)
+    placed = S.PlacedObject(name="fridge_0", asset=ref, role="target", size=1.7, pos=[1, 0, 0], joint_states=[joint])
+    examples = {
+        S.TaskProposal: S.TaskProposal.model_validate(_proposal()),
+        S.AssetRef: ref,
+        S.JointState: joint,
+        S.PlacedObject: placed,
+        S.SceneSpec: S.SceneSpec(scene_id="s", task_id="t", room="kitchen", seed=0, objects=[placed]),
+        S.SceneGraph: S.SceneGraph(
+            scene_id="s",
+            room="kitchen",
+            objects=[
+                S.GraphObject(name="fridge_0", category="Refrigerator", position=[1, 0, 0.85], size=[0.7, 0.7, 1.7],
+                              height_above_floor=0.0, on_floor=True, child_reachable=True, joints=[joint])
+            ],
+            relations=[S.Relation(subject="fridge_0", predicate="on_floor")],
+        ),
+        S.Hypothesis: S.Hypothesis(rank=1, problem="fridge open", solution="close it", target_object="fridge_0"),
+        S.Detection: S.Detection(task_id="t", scene_id="s", detector="rules", hypotheses=[], hit_rank=None),
+        S.SubTask: S.SubTask(id="1", description="close door", method="primitive", primitive="push"),
+        S.Plan: S.Plan(task_id="t", source="ground_truth", engine="knowledge", subtasks=[], success=S.SuccessSpec()),
+        S.RewardSpec: S.RewardSpec(terms=[S.RewardTerm(kind="joint", a="fridge_0", joint="door", target=0.0)]),
+        S.SuccessSpec: S.SuccessSpec(predicates=[S.PredicateCall(name="joint_closed", args={"object": "$target"})]),
+        S.SkillResult: S.SkillResult(task_id="t", seed=0, success=True),
+        S.RunManifest: S.RunManifest(name="r", created="2026-01-01T00:00:00+00:00", package_version="0"),
+        S.ItemError: S.ItemError(item_id="t", stage="build", error="boom"),
+    }
+    return examples[cls]
+
+
+@pytest.mark.parametrize("name", sorted(S.ARTEFACTS))
+def test_every_artefact_round_trips_through_json(name):
+    cls = S.ARTEFACTS[name]
+    obj = _example(cls)
+    again = cls.model_validate_json(obj.model_dump_json())
+    assert again == obj
+    assert again.schema_version == S.SCHEMA_VERSION
+
+
+@pytest.mark.parametrize("name", sorted(S.ARTEFACTS))
+def test_unknown_fields_are_rejected_with_the_field_named(name):
+    cls = S.ARTEFACTS[name]
+    data = json.loads(_example(cls).model_dump_json())
+    data["surprise_field"] = 1
+    with pytest.raises(ValidationError) as exc:
+        cls.model_validate(data)
+    assert "unknown field 'surprise_field'" in S.format_validation_error(exc.value)
+
+
+def test_nested_unknown_field_is_named_with_its_path():
+    with pytest.raises(ValidationError) as exc:
+        S.TaskProposal.model_validate(_proposal(scenario={"hazard_object": "Knife", "room": "k", "placement": "floor", "colour": "red"}))
+    assert "unknown field 'scenario.colour'" in S.format_validation_error(exc.value)
+
+
+def test_wrong_types_are_reported_per_field():
+    with pytest.raises(ValidationError) as exc:
+        S.TaskProposal.model_validate(_proposal(category="kitchen_mess"))
+    assert "category" in S.format_validation_error(exc.value)
+
+
+def test_joint_open_fraction_measures_distance_from_the_closed_value():
+    door = S.JointState(name="d", label="door", value=0.8, range=(0.0, 1.6), closed_value=0.0)
+    assert door.open_fraction == pytest.approx(0.5)
+    reversed_door = S.JointState(name="d", label="door", value=-1.6, range=(-1.6, 0.0), closed_value=0.0)
+    assert reversed_door.open_fraction == pytest.approx(1.0)
+    shut = S.JointState(name="d", label="drawer", value=0.0, range=(0.0, 0.4), closed_value=0.0)
+    assert shut.open_fraction == 0.0
+
+
+def test_usage_adds_up_including_cost():
+    a = S.LLMUsage(requests=1, prompt_tokens=10, cost_usd=0.5)
+    a.add(S.LLMUsage(requests=2, completion_tokens=5, cache_hits=1, cost_usd=0.25))
+    assert (a.requests, a.prompt_tokens, a.completion_tokens, a.cache_hits, a.cost_usd) == (3, 10, 5, 1, 0.75)
