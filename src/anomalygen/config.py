@@ -81,6 +81,8 @@ class LearnConfig(Section):
 class EvaluateConfig(Section):
     image_metrics: bool = True
     vit_weights: str | None = Field(None, description="optional path to ViT/CLIP weights for image similarity")
+    wmd_pairs: int = Field(300, ge=1, description="pairs sampled per text set for mean Word Mover's Distance")
+    baselines: bool = Field(True, description="recompute the six benchmark baselines in the diversity table")
 
 
 class Settings(BaseSettings):

@@ -1,0 +1,71 @@
+"""The typed result of ``anomalygen evaluate`` (``evaluation.json``), read back by the report.
+
+Every section is optional: a stage that has not run leaves its section ``None`` and the report says
+"not run" instead of failing.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import Field
+
+from anomalygen.schema import Artefact, LLMUsage, StageRecord, Strict
+
+
+class DiversityRow(Strict):
+    """One line of the diversity table. ``None`` = not measured for this row."""
+
+    name: str
+    kind: Literal["run", "baseline", "paper"]
+    tasks: int
+    self_bleu: float | None = None
+    sbert: float | None = None
+    wmd: float | None = None
+    image: float | None = None
+    clip: float | None = None
+    image_embedder: str | None = None
+
+
+class Rate(Strict):
+    n: int = 0
+    successes: int = 0
+
+    @property
+    def rate(self) -> float:
+        return self.successes / self.n if self.n else 0.0
+
+
+class DetectionSummary(Strict):
+    scenes: int
+    k: int
+    hit_at_k: dict[int, float] = Field(description="k -> fraction of scenes whose first hit has rank <= k")
+    errors: int = 0
+    by_category: dict[str, dict[int, float]] = Field(default_factory=dict)
+
+
+class SuccessSummary(Strict):
+    results: int = Field(description="(task, seed) results read")
+    tasks: int
+    overall: Rate
+    by_category: dict[str, Rate] = Field(default_factory=dict)
+    by_class: dict[str, Rate] = Field(default_factory=dict)
+    by_method: dict[str, Rate] = Field(default_factory=dict, description="sub-task success per skill method")
+    errors: int = 0
+
+
+class Evaluation(Artefact):
+    run: str
+    tasks: int
+    diversity: list[DiversityRow] = Field(default_factory=list)
+    categories: dict[str, int] = Field(default_factory=dict)
+    classes: dict[str, int] = Field(default_factory=dict)
+    target_assets: dict[str, int] = Field(default_factory=dict)
+    scenes_built: int = 0
+    scenes_failed: int = 0
+    detection: DetectionSummary | None = None
+    success: SuccessSummary | None = None
+    timings: dict[str, StageRecord] = Field(default_factory=dict)
+    llm_usage: LLMUsage = Field(default_factory=LLMUsage)
+    not_run: list[str] = Field(default_factory=list, description="stages with no artefacts yet")
+    wall_s: dict[str, float] = Field(default_factory=dict, description="seconds per metric, for the curious")

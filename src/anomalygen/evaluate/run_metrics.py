@@ -1,0 +1,117 @@
+"""Counting metrics over a run's artefacts: distributions, detection hit@k, success by class.
+
+Pure functions of typed artefacts, so they are tested on hand-built runs and reused by the report.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+
+from anomalygen.evaluate.results import DetectionSummary, Rate, SuccessSummary
+from anomalygen.runfolder import RunFolder, read_jsonl, try_read_model
+from anomalygen.schema import Detection, SceneSpec, SkillResult, TaskProposal
+
+
+def distribution(values: Iterable[str]) -> dict[str, int]:
+    """Counts, most common first (ties by name) so tables and pies are stable."""
+    counts = Counter(values)
+    return dict(sorted(counts.items(), key=lambda kv: (-kv[1], kv[0])))
+
+
+def category_distribution(tasks: Sequence[TaskProposal]) -> dict[str, int]:
+    return distribution(str(t.category) for t in tasks)
+
+
+def class_distribution(tasks: Sequence[TaskProposal]) -> dict[str, int]:
+    return distribution(t.hazard_class for t in tasks)
+
+
+def hit_at_k(detections: Sequence[Detection], k: int) -> dict[int, float]:
+    """Fraction of scenes whose first correct hypothesis has rank <= j, for j = 1..k (errors are misses)."""
+    n = len(detections)
+    return {j: (sum(1 for d in detections if d.hit_rank is not None and d.hit_rank <= j) / n if n else 0.0)
+            for j in range(1, k + 1)}
+
+
+def detection_summary(detections: Sequence[Detection], tasks: Sequence[TaskProposal], k: int) -> DetectionSummary:
+    k = max([k, *(len(d.hypotheses) for d in detections)]) if detections else k
+    category = {t.id: str(t.category) for t in tasks}
+    groups: dict[str, list[Detection]] = {}
+    for d in detections:
+        groups.setdefault(category.get(d.task_id, "unknown"), []).append(d)
+    return DetectionSummary(
+        scenes=len(detections),
+        k=k,
+        hit_at_k=hit_at_k(detections, k),
+        errors=sum(1 for d in detections if d.error),
+        by_category={c: hit_at_k(ds, k) for c, ds in sorted(groups.items())},
+    )
+
+
+def success_summary(results: Sequence[SkillResult], tasks: Sequence[TaskProposal]) -> SuccessSummary:
+    """Success over every (task, seed) result, grouped by the task's category and hazard class."""
+    by_id = {t.id: t for t in tasks}
+    overall = Rate()
+    by_category: dict[str, Rate] = {}
+    by_class: dict[str, Rate] = {}
+    by_method: dict[str, Rate] = {}
+
+    def bump(table: dict[str, Rate], key: str, ok: bool) -> None:
+        cell = table.setdefault(key, Rate())
+        cell.n += 1
+        cell.successes += int(ok)
+
+    for r in results:
+        task = by_id.get(r.task_id)
+        overall.n += 1
+        overall.successes += int(r.success)
+        bump(by_category, str(task.category) if task else "unknown", r.success)
+        bump(by_class, task.hazard_class if task else "unknown", r.success)
+        for sub in r.subtasks:
+            bump(by_method, str(sub.method), sub.success)
+    return SuccessSummary(
+        results=len(results),
+        tasks=len({r.task_id for r in results}),
+        overall=overall,
+        by_category=dict(sorted(by_category.items())),
+        by_class=dict(sorted(by_class.items())),
+        by_method=dict(sorted(by_method.items())),
+        errors=sum(1 for r in results if r.error),
+    )
+
+
+# --------------------------------------------------------------------------- reading a run
+
+
+def load_tasks(run: RunFolder) -> list[TaskProposal]:
+    return run.load_tasks() if run.tasks_path.is_file() else []
+
+
+def load_detections(run: RunFolder) -> list[Detection]:
+    if run.detections_path.is_file():
+        return read_jsonl(run.detections_path, Detection, strict=False)
+    if run.detections_dir.is_dir():  # per-item files before the stage merges them
+        return [d for p in sorted(run.detections_dir.glob("*.json")) if (d := try_read_model(p, Detection))]
+    return []
+
+
+def load_skill_results(run: RunFolder) -> list[SkillResult]:
+    if not run.skills_dir.is_dir():
+        return []
+    paths = sorted(run.skills_dir.glob("*/seed*/result.json"))
+    return [r for p in paths if (r := try_read_model(p, SkillResult)) is not None]
+
+
+def built_scenes(run: RunFolder) -> list[SceneSpec]:
+    if not run.scenes_dir.is_dir():
+        return []
+    return [s for p in sorted(run.scenes_dir.glob("*/scene.json")) if (s := try_read_model(p, SceneSpec))]
+
+
+def scene_renders(run: RunFolder) -> list[Path]:
+    """One front render per built scene (the paper embeds one image per scene)."""
+    if not run.scenes_dir.is_dir():
+        return []
+    return sorted(p for p in run.scenes_dir.glob("*/render_front.png") if p.is_file())

@@ -1,0 +1,88 @@
+"""``anomalygen evaluate``: compute every metric of a run into ``evaluation.json`` and print the diversity table.
+
+Works on whatever the run holds: a missing stage leaves its section empty and is listed in ``not_run``.
+"""
+
+from __future__ import annotations
+
+import time
+
+from anomalygen.evaluate import run_metrics as rm
+from anomalygen.evaluate.diversity import diversity_table, rich_table
+from anomalygen.evaluate.results import Evaluation
+from anomalygen.evaluate.text_metrics import task_text
+from anomalygen.runfolder import RunFolder, now_iso, read_model, write_model
+from anomalygen.runner import StageSummary
+from anomalygen.schema import StageRecord
+
+EVALUATION_FILE = "evaluation.json"
+
+
+def evaluation_path(run: RunFolder):
+    return run.root / EVALUATION_FILE
+
+
+def load_evaluation(run: RunFolder) -> Evaluation | None:
+    path = evaluation_path(run)
+    return read_model(path, Evaluation) if path.is_file() else None
+
+
+def evaluate_run(run: RunFolder, settings) -> Evaluation:
+    """All metrics of one run, as a typed record (no printing, no writing)."""
+    cfg = settings.evaluate
+    tasks = rm.load_tasks(run)
+    scenes = rm.built_scenes(run)
+    detections = rm.load_detections(run)
+    results = rm.load_skill_results(run)
+    manifest = run.load_manifest()
+    timings: dict[str, float] = {}
+
+    renders = rm.scene_renders(run)
+    rows = diversity_table(
+        run.root.name,
+        [task_text(t.name, t.description) for t in tasks],
+        renders,
+        seed=settings.seed,
+        wmd_pairs=cfg.wmd_pairs,
+        baselines=cfg.baselines,
+        image_metrics=cfg.image_metrics,
+        vit_weights=cfg.vit_weights,
+        timings=timings,
+    )
+    not_run = [name for name, present in (
+        ("brainstorm", bool(tasks)), ("build", bool(scenes)), ("detect", bool(detections)),
+        ("plan", run.plans_dir.is_dir() and any(run.plans_dir.glob("*.json"))), ("learn", bool(results)),
+    ) if not present]
+    return Evaluation(
+        run=run.root.name,
+        tasks=len(tasks),
+        diversity=rows,
+        categories=rm.category_distribution(tasks),
+        classes=rm.class_distribution(tasks),
+        target_assets=rm.distribution(t.target_asset for t in tasks),
+        scenes_built=sum(1 for s in scenes if s.validation is None or s.validation.ok),
+        scenes_failed=len(run.errors("build")),
+        detection=rm.detection_summary(detections, tasks, settings.detect.k) if detections else None,
+        success=rm.success_summary(results, tasks) if results else None,
+        timings=dict(manifest.stages),
+        llm_usage=manifest.llm_usage,
+        not_run=not_run,
+        wall_s=timings,
+    )
+
+
+def run_stage(run: RunFolder, settings) -> StageSummary:
+    started, record = time.perf_counter(), StageRecord(started=now_iso())
+    evaluation = evaluate_run(run, settings)
+    write_model(evaluation_path(run), evaluation)
+    if not settings.quiet:
+        from rich.console import Console
+
+        Console(width=max(Console().width, 120)).print(rich_table(evaluation.diversity))
+        if evaluation.not_run:
+            Console(stderr=True).print(f"not run yet: {', '.join(evaluation.not_run)}", highlight=False)
+    summary = StageSummary("evaluate", done=1, wall_s=time.perf_counter() - started)
+    summary.results["evaluation"] = str(evaluation_path(run))
+    record.finished, record.wall_s, record.done = now_iso(), round(summary.wall_s, 3), 1
+    run.record_stage("evaluate", record)
+    return summary

@@ -1,0 +1,62 @@
+"""Counting metrics on a hand-built run: distributions, hit@k, success by category and class."""
+
+import pytest
+
+from anomalygen.evaluate import run_metrics as rm
+from anomalygen.evaluate.baselines import BASELINES, PAPER_DIVERSITY, baseline_records, baseline_texts
+from anomalygen.evaluate.text_metrics import sample_pairs, task_text
+
+
+def test_distributions(synthetic_run):
+    tasks = rm.load_tasks(synthetic_run)
+    assert rm.category_distribution(tasks) == {"child_safety": 2, "household_hazard": 2, "hygiene": 1}
+    assert sum(rm.class_distribution(tasks).values()) == 5
+
+
+def test_hit_at_k(synthetic_run):
+    tasks = rm.load_tasks(synthetic_run)
+    summary = rm.detection_summary(rm.load_detections(synthetic_run), tasks, k=3)
+    # hit ranks: 1, 2, 1, miss, 3
+    assert summary.hit_at_k == {1: pytest.approx(0.4), 2: pytest.approx(0.6), 3: pytest.approx(0.8)}
+    assert summary.by_category["hygiene"][1] == 1.0
+    assert summary.by_category["household_hazard"] == {1: 0.0, 2: 0.5, 3: 1.0}
+
+
+def test_success_by_category_and_class(synthetic_run):
+    tasks = rm.load_tasks(synthetic_run)
+    s = rm.success_summary(rm.load_skill_results(synthetic_run), tasks)
+    assert (s.overall.n, s.overall.successes) == (5, 3)
+    assert s.by_category["child_safety"].rate == 1.0
+    assert s.by_category["hygiene"].rate == 0.0
+    assert s.by_class["fire"].successes == 0 and s.by_class["choking"].successes == 1
+    assert s.by_method["primitive"].rate == 1.0 and s.by_method["sac"].successes == 3
+
+
+def test_missing_stages_give_empty_inputs(tmp_path):
+    from anomalygen.runfolder import RunFolder
+
+    run = RunFolder.create(tmp_path / "empty")
+    assert rm.load_tasks(run) == [] and rm.load_detections(run) == [] and rm.load_skill_results(run) == []
+    assert rm.scene_renders(run) == []
+
+
+def test_baselines_are_packaged_with_sources():
+    counts = {stem: len(baseline_records(stem)) for stem in BASELINES}
+    assert counts == {"robogen": 46, "behavior100": 100, "rlbench": 106, "metaworld": 50, "maniskill2": 20, "gensim": 70}
+    assert all(r["source"] for stem in BASELINES for r in baseline_records(stem))
+    assert set(BASELINES.values()) | {"AnomalyGen"} == set(PAPER_DIVERSITY)
+    assert baseline_texts("rlbench")[0] == "basketball in hoop. put the ball in the hoop"
+
+
+def test_task_text_does_not_repeat_names():
+    assert task_text("assembling_gift_baskets", "assembling gift baskets") == "assembling gift baskets"
+    assert task_text("knife_at_edge", "A knife.") == "knife at edge. A knife."
+
+
+def test_sample_pairs_is_seeded_and_distinct():
+    import numpy as np
+
+    a = sample_pairs(50, 100, np.random.default_rng(3))
+    b = sample_pairs(50, 100, np.random.default_rng(3))
+    assert a == b and len(set(a)) == 100 and all(0 <= i < j < 50 for i, j in a)
+    assert len(sample_pairs(5, 100, np.random.default_rng(0))) == 10
