@@ -1,0 +1,137 @@
+"""Any OpenAI-compatible endpoint (OpenAI, vLLM, Ollama, llama.cpp server, LM Studio) via the SDK.
+
+Structured output degrades gracefully: ``json_schema`` response format first; a server that answers
+400 to it gets ``json_object`` (JSON mode) instead; one that rejects that too gets a plain request.
+The schema is also in the prompt, and the client validates every reply, so each level is safe.
+The SDK's own retries are off: ``anomalygen.llm.client`` owns retry, backoff and their counting.
+"""
+
+from __future__ import annotations
+
+import base64
+import os
+import threading
+from typing import Any
+
+from anomalygen.errors import UserError
+from anomalygen.llm.backends import PermanentError, RawReply, Request, TransientError
+
+_MODES = ("json_schema", "json_object", "plain")
+
+
+def image_mime(data: bytes) -> str:
+    if data[:8] == b"\x89PNG\r\n\x1a\n":
+        return "image/png"
+    if data[:3] == b"\xff\xd8\xff":
+        return "image/jpeg"
+    if data[:4] == b"RIFF" and data[8:12] == b"WEBP":
+        return "image/webp"
+    return "application/octet-stream"
+
+
+def with_images_openai(messages: list[dict[str, Any]], images: list[bytes]) -> list[dict[str, Any]]:
+    """Attach images as data-URI parts to the last user message (the vision chat format)."""
+    out = [dict(m) for m in messages]
+    for msg in reversed(out):
+        if msg.get("role") == "user":
+            parts: list[dict[str, Any]] = [{"type": "text", "text": str(msg.get("content", ""))}]
+            for img in images:
+                b64 = base64.b64encode(img).decode("ascii")
+                parts.append({"type": "image_url", "image_url": {"url": f"data:{image_mime(img)};base64,{b64}"}})
+            msg["content"] = parts
+            break
+    return out
+
+
+class OpenAIBackend:
+    name = "openai"
+    prompt_schema_style = "full"
+
+    def __init__(self, config):
+        import openai
+
+        if not config.model:
+            raise UserError("llm.model is not set: pass --model NAME or set ANOMALYGEN_LLM__MODEL")
+        key = config.api_key.get_secret_value() if config.api_key else os.environ.get("OPENAI_API_KEY")
+        if not key and not config.base_url:
+            raise UserError("no OpenAI API key: set OPENAI_API_KEY or ANOMALYGEN_LLM__API_KEY (or --base-url for a local server)")
+        self.model = config.model
+        self.supports_images = bool(config.vision)
+        self._openai = openai
+        self._client = openai.OpenAI(
+            api_key=key or "not-needed", base_url=config.base_url, timeout=config.timeout_s, max_retries=0
+        )
+        self._mode_index = 0  # moves down _MODES when a server rejects a structured-output mode
+        self._lock = threading.Lock()
+
+    @property
+    def structured_mode(self) -> str:
+        return _MODES[self._mode_index]
+
+    def complete_raw(self, request: Request) -> RawReply:
+        messages = request.messages
+        if request.images:
+            messages = with_images_openai(messages, request.images)
+        while True:
+            mode = _MODES[self._mode_index] if request.schema_json is not None else "plain"
+            kwargs: dict[str, Any] = {
+                "model": self.model,
+                "messages": messages,
+                "temperature": request.temperature,
+                "max_tokens": request.max_tokens,
+            }
+            if request.seed is not None:
+                kwargs["seed"] = request.seed
+            if mode == "json_schema":
+                kwargs["response_format"] = {
+                    "type": "json_schema",
+                    "json_schema": {"name": request.schema_name or "reply", "schema": request.schema_json, "strict": False},
+                }
+            elif mode == "json_object":
+                kwargs["response_format"] = {"type": "json_object"}
+            try:
+                resp = self._client.chat.completions.create(**kwargs)
+            except self._openai.BadRequestError as exc:
+                if mode != "plain":
+                    with self._lock:  # remember for later requests: this server lacks the mode
+                        if _MODES[self._mode_index] == mode:
+                            self._mode_index += 1
+                    continue
+                raise PermanentError(f"HTTP 400 bad request: {_short(exc)}") from None
+            except (self._openai.RateLimitError, self._openai.InternalServerError) as exc:
+                raise TransientError(f"HTTP {exc.status_code}: {_short(exc)}") from None
+            except self._openai.APITimeoutError:
+                raise TransientError("request timed out") from None
+            except self._openai.APIConnectionError as exc:
+                raise TransientError(f"connection failed: {type(exc).__name__}") from None
+            except self._openai.APIStatusError as exc:
+                if exc.status_code in (408, 409) or exc.status_code >= 500:
+                    raise TransientError(f"HTTP {exc.status_code}: {_short(exc)}") from None
+                raise PermanentError(f"HTTP {exc.status_code}: {_short(exc)}") from None
+            choices = getattr(resp, "choices", None) or []
+            text = (choices[0].message.content if choices and choices[0].message else None) or ""
+            usage = getattr(resp, "usage", None)
+            return RawReply(
+                text=text,
+                prompt_tokens=int(getattr(usage, "prompt_tokens", 0) or 0),
+                completion_tokens=int(getattr(usage, "completion_tokens", 0) or 0),
+            )
+
+    def ping(self) -> str:
+        """List models (cheap, no tokens); returns the first model id the server reports."""
+        try:
+            models = self._client.models.list()
+            first = next(iter(models), None)
+        except self._openai.APIError as exc:
+            raise PermanentError(f"{type(exc).__name__}: {_short(exc)}") from None
+        return first.id if first is not None else ""
+
+
+def _short(exc: Exception) -> str:
+    body = getattr(exc, "body", None)
+    msg = None
+    if isinstance(body, dict):
+        err = body.get("error", body)
+        msg = err.get("message") if isinstance(err, dict) else str(err)
+    text = str(msg or getattr(exc, "message", None) or exc)
+    return " ".join(text.split())[:200]

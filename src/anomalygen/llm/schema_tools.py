@@ -1,0 +1,82 @@
+"""JSON schemas handed to models, derived from the pydantic classes that validate their replies.
+
+Two variants: ``response_schema`` is the faithful schema (OpenAI ``json_schema`` / Anthropic tool
+input), ``bounded_schema`` adds ``maxLength``/``maxItems`` caps and drops optional fields so a
+grammar-constrained local model cannot ramble for minutes. Validation always uses the real model,
+so the caps only shape generation, never what is accepted.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+from typing import Any
+
+from pydantic import BaseModel
+
+
+def response_schema(schema: type[BaseModel]) -> dict[str, Any]:
+    return schema.model_json_schema()
+
+
+def schema_fingerprint(schema: type[BaseModel] | None) -> str | None:
+    """Canonical JSON of the schema, part of the cache key (a changed class invalidates old replies)."""
+    if schema is None:
+        return None
+    return json.dumps(response_schema(schema), sort_keys=True, separators=(",", ":"))
+
+
+def inline_refs(node: Any, defs: dict[str, Any], depth: int = 0) -> Any:
+    """Replace ``$ref`` pointers into ``$defs`` by copies (bounded depth; our models are not recursive)."""
+    if depth > 32:
+        return {}
+    if isinstance(node, dict):
+        ref = node.get("$ref")
+        if isinstance(ref, str) and ref.startswith("#/$defs/"):
+            target = copy.deepcopy(defs.get(ref.split("/")[-1], {}))
+            extra = {k: v for k, v in node.items() if k != "$ref"}
+            target.update(extra)
+            return inline_refs(target, defs, depth + 1)
+        return {k: inline_refs(v, defs, depth + 1) for k, v in node.items() if k != "$defs"}
+    if isinstance(node, list):
+        return [inline_refs(v, defs, depth + 1) for v in node]
+    return node
+
+
+def bounded_schema(
+    schema: type[BaseModel], *, max_string: int = 60, max_items: int = 2, required_only: bool = True
+) -> dict[str, Any]:
+    """A self-contained schema with generation caps, for grammar-constrained local decoding."""
+    raw = response_schema(schema)
+    tree = inline_refs(raw, raw.get("$defs", {}))
+    return _cap(tree, max_string=max_string, max_items=max_items, required_only=required_only)
+
+
+def _cap(node: Any, *, max_string: int, max_items: int, required_only: bool) -> Any:
+    if isinstance(node, list):
+        return [_cap(v, max_string=max_string, max_items=max_items, required_only=required_only) for v in node]
+    if not isinstance(node, dict):
+        return node
+    out = {k: v for k, v in node.items() if k not in ("title", "description", "default", "examples")}
+    kw = {"max_string": max_string, "max_items": max_items, "required_only": required_only}
+    if out.get("type") == "object" and isinstance(out.get("properties"), dict):
+        required = set(out.get("required", []))
+        props = out["properties"]
+        if required_only and required:
+            props = {k: v for k, v in props.items() if k in required}
+            out["required"] = [k for k in out.get("required", []) if k in props]
+        out["properties"] = {k: _cap(v, **kw) for k, v in props.items()}
+        out.setdefault("additionalProperties", False)
+    elif out.get("type") == "object" and isinstance(out.get("additionalProperties"), dict):
+        out["additionalProperties"] = _cap(out["additionalProperties"], **kw)
+        out.setdefault("maxProperties", max_items)
+    for key in ("anyOf", "oneOf", "allOf", "prefixItems"):
+        if key in out:
+            out[key] = _cap(out[key], **kw)
+    if "items" in out:
+        out["items"] = _cap(out["items"], **kw)
+    if out.get("type") == "string" and not ({"enum", "const", "pattern", "format"} & out.keys()):
+        out["maxLength"] = min(int(out.get("maxLength", max_string)), max_string)
+    if out.get("type") == "array" and "prefixItems" not in out:
+        out["maxItems"] = min(int(out.get("maxItems", max_items)), max(max_items, int(out.get("minItems", 0))))
+    return out
