@@ -105,7 +105,9 @@ class ScriptedOpenAIServer:
         self._server.daemon_threads = True
         self.port = self._server.server_address[1]
         self.base_url = f"http://127.0.0.1:{self.port}/v1"
-        self._thread = threading.Thread(target=self._server.serve_forever, kwargs={"poll_interval": 0.05}, daemon=True)
+        self._thread = threading.Thread(
+            target=self._server.serve_forever, kwargs={"poll_interval": 0.05}, daemon=True
+        )
         self._thread.start()
         return self
 
@@ -163,7 +165,10 @@ def _make_handler(srv: ScriptedOpenAIServer) -> type[BaseHTTPRequestHandler]:
 
         def do_GET(self) -> None:
             if self.path.rstrip("/").endswith("/models"):
-                self._send(200, {"object": "list", "data": [{"id": srv._model, "object": "model", "owned_by": "tests"}]})
+                self._send(
+                    200,
+                    {"object": "list", "data": [{"id": srv._model, "object": "model", "owned_by": "tests"}]},
+                )
             else:
                 self._send(404, {"error": {"message": f"no route {self.path}", "type": "not_found"}})
 
@@ -224,7 +229,12 @@ def _chat_completion(model: str, reply: Reply) -> dict[str, Any]:
         "created": int(time.time()),
         "model": model,
         "choices": [
-            {"index": 0, "message": {"role": "assistant", "content": content}, "finish_reason": "stop", "logprobs": None}
+            {
+                "index": 0,
+                "message": {"role": "assistant", "content": content},
+                "finish_reason": "stop",
+                "logprobs": None,
+            }
         ],
         "usage": {
             "prompt_tokens": reply.prompt_tokens,
@@ -239,7 +249,12 @@ def _anthropic_message(model: str, body: dict[str, Any], reply: Reply) -> dict[s
         forced = (body.get("tool_choice") or {}).get("name")
         tools = body.get("tools") or [{}]
         name = reply.tool_name or forced or tools[0].get("name", "tool")
-        block: dict[str, Any] = {"type": "tool_use", "id": f"toolu_{time.monotonic_ns()}", "name": name, "input": reply.tool_input}
+        block: dict[str, Any] = {
+            "type": "tool_use",
+            "id": f"toolu_{time.monotonic_ns()}",
+            "name": name,
+            "input": reply.tool_input,
+        }
         stop = "tool_use"
     else:
         block = {"type": "text", "text": reply.content}

@@ -57,9 +57,11 @@ class ReplyCache:
         return con
 
     def get(self, key: str) -> tuple[str, int, int] | None:
-        row = self._connect().execute(
-            "SELECT text, prompt_tokens, completion_tokens FROM replies WHERE key = ?", (key,)
-        ).fetchone()
+        row = (
+            self._connect()
+            .execute("SELECT text, prompt_tokens, completion_tokens FROM replies WHERE key = ?", (key,))
+            .fetchone()
+        )
         return None if row is None else (row[0], int(row[1] or 0), int(row[2] or 0))
 
     def put(self, key: str, text: str, prompt_tokens: int, completion_tokens: int) -> None:

@@ -18,21 +18,36 @@ import typer
 
 from anomalygen.errors import UserError
 
-app = typer.Typer(help="Talk to the configured LLM: ping, ask.", no_args_is_help=True, pretty_exceptions_enable=False)
+app = typer.Typer(
+    help="Talk to the configured LLM: ping, ask.", no_args_is_help=True, pretty_exceptions_enable=False
+)
 
 ConfigOpt = Annotated[Path | None, typer.Option("--config", "-c", help="TOML config file.")]
 BackendOpt = Annotated[str | None, typer.Option("--backend", help="openai, anthropic or llamacpp.")]
 ModelOpt = Annotated[str | None, typer.Option("--model", help="Model name, or a GGUF path for llamacpp.")]
-BaseUrlOpt = Annotated[str | None, typer.Option("--base-url", help="OpenAI-compatible endpoint, e.g. http://localhost:8000/v1.")]
+BaseUrlOpt = Annotated[
+    str | None, typer.Option("--base-url", help="OpenAI-compatible endpoint, e.g. http://localhost:8000/v1.")
+]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Machine-readable JSON output.")]
 NoCacheOpt = Annotated[bool, typer.Option("--no-cache", help="Bypass the LLM response cache.")]
 
 
-def llm_settings(config: Path | None, backend: str | None, model: str | None, base_url: str | None, no_cache: bool = False, **more: Any):
+def llm_settings(
+    config: Path | None,
+    backend: str | None,
+    model: str | None,
+    base_url: str | None,
+    no_cache: bool = False,
+    **more: Any,
+):
     """Settings with CLI overrides on top of TOML and env (same rules as the stage commands)."""
     from anomalygen.config import load_settings
 
-    overrides: dict[str, Any] = {"llm.backend": backend, "llm.base_url": base_url, "llm.cache": False if no_cache else None}
+    overrides: dict[str, Any] = {
+        "llm.backend": backend,
+        "llm.base_url": base_url,
+        "llm.cache": False if no_cache else None,
+    }
     if model is not None:
         effective_backend = backend or load_settings(config).llm.backend
         is_gguf = effective_backend == "llamacpp" or model.endswith(".gguf")
@@ -67,7 +82,10 @@ def ping(
     client = get_client(settings.llm)
     start = time.perf_counter()
     reply = client.complete(
-        [{"role": "user", "content": "Reply with the single word: pong"}], max_tokens=8, temperature=0.0, cache=False
+        [{"role": "user", "content": "Reply with the single word: pong"}],
+        max_tokens=8,
+        temperature=0.0,
+        cache=False,
     )
     latency = time.perf_counter() - start
     payload = {
@@ -81,13 +99,17 @@ def ping(
     if as_json:
         print(json.dumps(payload, indent=2))
     else:
-        print(f"backend={payload['backend']} model={payload['model']} latency={latency:.2f}s reply={payload['reply']!r}")
+        print(
+            f"backend={payload['backend']} model={payload['model']} latency={latency:.2f}s reply={payload['reply']!r}"
+        )
 
 
 @app.command()
 def ask(
     prompt: Annotated[str, typer.Argument(help="The user message.")],
-    schema: Annotated[str | None, typer.Option("--schema", help="Validate the reply as this artefact, e.g. TaskProposal.")] = None,
+    schema: Annotated[
+        str | None, typer.Option("--schema", help="Validate the reply as this artefact, e.g. TaskProposal.")
+    ] = None,
     system: Annotated[str | None, typer.Option("--system", help="Optional system message.")] = None,
     backend: BackendOpt = None,
     model: ModelOpt = None,
@@ -107,9 +129,13 @@ def ask(
     model_cls = schema_by_name(schema) if schema else None
     settings = llm_settings(config, backend, model, base_url, no_cache)
     client = get_client(settings.llm)
-    messages = ([{"role": "system", "content": system}] if system else []) + [{"role": "user", "content": prompt}]
+    messages = ([{"role": "system", "content": system}] if system else []) + [
+        {"role": "user", "content": prompt}
+    ]
     start = time.perf_counter()
-    result = client.complete(messages, schema=model_cls, temperature=temperature, seed=seed, max_tokens=max_tokens)
+    result = client.complete(
+        messages, schema=model_cls, temperature=temperature, seed=seed, max_tokens=max_tokens
+    )
     wall = time.perf_counter() - start
     if model_cls is not None:
         print(result.model_dump_json(indent=2))

@@ -150,7 +150,9 @@ class LLMClient:
                     {"role": "user", "content": repair_instruction(schema, last_error)},
                 ]
         raise LLMItemError(
-            self._scrub(f"LLM reply is not a valid {schema.__name__} after {attempts} attempt(s): {_one_line(last_error)}")
+            self._scrub(
+                f"LLM reply is not a valid {schema.__name__} after {attempts} attempt(s): {_one_line(last_error)}"
+            )
         )
 
     def complete_many(
@@ -214,14 +216,18 @@ class LLMClient:
             except TransientError as exc:
                 if attempt + 1 >= attempts:
                     raise LLMItemError(
-                        self._scrub(f"{self.backend.name} request failed after {attempts} attempt(s): {_one_line(str(exc))}")
+                        self._scrub(
+                            f"{self.backend.name} request failed after {attempts} attempt(s): {_one_line(str(exc))}"
+                        )
                     ) from None
                 with self._lock:
                     self.usage.retries += 1
                 self._sleep(self._backoff(attempt))
                 continue
             except PermanentError as exc:
-                raise LLMItemError(self._scrub(f"{self.backend.name} request failed: {_one_line(str(exc))}")) from None
+                raise LLMItemError(
+                    self._scrub(f"{self.backend.name} request failed: {_one_line(str(exc))}")
+                ) from None
             self._account(raw)
             return raw
         raise AssertionError("unreachable")  # pragma: no cover

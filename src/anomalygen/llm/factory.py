@@ -32,7 +32,13 @@ def make_backend(config):
 
 
 def get_client(
-    config, *, rng: np.random.Generator | None = None, backoff_base_s: float = 0.5, backoff_max_s: float = 20.0
+    config,
+    *,
+    rng: np.random.Generator | None = None,
+    backoff_base_s: float = 0.5,
+    backoff_max_s: float = 20.0,
 ) -> LLMClient:
     """The client for ``settings.llm``. ``rng`` adds jitter to retry backoff (none: deterministic delays)."""
-    return LLMClient(config, make_backend(config), rng=rng, backoff_base_s=backoff_base_s, backoff_max_s=backoff_max_s)
+    return LLMClient(
+        config, make_backend(config), rng=rng, backoff_base_s=backoff_base_s, backoff_max_s=backoff_max_s
+    )

@@ -49,5 +49,9 @@ def extract_json(text: str) -> Any:
         if isinstance(value, dict) or (isinstance(value, list) and value):
             return value
     if "{" in text and text.count("{") > text.count("}"):
-        raise JSONExtractError("the JSON object is truncated (unbalanced braces); reply with the complete object")
-    raise JSONExtractError("no JSON object found in the reply; reply with a single JSON object and nothing else")
+        raise JSONExtractError(
+            "the JSON object is truncated (unbalanced braces); reply with the complete object"
+        )
+    raise JSONExtractError(
+        "no JSON object found in the reply; reply with a single JSON object and nothing else"
+    )

@@ -54,7 +54,9 @@ def bounded_schema(
 
 def _cap(node: Any, *, max_string: int, max_items: int, required_only: bool) -> Any:
     if isinstance(node, list):
-        return [_cap(v, max_string=max_string, max_items=max_items, required_only=required_only) for v in node]
+        return [
+            _cap(v, max_string=max_string, max_items=max_items, required_only=required_only) for v in node
+        ]
     if not isinstance(node, dict):
         return node
     out = {k: v for k, v in node.items() if k not in ("title", "description", "default", "examples")}
@@ -78,5 +80,7 @@ def _cap(node: Any, *, max_string: int, max_items: int, required_only: bool) -> 
     if out.get("type") == "string" and not ({"enum", "const", "pattern", "format"} & out.keys()):
         out["maxLength"] = min(int(out.get("maxLength", max_string)), max_string)
     if out.get("type") == "array" and "prefixItems" not in out:
-        out["maxItems"] = min(int(out.get("maxItems", max_items)), max(max_items, int(out.get("minItems", 0))))
+        out["maxItems"] = min(
+            int(out.get("maxItems", max_items)), max(max_items, int(out.get("minItems", 0)))
+        )
     return out

@@ -19,7 +19,9 @@ from anomalygen.llm.backends.openai_backend import _short, image_mime
 
 def split_system(messages: list[dict[str, Any]]) -> tuple[str, list[dict[str, Any]]]:
     system = "\n\n".join(str(m.get("content", "")) for m in messages if m.get("role") == "system")
-    rest = [{"role": m["role"], "content": m.get("content", "")} for m in messages if m.get("role") != "system"]
+    rest = [
+        {"role": m["role"], "content": m.get("content", "")} for m in messages if m.get("role") != "system"
+    ]
     return system, rest
 
 
@@ -41,7 +43,9 @@ class AnthropicBackend:
         self.model = config.model
         self.supports_images = bool(config.vision)
         self._anthropic = anthropic
-        self._client = anthropic.Anthropic(api_key=key or "not-needed", base_url=base, timeout=config.timeout_s, max_retries=0)
+        self._client = anthropic.Anthropic(
+            api_key=key or "not-needed", base_url=base, timeout=config.timeout_s, max_retries=0
+        )
 
     def complete_raw(self, request: Request) -> RawReply:
         system, messages = split_system(request.messages)
@@ -59,7 +63,11 @@ class AnthropicBackend:
         if request.schema_json is not None:
             tool_name = _tool_name(request.schema_name)
             kwargs["tools"] = [
-                {"name": tool_name, "description": "Return the answer as this structured object.", "input_schema": request.schema_json}
+                {
+                    "name": tool_name,
+                    "description": "Return the answer as this structured object.",
+                    "input_schema": request.schema_json,
+                }
             ]
             kwargs["tool_choice"] = {"type": "tool", "name": tool_name}
         a = self._anthropic
@@ -104,7 +112,14 @@ def _with_images(messages: list[dict[str, Any]], images: list[bytes]) -> list[di
     for msg in reversed(out):
         if msg.get("role") == "user":
             parts: list[dict[str, Any]] = [
-                {"type": "image", "source": {"type": "base64", "media_type": image_mime(img), "data": base64.b64encode(img).decode("ascii")}}
+                {
+                    "type": "image",
+                    "source": {
+                        "type": "base64",
+                        "media_type": image_mime(img),
+                        "data": base64.b64encode(img).decode("ascii"),
+                    },
+                }
                 for img in images
             ]
             parts.append({"type": "text", "text": str(msg.get("content", ""))})

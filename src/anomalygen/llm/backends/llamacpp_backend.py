@@ -92,7 +92,9 @@ class LlamaCppBackend:
             try:
                 resp = llama.create_chat_completion(**kwargs)
             except ValueError as exc:  # e.g. prompt longer than the context
-                raise PermanentError(f"llama.cpp rejected the request: {' '.join(str(exc).split())[:200]}") from None
+                raise PermanentError(
+                    f"llama.cpp rejected the request: {' '.join(str(exc).split())[:200]}"
+                ) from None
         choice = (resp.get("choices") or [{}])[0]
         usage = resp.get("usage") or {}
         return RawReply(

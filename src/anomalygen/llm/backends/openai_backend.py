@@ -37,7 +37,9 @@ def with_images_openai(messages: list[dict[str, Any]], images: list[bytes]) -> l
             parts: list[dict[str, Any]] = [{"type": "text", "text": str(msg.get("content", ""))}]
             for img in images:
                 b64 = base64.b64encode(img).decode("ascii")
-                parts.append({"type": "image_url", "image_url": {"url": f"data:{image_mime(img)};base64,{b64}"}})
+                parts.append(
+                    {"type": "image_url", "image_url": {"url": f"data:{image_mime(img)};base64,{b64}"}}
+                )
             msg["content"] = parts
             break
     return out
@@ -54,7 +56,9 @@ class OpenAIBackend:
             raise UserError("llm.model is not set: pass --model NAME or set ANOMALYGEN_LLM__MODEL")
         key = config.api_key.get_secret_value() if config.api_key else os.environ.get("OPENAI_API_KEY")
         if not key and not config.base_url:
-            raise UserError("no OpenAI API key: set OPENAI_API_KEY or ANOMALYGEN_LLM__API_KEY (or --base-url for a local server)")
+            raise UserError(
+                "no OpenAI API key: set OPENAI_API_KEY or ANOMALYGEN_LLM__API_KEY (or --base-url for a local server)"
+            )
         self.model = config.model
         self.supports_images = bool(config.vision)
         self._openai = openai
@@ -85,7 +89,11 @@ class OpenAIBackend:
             if mode == "json_schema":
                 kwargs["response_format"] = {
                     "type": "json_schema",
-                    "json_schema": {"name": request.schema_name or "reply", "schema": request.schema_json, "strict": False},
+                    "json_schema": {
+                        "name": request.schema_name or "reply",
+                        "schema": request.schema_json,
+                        "strict": False,
+                    },
                 }
             elif mode == "json_object":
                 kwargs["response_format"] = {"type": "json_object"}
