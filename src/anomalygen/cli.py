@@ -273,9 +273,9 @@ def run_all(
     as_json: JsonOpt = False,
 ):
     """Run every stage end to end (resumable). Without a config: the embedded offline defaults."""
-    from anomalygen.pipeline import run_pipeline
+    from anomalygen.pipeline import demo_config_path, run_pipeline
 
-    settings = _common(config, seed, quiet, workers, executor, address, **{"brainstorm.n": n})
+    settings = _common(config or demo_config_path(), seed, quiet, workers, executor, address, **{"brainstorm.n": n})
     result = run_pipeline(_open_run(run, create=True, settings=settings), settings, force=force)
     if as_json:
         print(json.dumps(result, indent=2, default=str))
