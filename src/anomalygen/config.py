@@ -66,6 +66,8 @@ class BuildConfig(Section):
 class DetectConfig(Section):
     detector: Literal["rules", "llm", "hybrid"] = "rules"
     k: int = Field(3, ge=1, le=10)
+    llm_judge: bool = Field(True, description="when an LLM is configured, ask it about hypotheses exact+SBERT judged a miss")
+    judge_threshold: float | None = Field(None, ge=-1, le=1, description="SBERT judge threshold; default: the calibrated one")
 
 
 class LearnConfig(Section):
