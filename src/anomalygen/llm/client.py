@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 from pydantic import BaseModel, ValidationError
+from pydantic_core import PydanticSerializationError
 
 from anomalygen.errors import ItemFailed
 from anomalygen.llm.backends import Backend, PermanentError, RawReply, Request, TransientError
@@ -269,11 +270,18 @@ def parse_reply(text: str, schema: type[BaseModel]) -> BaseModel:
     if not isinstance(value, dict):
         raise ReplyInvalid(f"expected a JSON object, got a JSON {type(value).__name__}")
     try:
-        return schema.model_validate(value)
+        model = schema.model_validate(value)
     except ValidationError as exc:
         raise ReplyInvalid(format_validation_error(exc)) from None
     except (ValueError, TypeError, RecursionError) as exc:  # validators of odd inputs
         raise ReplyInvalid(f"invalid value: {_one_line(str(exc), 200)}") from None
+    try:  # it must be storable as an artefact: JSON escapes can smuggle in lone surrogates
+        model.model_dump_json()
+    except (PydanticSerializationError, UnicodeError, ValueError):
+        raise ReplyInvalid(
+            "the reply contains text that is not valid Unicode (e.g. a lone surrogate escape)"
+        ) from None
+    return model
 
 
 def _check_messages(messages: Any) -> None:

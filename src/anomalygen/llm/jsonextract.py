@@ -25,7 +25,10 @@ def extract_json(text: str) -> Any:
     """The first JSON object (or array) found in ``text``; raises ``JSONExtractError``."""
     if not isinstance(text, str) or not text.strip():
         raise JSONExtractError("the reply was empty; reply with a single JSON object")
-    text = text[:MAX_SCAN_CHARS]
+    if len(text) > MAX_SCAN_CHARS:
+        raise JSONExtractError(
+            f"the reply is too long ({len(text)} characters); reply with a compact JSON object"
+        )
     stripped = text.strip()
     try:
         return json.loads(stripped)

@@ -8,6 +8,7 @@ Why tool use: the API has no JSON mode, but a tool whose ``input_schema`` is our
 from __future__ import annotations
 
 import base64
+import inspect
 import json
 import os
 from typing import Any
@@ -43,6 +44,10 @@ class AnthropicBackend:
         self.model = config.model
         self.supports_images = bool(config.vision)
         self._anthropic = anthropic
+        # Recent SDKs dropped sampling parameters from ``messages.create``; send them only where accepted.
+        self._accepts_temperature = (
+            "temperature" in inspect.signature(anthropic.resources.messages.Messages.create).parameters
+        )
         self._client = anthropic.Anthropic(
             api_key=key or "not-needed", base_url=base, timeout=config.timeout_s, max_retries=0
         )
@@ -55,8 +60,9 @@ class AnthropicBackend:
             "model": self.model,
             "messages": messages,
             "max_tokens": request.max_tokens,
-            "temperature": min(request.temperature, 1.0),
         }
+        if self._accepts_temperature:
+            kwargs["temperature"] = min(request.temperature, 1.0)
         if system:
             kwargs["system"] = system
         tool_name = None
