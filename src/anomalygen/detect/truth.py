@@ -47,7 +47,11 @@ def task_text(task: TaskProposal) -> str:
     return ". ".join(p.strip().rstrip(".") for p in parts if p and p.strip())
 
 
-def ground_truth(task: TaskProposal, spec: SceneSpec | None, graph: SceneGraph | None) -> GroundTruth:
+def ground_truth(
+    task: TaskProposal, spec: SceneSpec | None, graph: SceneGraph | None, *, hazard_variable: str | None = None
+) -> GroundTruth:
+    """``hazard_variable`` is the knowledge-base class's variable for the object at fault (``$target``
+    for an open fridge); its binding counts as well as ``$hazard``'s."""
     instances: set[str] = set()
     categories: set[str] = set()
     by_name = {norm_name(o.name): o for o in graph.objects} if graph is not None else {}
@@ -56,6 +60,8 @@ def ground_truth(task: TaskProposal, spec: SceneSpec | None, graph: SceneGraph |
     chosen = [bindings["$hazard"]] if "$hazard" in bindings else []
     if "$target" in bindings and (not chosen or norm_name(bindings["$target"]) == norm_name(chosen[0])):
         chosen.append(bindings["$target"])
+    if hazard_variable and hazard_variable in bindings:
+        chosen.append(bindings[hazard_variable])
     for inst in chosen:
         key = norm_name(inst)
         instances.add(key)
@@ -65,7 +71,7 @@ def ground_truth(task: TaskProposal, spec: SceneSpec | None, graph: SceneGraph |
             categories.add(norm_name(spec_cat[key]))
     if not instances:  # no built scene: the proposal's catalogue names
         categories.add(norm_name(task.scenario.hazard_object))
-        if norm_name(task.scenario.hazard_object) == norm_name(task.target_asset):
+        if hazard_variable == "$target" or norm_name(task.scenario.hazard_object) == norm_name(task.target_asset):
             categories.add(norm_name(task.target_asset))
     shown = sorted(instances) or sorted(categories)
     return GroundTruth(

@@ -1,0 +1,141 @@
+"""The rule detector: every knowledge-base hazard class's preconditions, evaluated on the scene graph.
+
+Why rules at all: they need no LLM, are deterministic, and every hit comes with the predicate
+explanations that made it fire, so a miss can be traced to a knowledge-base rule rather than to a
+model's mood. They read only the scene graph (through the same predicates planning and evaluation
+use), never the task.
+
+Ranking. Each (object, class) pair is one candidate, scored by the class's severity, plus a small
+bonus for specificity (a class with more preconditions that all hold is a sharper explanation of the
+same object than a generic one). When several objects are hazardous, the top of the list should
+cover them all rather than repeat one object under three classes, so each further hypothesis about
+an object already listed pays a diversity penalty.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from anomalygen.schema import Hypothesis, SceneGraph
+
+#: Score bonus per precondition beyond the first (specificity), kept below the gaps between severities.
+SPECIFICITY_BONUS = 0.01
+#: Penalty for each hypothesis already listed about the same object (coverage of several hazards).
+REPEAT_PENALTY = 0.12
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One hazard class firing on one object, before ranking."""
+
+    hazard_class: str
+    object: str
+    category: str
+    severity: float
+    score: float
+    problem: str
+    solution: str
+    explanation: str
+    bindings: tuple[tuple[str, str], ...]
+
+
+def _fill(template: str, slots: dict[str, str]) -> str:
+    out = template
+    for key, value in slots.items():
+        out = out.replace("{" + key + "}", value)
+    return out
+
+
+def _hazard_instance(hc, bindings: dict[str, str]) -> str:
+    """The object the class is about: its hazard variable, else $target, else the first binding."""
+    for var in (hc.hazard_variable, "$hazard", "$target"):
+        if var in bindings:
+            return bindings[var]
+    return next(iter(bindings.values()), "")
+
+
+def candidates(graph: SceneGraph, kb=None) -> list[Candidate]:
+    """Every (object, class) hit in the scene, de-duplicated (best match kept), unranked."""
+    from anomalygen.knowledge.predicates import PredicateError, match_class
+
+    kb = kb if kb is not None else _kb()
+    by_name = {o.name: o for o in graph.objects}
+    best: dict[tuple[str, str], Candidate] = {}
+    for hc_id in sorted(kb.hazard_classes):
+        hc = kb.hazard_classes[hc_id]
+        try:
+            matches = match_class(hc, graph)
+        except PredicateError:
+            continue  # a malformed rule must not hide every other class; KB tests catch it
+        for m in matches:
+            obj = _hazard_instance(hc, m.bindings)
+            if obj not in by_name:
+                continue
+            category = by_name[obj].category
+            slots = {"hazard": obj, "target": m.bindings.get("$target", obj)}
+            slots["container"] = m.bindings.get("$container") or (hc.default_containers[0].replace("_", " ") if hc.default_containers else "a safe place")
+            slots["support"] = m.bindings.get("$support") or (hc.default_supports[0].replace("_", " ") if hc.default_supports else "a safe surface")
+            solution = _fill(hc.solution, slots) if hc.solution else "; ".join(_fill(str(s), {}) for s in hc.recipe)
+            score = hc.severity + SPECIFICITY_BONUS * max(0, len(hc.preconditions) - 1) + 0.001 * m.score
+            cand = Candidate(
+                hazard_class=hc.id,
+                object=obj,
+                category=category,
+                severity=hc.severity,
+                score=round(score, 6),
+                problem=f"{hc.name}: {obj} ({category.replace('_', ' ')}) — {hc.why}",
+                solution=solution,
+                explanation=f"{hc.id} holds because {m.explanation}",
+                bindings=tuple(sorted(m.bindings.items())),
+            )
+            key = (obj, hc.id)
+            if key not in best or (cand.score, cand.bindings) > (best[key].score, best[key].bindings):
+                best[key] = cand
+    return list(best.values())
+
+
+def rank(cands: list[Candidate], k: int) -> list[Candidate]:
+    """Greedy ranking by score with a penalty for objects already listed; deterministic ties."""
+    pool = sorted(cands, key=lambda c: (-c.score, c.object, c.hazard_class))
+    chosen: list[Candidate] = []
+    seen: dict[str, int] = {}
+    while pool and len(chosen) < k:
+        best_i = min(
+            range(len(pool)),
+            key=lambda i: (-(pool[i].score - REPEAT_PENALTY * seen.get(pool[i].object, 0)), i),
+        )
+        c = pool.pop(best_i)
+        chosen.append(c)
+        seen[c.object] = seen.get(c.object, 0) + 1
+    return chosen
+
+
+def to_hypotheses(ranked: list[Candidate]) -> list[Hypothesis]:
+    return [
+        Hypothesis(
+            rank=i,
+            problem=c.problem,
+            solution=c.solution,
+            target_object=c.object,
+            hazard_class=c.hazard_class,
+            score=c.score,
+            explanation=c.explanation,
+        )
+        for i, c in enumerate(ranked, start=1)
+    ]
+
+
+class RuleDetector:
+    name = "rules"
+
+    def __init__(self, kb=None):
+        self.kb = kb
+
+    def detect(self, graph: SceneGraph, k: int) -> list[Hypothesis]:
+        return to_hypotheses(rank(candidates(graph, self.kb), k))
+
+
+def _kb():
+    from anomalygen.knowledge import load_kb
+
+    return load_kb()

@@ -1,0 +1,182 @@
+"""Stage 3 entry point: detect the hazard in every built scene, judge it, collate, summarise.
+
+Per scene (one runner item): read ``scene_graph.json`` (the only input a detector sees), run the
+configured detector, then judge its hypotheses against the hidden task and write
+``detections/<task_id>.json``. A detector failure (an LLM that never produced a valid reply) is
+recorded in that scene's ``Detection.error`` and counts as a miss; it never ends the batch. After the
+items: collate ``detections.jsonl`` atomically in task order, write ``detections_summary.json`` and
+print the hit@k table.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Any
+
+from anomalygen.errors import ItemFailed, UserError
+from anomalygen.runfolder import RunFolder, try_read_model, write_jsonl, write_model
+from anomalygen.runner import StageContext, StageSummary, run_items
+from anomalygen.schema import Detection, SceneGraph, SceneSpec, TaskProposal
+
+STAGE = "detect"
+
+
+def summary_path(run: RunFolder):
+    return run.root / "detections_summary.json"
+
+
+def detection_path(run: RunFolder, task_id: str):
+    return run.detections_dir / f"{task_id}.json"
+
+
+@functools.cache
+def _client(llm_json: str):
+    """One LLM client per process and configuration (its cache and HTTP pool are reused across scenes)."""
+    from anomalygen.config import LLMConfig
+    from anomalygen.llm import get_client
+
+    return get_client(LLMConfig.model_validate_json(llm_json))
+
+
+def make_detector(settings):
+    """The configured detector; 'llm' and 'hybrid' need an LLM and say so clearly when there is none."""
+    from anomalygen.detect.rules import RuleDetector
+
+    name = settings.detect.detector
+    if name == "rules":
+        return RuleDetector()
+    if not settings.llm.configured:
+        raise UserError(f"detector '{name}' needs an LLM: pass --backend openai|anthropic|llamacpp (or use --detector rules)")
+    client = _client(settings.llm.model_dump_json())
+    if name == "llm":
+        from anomalygen.detect.llm_detector import LLMDetector
+
+        return LLMDetector(client)
+    from anomalygen.detect.hybrid import HybridDetector
+
+    return HybridDetector(client)
+
+
+def make_judge(settings):
+    from anomalygen.detect.judge import Judge
+
+    client = None
+    if settings.llm.configured and settings.detect.llm_judge:
+        client = _client(settings.llm.model_dump_json())
+    # Rule and hybrid hypotheses name a knowledge-base class, so the exact comparison decides them.
+    decisive = settings.detect.detector in ("rules", "hybrid")
+    return Judge(threshold=settings.detect.judge_threshold, llm_client=client, structured_decisive=decisive)
+
+
+def detect_scene(task: TaskProposal, graph: SceneGraph, spec: SceneSpec | None, settings, *, detector=None, judge=None) -> Detection:
+    """Detect and judge one scene (pure apart from LLM calls): what the item function writes."""
+    from anomalygen.detect.judge import first_hit, miss_reason
+    from anomalygen.detect.truth import ground_truth
+    from anomalygen.llm import LLMItemError
+
+    detector = detector or make_detector(settings)
+    judge = judge or make_judge(settings)
+    error = None
+    try:
+        hyps = detector.detect(graph, settings.detect.k)
+    except LLMItemError as exc:
+        hyps, error = [], str(exc)
+    truth = ground_truth(task, spec, graph, hazard_variable=_hazard_variable(task.hazard_class))
+    judgements = judge.judge(hyps, truth, graph)
+    hit = first_hit(judgements)
+    return Detection(
+        task_id=task.id,
+        scene_id=graph.scene_id,
+        detector=settings.detect.detector,
+        hypotheses=hyps,
+        judgements=judgements,
+        hit_rank=hit,
+        miss_reason=None if hit is not None else (f"detector failed: {error}" if error else miss_reason(hyps, judgements, truth)),
+        error=error,
+    )
+
+
+def _hazard_variable(class_id: str) -> str | None:
+    """The knowledge base's variable for the object at fault of a class (None for unknown classes)."""
+    from anomalygen.knowledge import load_kb
+
+    hc = load_kb().hazard_classes.get(class_id)
+    return hc.hazard_variable if hc is not None else None
+
+
+def _item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str, Any]:
+    run, settings = ctx.run, ctx.settings
+    scene_dir = run.scene_dir(task_id)
+    graph = try_read_model(scene_dir / "scene_graph.json", SceneGraph)
+    if graph is None:
+        raise ItemFailed(f"no valid scene_graph.json in {scene_dir} (build the scene first)")
+    spec = try_read_model(scene_dir / "scene.json", SceneSpec)
+    task = TaskProposal.model_validate(payload)
+    detector = make_detector(settings)
+    judge = make_judge(settings)
+    usage_before = None
+    client = getattr(detector, "client", None) or judge.llm
+    if client is not None:
+        client.reset_usage()
+    det = detect_scene(task, graph, spec, settings, detector=detector, judge=judge)
+    write_model(detection_path(run, task_id), det)
+    if client is not None:
+        usage_before = client.reset_usage().model_dump()
+    return {
+        "hit_rank": det.hit_rank,
+        "error": det.error,
+        "fallback": getattr(detector, "fell_back", None),
+        "usage": usage_before,
+    }
+
+
+def _is_done_for(run: RunFolder, settings):
+    def is_done(task_id: str) -> bool:
+        det = try_read_model(detection_path(run, task_id), Detection)
+        return (det is not None and det.error is None and det.detector == settings.detect.detector
+                and len(det.hypotheses) <= settings.detect.k)
+    return is_done
+
+
+def run_stage(run: RunFolder, settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
+    from anomalygen.detect.report import print_report, summarise
+
+    tasks = run.load_tasks()
+    if only:
+        unknown = sorted(set(only) - {t.id for t in tasks})
+        if unknown:
+            raise UserError(f"unknown task id(s): {', '.join(unknown)}")
+    make_detector(settings)  # fail fast (no LLM for llm/hybrid) before any item runs
+    chosen = [t for t in tasks if not only or t.id in only]
+    items = [(t.id, t.model_dump(mode="json")) for t in chosen]
+    summary = run_items(run, STAGE, items, _item, settings=settings, is_done=_is_done_for(run, settings), force=force,
+                        description=f"detect ({settings.detect.detector})")
+    _record_llm_usage(run, summary)
+
+    detections = [d for t in tasks if (d := try_read_model(detection_path(run, t.id), Detection)) is not None]
+    write_jsonl(run.detections_path, detections)
+    report = summarise(detections, tasks, settings.detect.k)
+    write_model(summary_path(run), report)
+    fallbacks = sum(1 for r in summary.results.values() if isinstance(r, dict) and r.get("fallback"))
+    if not settings.quiet:
+        from rich.console import Console
+
+        console = Console(stderr=True)
+        print_report(report, console=console)
+        if fallbacks:
+            console.print(f"[yellow]{fallbacks} scene(s): LLM ranking failed, rule order kept[/yellow]")
+    summary.results["report"] = report.model_dump(mode="json")
+    return summary
+
+
+def _record_llm_usage(run: RunFolder, summary: StageSummary) -> None:
+    from anomalygen.schema import LLMUsage
+
+    total = LLMUsage()
+    for r in summary.results.values():
+        if isinstance(r, dict) and r.get("usage"):
+            total.add(LLMUsage.model_validate(r["usage"]))
+    if total.requests or total.cache_hits:
+        from anomalygen.llm import record_usage
+
+        record_usage(run, total)
