@@ -1,0 +1,231 @@
+"""Loading the knowledge base from its data files, plus the queries other stages need.
+
+The data lives in JSON (``anomalygen/data/knowledge/``) so it can be reviewed and extended without
+touching code; this module validates it once, caches it, and answers questions such as "which
+catalogue objects can be the hazard of this class?" from the same data the predicates use.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+from pathlib import Path
+from typing import Any
+
+from anomalygen.knowledge.models import (
+    PLACEMENT_PREFIXES,
+    PLACEMENTS,
+    PROPERTIES,
+    RECIPE_ARGS,
+    ROOMS,
+    HazardClass,
+    ObjectInfo,
+    RoleProfile,
+)
+from anomalygen.schema import HazardCategory, PredicateCall
+
+#: Placement -> the support kind an object must usually rest on for it to be plausible.
+PLACEMENT_SUPPORT: dict[str, str] = {
+    "floor": "floor",
+    "walkway": "floor",
+    "table": "table",
+    "low_table": "low_table",
+    "table_edge": "table",
+    "counter": "counter",
+    "counter_edge": "counter",
+    "shelf": "shelf",
+}
+
+
+DATA_DIR = Path(__file__).resolve().parent.parent / "data"
+KNOWLEDGE_DIR = DATA_DIR / "knowledge"
+
+
+def _data(name: str) -> Any:
+    return json.loads((KNOWLEDGE_DIR / name).read_text(encoding="utf-8"))
+
+
+def vocabulary() -> dict[str, Any]:
+    return json.loads((DATA_DIR / "vocabulary.json").read_text(encoding="utf-8"))
+
+
+class KnowledgeBase:
+    """Hazard classes, object knowledge and role profiles, validated and indexed."""
+
+    def __init__(self, hazard_classes: list[HazardClass], objects: list[ObjectInfo], roles: list[RoleProfile]):
+        self.hazard_classes: dict[str, HazardClass] = {hc.id: hc for hc in hazard_classes}
+        self.objects: dict[str, ObjectInfo] = {o.name: o for o in objects}
+        self.roles: dict[str, RoleProfile] = {r.id: r for r in roles}
+
+    # ------------------------------------------------------------------ simple views
+    @property
+    def targets(self) -> list[str]:
+        return [n for n, o in self.objects.items() if o.kind == "target"]
+
+    @property
+    def household(self) -> list[str]:
+        return [n for n, o in self.objects.items() if o.kind == "household"]
+
+    def paper_classes(self) -> list[HazardClass]:
+        return [hc for hc in self.hazard_classes.values() if hc.paper_class]
+
+    def classes_in(self, category: HazardCategory | str) -> list[HazardClass]:
+        return [hc for hc in self.hazard_classes.values() if hc.category == category]
+
+    def properties_of(self, name: str) -> list[str]:
+        """Perceived properties of a catalogue object (what the scene builder puts in GraphObject.properties)."""
+        info = self.objects.get(name)
+        return list(info.properties) if info else []
+
+    def benign_objects(self) -> list[str]:
+        """Household objects with no hazard-relevant property: safe clutter that triggers no class."""
+        from anomalygen.knowledge.models import HAZARD_PROPERTIES
+
+        blocked = HAZARD_PROPERTIES | {"furniture", "appliance", "container"}
+        return [n for n, o in self.objects.items() if o.kind == "household" and not (set(o.properties) & blocked)]
+
+    # ------------------------------------------------------------------ class queries
+    def static_candidates(self, hc: HazardClass, variable: str) -> list[str]:
+        """Catalogue names that satisfy every object-intrinsic precondition on ``variable``.
+
+        Intrinsic means decidable from the object alone (``has_property``, ``category_is``); the
+        situational ones (height, joints, walkway) are what a scenario sets up.
+        """
+        calls = [
+            c
+            for c in hc.preconditions
+            if c.name in ("has_property", "category_is", "joint_open", "joint_closed") and c.args.get("object") == variable
+        ]
+        return [name for name, info in self.objects.items() if all(_static_holds(c, info) for c in calls)]
+
+    def hazard_candidates(self, hc: HazardClass) -> list[str]:
+        """Catalogue objects that can be the hazard of ``hc`` (the curated list, if any, filtered)."""
+        able = self.static_candidates(hc, hc.hazard_variable)
+        if hc.hazard_objects:
+            return [n for n in hc.hazard_objects if n in able]
+        return able
+
+    def containers_for(self, hc: HazardClass, obj: str) -> list[str]:
+        """Where ``obj`` can be put away for class ``hc``: class defaults the object fits, in class order."""
+        if not hc.default_containers:
+            return []
+        own = self.objects[obj].containers if obj in self.objects else []
+        both = [c for c in hc.default_containers if c in own]
+        return both or list(hc.default_containers)
+
+    def placements_for(self, hc: HazardClass, obj: str) -> list[str]:
+        """Class placements that are plausible for ``obj`` given where it usually rests."""
+        info = self.objects.get(obj)
+        out = []
+        for p in hc.placements:
+            if p.startswith("inside:"):
+                if info is None or p.split(":", 1)[1] in info.containers or p.split(":", 1)[1] == "Refrigerator":
+                    out.append(p)
+            elif info is None or not info.supports or PLACEMENT_SUPPORT.get(p) in info.supports or p.startswith("on:"):
+                out.append(p)
+        return out or list(hc.placements)
+
+    def articulation_part(self, hc: HazardClass, obj: str) -> str | None:
+        """The concrete joint label of ``obj`` that ``hc``'s articulation is about (first alternative it has)."""
+        if hc.articulation is None:
+            return None
+        info = self.objects.get(obj)
+        labels = [p.label for p in info.parts] if info else []
+        alts = hc.articulation.part.split("|")
+        return next((a for a in alts if a in labels), None)
+
+    # ------------------------------------------------------------------ consistency
+    def problems(self) -> list[str]:
+        """Every broken reference in the data; empty when the knowledge base is consistent."""
+        from anomalygen.knowledge.predicates import PREDICATES
+
+        out: list[str] = []
+        names = set(self.objects)
+        voc = vocabulary()
+        missing = (set(voc["targets"]) | set(voc["household"])) - names
+        if missing:
+            out.append(f"vocabulary names without ObjectInfo: {sorted(missing)}")
+        for o in self.objects.values():
+            out += [f"object {o.name}: unknown property {p}" for p in o.properties if p not in PROPERTIES]
+            out += [f"object {o.name}: unknown room {r}" for r in o.rooms if r not in ROOMS]
+            out += [f"object {o.name}: unknown container {c}" for c in o.containers if c not in names]
+            out += [f"object {o.name}: unknown support {s}" for s in o.supports if s not in PLACEMENT_SUPPORT.values()]
+            lo, hi = o.size_range
+            if not 0 < lo <= hi:
+                out.append(f"object {o.name}: bad size_range {o.size_range}")
+        for hc in self.hazard_classes.values():
+            where = f"class {hc.id}"
+            if not hc.preconditions or not hc.recipe or not hc.success:
+                out.append(f"{where}: needs preconditions, recipe and success")
+            declared = set(hc.variables)
+            if hc.hazard_variable not in declared:
+                out.append(f"{where}: hazard_variable {hc.hazard_variable} not declared")
+            for call in [*hc.preconditions, *hc.success]:
+                out += [f"{where}: {m}" for m in _call_problems(call, PREDICATES, names, declared)]
+            for step in hc.recipe:
+                allowed = RECIPE_ARGS[step.action]
+                if set(step.args) - set(allowed) or "object" not in step.args:
+                    out.append(f"{where}: recipe step {step} has wrong arguments (wants {allowed})")
+                for v in step.args.values():
+                    if v.startswith("$") and v not in declared:
+                        out.append(f"{where}: recipe uses undeclared variable {v}")
+            for p in hc.placements:
+                ok = p in PLACEMENTS or any(p.startswith(x) and p[len(x):] in names for x in PLACEMENT_PREFIXES)
+                if not ok:
+                    out.append(f"{where}: unknown placement {p}")
+            out += [f"{where}: unknown container {c}" for c in hc.default_containers if c not in names]
+            out += [f"{where}: unknown support {c}" for c in hc.default_supports if c not in names]
+            out += [f"{where}: target {t} is not a target category" for t in hc.target_assets if t not in voc["targets"]]
+            out += [f"{where}: unknown room {r}" for r in hc.rooms if r not in ROOMS]
+            if "$container" in declared and not hc.default_containers:
+                out.append(f"{where}: uses $container but has no default_containers")
+            if "$support" in declared and not hc.default_supports:
+                out.append(f"{where}: uses $support but has no default_supports")
+            bad = [n for n in hc.hazard_objects if n not in self.static_candidates(hc, hc.hazard_variable)]
+            if bad:
+                out.append(f"{where}: hazard_objects {bad} do not meet the class's intrinsic preconditions")
+            if not self.hazard_candidates(hc):
+                out.append(f"{where}: no catalogue object can be its hazard")
+        for r in self.roles.values():
+            out += [f"role {r.id}: unknown class {c}" for c in r.class_interests if c not in self.hazard_classes]
+            out += [f"role {r.id}: unknown object {o}" for o in r.object_interests if o not in names]
+            out += [f"role {r.id}: unknown room {x}" for x in r.room_interests if x not in ROOMS]
+        return out
+
+
+def _static_holds(call: PredicateCall, info: ObjectInfo) -> bool:
+    if call.name in ("joint_open", "joint_closed"):  # the object must at least have such a part
+        labels = str(call.args.get("label", "*")).split("|")
+        return "*" in labels or any(p.label in labels for p in info.parts)
+    alts = [a for a in str(call.args.get("property" if call.name == "has_property" else "category", "")).split("|") if a]
+    if call.name == "has_property":
+        holds = any(a in info.properties for a in alts)
+    else:
+        holds = info.name in alts
+    return holds != call.negate
+
+
+def _call_problems(call: PredicateCall, predicates, names: set[str], declared: set[str]) -> list[str]:
+    spec = predicates.get(call.name)
+    if spec is None:
+        return [f"unknown predicate {call.name}"]
+    out = [f"{call.name}: unknown argument {a}" for a in call.args if a not in spec.args]
+    for a, v in call.args.items():
+        if isinstance(v, str) and v.startswith("$") and v not in declared:
+            out.append(f"{call.name}: undeclared variable {v}")
+    if call.name == "has_property":
+        out += [f"unknown property {p}" for p in str(call.args.get("property", "")).split("|") if p not in PROPERTIES]
+    if call.name == "category_is":
+        out += [f"unknown category {c}" for c in str(call.args.get("category", "")).split("|") if c not in names]
+    if call.name == "room_is":
+        out += [f"unknown room {r}" for r in str(call.args.get("room", "")).split("|") if r not in ROOMS]
+    return out
+
+
+@functools.cache
+def load_kb() -> KnowledgeBase:
+    """The bundled knowledge base (validated, cached for the process)."""
+    classes = [HazardClass.model_validate(c) for c in _data("hazard_classes.json")["classes"]]
+    objects = [ObjectInfo.model_validate({"name": n, **o}) for n, o in _data("objects.json")["objects"].items()]
+    roles = [RoleProfile.model_validate(r) for r in _data("roles.json")["roles"]]
+    return KnowledgeBase(classes, objects, roles)

@@ -1,0 +1,209 @@
+"""Typed records of the household-hazard knowledge base.
+
+The knowledge base is data (JSON under ``anomalygen/data/knowledge/``); these classes are its
+contract. They are strict so a typo in a data file fails loudly at load time instead of silently
+weakening a hazard rule that detection, planning and evaluation all rely on.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from anomalygen.schema import HazardCategory, PredicateCall, ScalarArg
+
+#: Hazard-relevant object properties. Every ``has_property`` argument and every object's
+#: ``properties`` entry must be one of these.
+PROPERTIES: tuple[str, ...] = (
+    "sharp",
+    "choking_size",
+    "toxic",
+    "medication",
+    "perishable",
+    "spoiled",
+    "fragile",
+    "electrical",
+    "hot",
+    "heavy",
+    "flammable",
+    "cable",
+    "litter",
+    "container",
+    "furniture",
+    "appliance",
+    "soft",
+)
+
+#: Properties that make an object part of *some* hazard; objects with none of them are safe clutter.
+HAZARD_PROPERTIES: frozenset[str] = frozenset(
+    {"sharp", "choking_size", "toxic", "medication", "perishable", "spoiled", "fragile", "hot", "heavy", "flammable", "cable", "litter"}
+)
+
+#: Support surfaces and their typical top heights (metres). The scene builder uses these heights; the
+#: predicates' height thresholds (0.55 m "low", 0.6 m "raised", 1.0 m "child reach") rely on them.
+SUPPORT_HEIGHTS: dict[str, tuple[float, float]] = {
+    "floor": (0.0, 0.0),
+    "low_table": (0.35, 0.5),
+    "table": (0.7, 0.8),
+    "counter": (0.85, 0.95),
+    "shelf": (1.2, 1.6),
+}
+
+#: The scenario placements the scene builder implements (``TaskProposal.scenario.placement``).
+#: ``inside:<name>`` and ``on:<name>`` take a catalogue name.
+PLACEMENTS: tuple[str, ...] = (
+    "floor",
+    "walkway",
+    "table",
+    "low_table",
+    "table_edge",
+    "counter",
+    "counter_edge",
+    "shelf",
+)
+PLACEMENT_PREFIXES: tuple[str, ...] = ("inside:", "on:")
+
+ROOMS: tuple[str, ...] = (
+    "kitchen",
+    "living_room",
+    "bedroom",
+    "bathroom",
+    "hallway",
+    "office",
+    "laundry_room",
+    "nursery",
+)
+
+RecipeAction = Literal[
+    "pick",
+    "place_inside",
+    "place_on",
+    "open_joint",
+    "close_joint",
+    "switch_off",
+    "move_away_from_edge",
+]
+
+#: Arguments each recipe action takes (all values are role variables or literal labels).
+RECIPE_ARGS: dict[str, tuple[str, ...]] = {
+    "pick": ("object",),
+    "place_inside": ("object", "container"),
+    "place_on": ("object", "support"),
+    "open_joint": ("object", "label"),
+    "close_joint": ("object", "label"),
+    "switch_off": ("object", "label"),
+    "move_away_from_edge": ("object",),
+}
+
+
+class KBModel(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class RecipeStep(KBModel):
+    """One sub-task type of a fix, e.g. ``place_inside(object=$hazard, container=$container)``."""
+
+    action: RecipeAction
+    args: dict[str, str] = Field(default_factory=dict)
+
+    def __str__(self) -> str:
+        inner = ", ".join(f"{k}={v}" for k, v in self.args.items())
+        return f"{self.action}({inner})"
+
+
+class ArticulationTemplate(KBModel):
+    """The articulated part a class is about and the state a scenario starts in (e.g. fridge door open)."""
+
+    variable: str = Field(description="role variable of the articulated object, e.g. $target")
+    part: str = Field(description="joint label: door, drawer, lid, knob, window, ...; alternatives 'a|b' (the object's own label is used)")
+    initial_state: Literal["open", "closed", "on", "off", "other"]
+    target_state: Literal["open", "closed", "on", "off", "other"]
+    function: str = ""
+
+
+class HazardClass(KBModel):
+    """One kind of household anomaly: how to see it in a scene graph, how to fix it, how to check the fix."""
+
+    id: str
+    name: str
+    category: HazardCategory
+    paper_class: bool = Field(description="one of the paper's 11 classes")
+    at_risk: str = Field(description="who is in danger, in a phrase")
+    people: list[str] = Field(default_factory=list, description="concrete people at risk, for scenario texts")
+    why: str = Field(description="why it is dangerous or unhygienic, one or two sentences")
+    severity: float = Field(ge=0, le=1, description="ranking weight; resolves overlaps between classes")
+    variables: dict[str, str] = Field(description="role variable -> what it is bound to")
+    hazard_variable: str = Field("$hazard", description="variable bound to Scenario.hazard_object (what the fix acts on)")
+    preconditions: list[PredicateCall]
+    recipe: list[RecipeStep]
+    success: list[PredicateCall]
+    placements: list[str] = Field(description="scenario placements under which the class can be set up")
+    default_containers: list[str] = Field(default_factory=list)
+    default_supports: list[str] = Field(default_factory=list, description="catalogue names for $support (place_on)")
+    hazard_objects: list[str] = Field(
+        default_factory=list,
+        description="curated catalogue names for the hazard variable; empty = every object meeting its intrinsic preconditions",
+    )
+    target_assets: list[str] = Field(description="target categories a proposal of this class may name")
+    rooms: list[str] = Field(default_factory=list)
+    articulation: ArticulationTemplate | None = None
+    mechanism: str = Field("", description="the hazard mechanism in a short phrase (borrowed in brainstorming)")
+    solution: str = Field("", description="the fix in words, with {hazard}/{container}/{support} slots")
+    success_text: str = Field("", description="the safe end state in words, same slots")
+
+    def variable_names(self) -> list[str]:
+        """Variables in first-use order across preconditions (the order match_class binds them)."""
+        seen: list[str] = []
+        for call in self.preconditions:
+            for value in call.args.values():
+                if isinstance(value, str) and value.startswith("$") and value not in seen:
+                    seen.append(value)
+        return seen
+
+
+class PartInfo(KBModel):
+    label: str = Field(description="joint label as in JointState.label: door, drawer, lid, knob, ...")
+    safe_state: Literal["open", "closed", "on", "off", "any"]
+    joint_type: Literal["hinge", "slide"]
+
+
+class ObjectInfo(KBModel):
+    name: str
+    kind: Literal["target", "household"]
+    description: str = ""
+    properties: list[str] = Field(default_factory=list)
+    size_range: tuple[float, float] = Field(description="largest dimension, metres (min, max)")
+    rooms: list[str] = Field(default_factory=list)
+    supports: list[str] = Field(default_factory=list, description="surfaces it usually rests on")
+    containers: list[str] = Field(default_factory=list, description="catalogue names it can be stored in")
+    parts: list[PartInfo] = Field(default_factory=list)
+
+    def has(self, prop: str) -> bool:
+        return prop in self.properties
+
+    def part(self, label: str) -> PartInfo | None:
+        return next((p for p in self.parts if p.label == label), None)
+
+
+class RoleProfile(KBModel):
+    """A household role for brainstorming agents, with weighted interests (weights are relative)."""
+
+    id: str
+    name: str
+    description: str
+    perspective: str = Field(description="how this role looks at a home, used in prompts and texts")
+    class_interests: dict[str, float] = Field(default_factory=dict)
+    object_interests: dict[str, float] = Field(default_factory=dict)
+    room_interests: dict[str, float] = Field(default_factory=dict)
+
+
+class PredicateSpec(KBModel):
+    """Documentation of one predicate: its arguments and meaning (used by docs and consistency tests)."""
+
+    name: str
+    args: dict[str, str]
+    meaning: str
+
+
+ArgValue = ScalarArg

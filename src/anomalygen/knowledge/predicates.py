@@ -1,0 +1,375 @@
+"""Predicates over a :class:`~anomalygen.schema.SceneGraph`: the one vocabulary for hazards and fixes.
+
+Detection (is this scene hazardous?), planning (what must hold after each step?) and evaluation (did
+the robot make the scene safe?) all evaluate the same predicates on the same observation, so a hazard
+class means one thing everywhere. Predicates read only the scene graph (never the task), which is
+what keeps the rule detector honest.
+
+Argument values that start with ``$`` are role variables resolved through ``bindings``; ``"*"``
+means "any object"; several alternatives are written ``"a|b"``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable
+
+from pydantic import BaseModel, ConfigDict
+
+from anomalygen.knowledge.models import PredicateSpec
+from anomalygen.schema import GraphObject, PredicateCall, PredicateResult, SceneGraph
+
+#: Horizontal clearance (m) from furniture/appliances beyond which a floor object is "in the walkway".
+WALKWAY_CLEARANCE = 0.3
+#: Properties of the objects that line a room (a floor object close to one of them is out of the way).
+_ROOM_FIXTURES = ("furniture", "appliance")
+
+
+class PredicateError(ValueError):
+    """A call that cannot be evaluated: unknown predicate, missing argument, unbound variable."""
+
+
+class Match(BaseModel):
+    """One way a hazard class holds in a scene: variable bindings, why, and a ranking score."""
+
+    model_config = ConfigDict(frozen=True)
+
+    bindings: dict[str, str]
+    explanation: str
+    score: float
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+class _Ctx:
+    def __init__(self, graph: SceneGraph, bindings: dict[str, str]):
+        self.graph = graph
+        self.bindings = bindings
+        self._by_name = {o.name: o for o in graph.objects}
+
+    def name(self, call: PredicateCall, arg: str) -> str:
+        if arg not in call.args:
+            raise PredicateError(f"{call.name}: missing argument '{arg}'")
+        value = str(call.args[arg])
+        if value.startswith("$"):
+            if value not in self.bindings:
+                raise PredicateError(f"{call.name}: variable {value} is not bound")
+            return self.bindings[value]
+        return value
+
+    def obj(self, call: PredicateCall, arg: str = "object") -> GraphObject:
+        name = self.name(call, arg)
+        try:
+            return self._by_name[name]
+        except KeyError:
+            raise PredicateError(f"{call.name}: no object '{name}' in scene {self.graph.scene_id}") from None
+
+    def num(self, call: PredicateCall, arg: str, default: float | None = None) -> float | None:
+        if arg not in call.args:
+            return default
+        try:
+            return float(call.args[arg])
+        except (TypeError, ValueError):
+            raise PredicateError(f"{call.name}: argument '{arg}' must be a number, got {call.args[arg]!r}") from None
+
+    def relations(self, subject: str, predicate: str) -> list[str | None]:
+        return [r.object for r in self.graph.relations if r.subject == subject and r.predicate == predicate]
+
+
+def _alternatives(value: object) -> list[str]:
+    return [v.strip() for v in str(value).split("|") if v.strip()]
+
+
+def _base(instance: str | None) -> str | None:
+    """``counter_0:top`` -> ``counter_0`` (relations may name a surface of an object)."""
+    return None if instance is None else instance.split(":", 1)[0]
+
+
+def aabb_gap(a: GraphObject, b: GraphObject, *, horizontal: bool = False) -> float:
+    """Distance between two axis-aligned boxes (0 when they touch or overlap)."""
+    axes = (0, 1) if horizontal else (0, 1, 2)
+    gaps = [max(0.0, abs(a.position[i] - b.position[i]) - (a.size[i] + b.size[i]) / 2) for i in axes]
+    return math.sqrt(sum(g * g for g in gaps))
+
+
+def _label_matches(label: str, wanted: list[str]) -> bool:
+    return "*" in wanted or label in wanted
+
+
+# --------------------------------------------------------------------------- predicates
+
+Impl = Callable[[_Ctx, PredicateCall], tuple[bool, str]]
+PREDICATES: dict[str, PredicateSpec] = {}
+_IMPLS: dict[str, Impl] = {}
+
+
+def _predicate(name: str, args: dict[str, str], meaning: str):
+    def deco(fn: Impl) -> Impl:
+        PREDICATES[name] = PredicateSpec(name=name, args=args, meaning=meaning)
+        _IMPLS[name] = fn
+        return fn
+
+    return deco
+
+
+@_predicate(
+    "has_property",
+    {"object": "variable or instance", "property": "a property, or alternatives 'a|b' (any of them)"},
+    "The object's perceived properties include the property (any of the alternatives).",
+)
+def _has_property(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    obj = ctx.obj(call)
+    wanted = _alternatives(call.args.get("property", ""))
+    found = [p for p in wanted if p in obj.properties]
+    return bool(found), f"{obj.name} is {'/'.join(found) or 'not ' + '/'.join(wanted)}"
+
+
+@_predicate(
+    "category_is",
+    {"object": "variable or instance", "category": "catalogue name, or alternatives 'A|B'"},
+    "The object's catalogue category is one of the given names.",
+)
+def _category_is(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    obj = ctx.obj(call)
+    wanted = _alternatives(call.args.get("category", ""))
+    return obj.category in wanted, f"{obj.name} is a {obj.category}"
+
+
+@_predicate("on_floor", {"object": "variable or instance"}, "The object rests directly on the floor.")
+def _on_floor(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    obj = ctx.obj(call)
+    return obj.on_floor, f"{obj.name} is {'on' if obj.on_floor else 'off'} the floor"
+
+
+@_predicate(
+    "height_above_floor",
+    {"object": "variable or instance", "max": "metres (optional)", "min": "metres (optional)"},
+    "The bottom of the object is between min and max metres above the floor.",
+)
+def _height(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    obj = ctx.obj(call)
+    hi, lo = ctx.num(call, "max"), ctx.num(call, "min")
+    if hi is None and lo is None:
+        raise PredicateError("height_above_floor: give max and/or min")
+    h = obj.height_above_floor
+    ok = (hi is None or h <= hi) and (lo is None or h >= lo)
+    return ok, f"{obj.name} is {h:.2f} m above the floor"
+
+
+@_predicate(
+    "near_edge",
+    {"object": "variable or instance", "max_distance": "metres"},
+    "The object rests on a raised surface within max_distance of that surface's edge.",
+)
+def _near_edge(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    obj = ctx.obj(call)
+    limit = ctx.num(call, "max_distance", 0.1)
+    d = obj.distance_to_edge
+    if d is None or obj.on_floor:
+        return False, f"{obj.name} is not on a raised surface"
+    return d <= limit, f"{obj.name} is {d:.2f} m from the edge"
+
+
+@_predicate(
+    "child_reachable",
+    {"object": "variable or instance"},
+    "A small child could reach the object: at most 1.0 m up and not inside a closed container "
+    "(computed by the scene builder into GraphObject.child_reachable).",
+)
+def _child_reachable(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    obj = ctx.obj(call)
+    return obj.child_reachable, f"{obj.name} is {'within' if obj.child_reachable else 'out of'} a child's reach"
+
+
+@_predicate(
+    "inside",
+    {"object": "variable or instance", "container": "variable, instance, category alternatives, or '*' for any"},
+    "A relation says the object is inside the container (or inside anything, for '*').",
+)
+def _inside(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    obj = ctx.obj(call)
+    holders = [_base(h) for h in ctx.relations(obj.name, "inside") if h]
+    want = str(call.args.get("container", "*"))
+    if want == "*":
+        return bool(holders), f"{obj.name} is {'inside ' + holders[0] if holders else 'not inside anything'}"
+    names = set(_resolve_many(ctx, call, "container"))
+    hit = [h for h in holders if h in names]
+    return bool(hit), f"{obj.name} is {'inside ' + hit[0] if hit else 'not inside ' + '/'.join(sorted(names))}"
+
+
+@_predicate(
+    "on",
+    {"object": "variable or instance", "support": "variable, instance, category alternatives, or '*'"},
+    "A relation says the object rests on the support.",
+)
+def _on(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    obj = ctx.obj(call)
+    supports = [_base(s) for s in ctx.relations(obj.name, "on") if s]
+    want = str(call.args.get("support", "*"))
+    if want == "*":
+        return bool(supports), f"{obj.name} rests on {supports[0] if supports else 'nothing'}"
+    names = set(_resolve_many(ctx, call, "support"))
+    hit = [s for s in supports if s in names]
+    return bool(hit), f"{obj.name} is {'on ' + hit[0] if hit else 'not on ' + '/'.join(sorted(names))}"
+
+
+def _resolve_many(ctx: _Ctx, call: PredicateCall, arg: str) -> list[str]:
+    """Instances named by an argument: a bound variable, an instance name, or category alternatives."""
+    value = str(call.args[arg])
+    if value.startswith("$"):
+        return [ctx.name(call, arg)]
+    alts = _alternatives(value)
+    by_name = [a for a in alts if a in ctx._by_name]
+    by_cat = [o.name for o in ctx.graph.objects if o.category in alts]
+    return by_name + by_cat
+
+
+@_predicate(
+    "joint_open",
+    {"object": "variable or instance", "label": "joint label, alternatives 'door|drawer', or '*'", "min_fraction": "0..1"},
+    "Some joint of the object with a matching label is open at least min_fraction of its range.",
+)
+def _joint_open(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    obj = ctx.obj(call)
+    wanted = _alternatives(call.args.get("label", "*"))
+    limit = ctx.num(call, "min_fraction", 0.2)
+    joints = [j for j in obj.joints if _label_matches(j.label, wanted)]
+    if not joints:
+        return False, f"{obj.name} has no {'/'.join(wanted)} joint"
+    best = max(joints, key=lambda j: j.open_fraction)
+    return best.open_fraction >= limit, f"{obj.name} {best.label} is {best.open_fraction:.0%} open"
+
+
+@_predicate(
+    "joint_closed",
+    {"object": "variable or instance", "label": "joint label, alternatives, or '*'", "max_fraction": "0..1"},
+    "The object has a joint with a matching label and every such joint is open at most max_fraction.",
+)
+def _joint_closed(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    obj = ctx.obj(call)
+    wanted = _alternatives(call.args.get("label", "*"))
+    limit = ctx.num(call, "max_fraction", 0.05)
+    joints = [j for j in obj.joints if _label_matches(j.label, wanted)]
+    if not joints:
+        return False, f"{obj.name} has no {'/'.join(wanted)} joint"
+    worst = max(joints, key=lambda j: j.open_fraction)
+    return worst.open_fraction <= limit, f"{obj.name} {worst.label} is {worst.open_fraction:.0%} open"
+
+
+@_predicate(
+    "near",
+    {"a": "variable or instance", "b": "variable or instance", "max_distance": "metres"},
+    "The gap between the two objects' bounding boxes is at most max_distance.",
+)
+def _near(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    a, b = ctx.obj(call, "a"), ctx.obj(call, "b")
+    limit = ctx.num(call, "max_distance", 0.3)
+    gap = aabb_gap(a, b)
+    return gap <= limit, f"{a.name} is {gap:.2f} m from {b.name}"
+
+
+@_predicate(
+    "in_walkway",
+    {"object": "variable or instance"},
+    "The object lies on the open floor where people walk: on the floor, not inside or under anything, "
+    f"and more than {WALKWAY_CLEARANCE} m (horizontally) from every furniture or appliance; a 'blocks' "
+    "relation also counts.",
+)
+def _in_walkway(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    obj = ctx.obj(call)
+    if ctx.relations(obj.name, "blocks"):
+        return True, f"{obj.name} blocks a passage"
+    if not obj.on_floor:
+        return False, f"{obj.name} is not on the floor"
+    if ctx.relations(obj.name, "inside") or ctx.relations(obj.name, "under"):
+        return False, f"{obj.name} is tucked away"
+    fixtures = [
+        o for o in ctx.graph.objects if o.name != obj.name and any(p in o.properties for p in _ROOM_FIXTURES)
+    ]
+    close = [o for o in fixtures if aabb_gap(obj, o, horizontal=True) <= WALKWAY_CLEARANCE]
+    if close:
+        return False, f"{obj.name} lies beside {close[0].name}, out of the way"
+    return True, f"{obj.name} lies in the open walkway"
+
+
+@_predicate("room_is", {"room": "room name or alternatives 'a|b'"}, "The scene's room is one of the given rooms.")
+def _room_is(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    wanted = _alternatives(call.args.get("room", ""))
+    return ctx.graph.room in wanted, f"the room is a {ctx.graph.room}"
+
+
+# --------------------------------------------------------------------------- evaluation
+
+
+def variables_of(call: PredicateCall) -> list[str]:
+    return [v for v in call.args.values() if isinstance(v, str) and v.startswith("$")]
+
+
+def evaluate(call: PredicateCall, graph: SceneGraph, bindings: dict[str, str] | None = None) -> PredicateResult:
+    """Evaluate one call (applying ``negate``) on a scene graph; raises PredicateError for bad calls."""
+    impl = _IMPLS.get(call.name)
+    if impl is None:
+        raise PredicateError(f"unknown predicate '{call.name}' (known: {', '.join(sorted(_IMPLS))})")
+    holds, why = impl(_Ctx(graph, bindings or {}), call)
+    if call.negate:
+        holds = not holds
+    return PredicateResult(call=call, holds=holds, explanation=why)
+
+
+def evaluate_all(calls: list[PredicateCall], graph: SceneGraph, bindings: dict[str, str]) -> list[PredicateResult]:
+    return [evaluate(c, graph, bindings) for c in calls]
+
+
+def all_hold(calls: list[PredicateCall], graph: SceneGraph, bindings: dict[str, str]) -> bool:
+    return all(r.holds for r in evaluate_all(calls, graph, bindings))
+
+
+def match_class(hc, graph: SceneGraph, *, fixed: dict[str, str] | None = None) -> list[Match]:
+    """Every binding of ``hc``'s precondition variables to distinct scene objects that satisfies them all.
+
+    Variables are bound in first-use order, and each precondition is checked as soon as its
+    variables are bound, so non-matching branches are cut early (scenes have tens of objects).
+    ``fixed`` pre-binds variables (e.g. the planner already knows ``$hazard``).
+    """
+    order = [v for v in hc.variable_names() if v not in (fixed or {})]
+    staged: list[list[PredicateCall]] = [[] for _ in range(len(order) + 1)]
+    for call in hc.preconditions:
+        needed = [v for v in variables_of(call) if v in order]
+        staged[max((order.index(v) + 1 for v in needed), default=0)].append(call)
+
+    matches: list[Match] = []
+    names = [o.name for o in graph.objects]
+
+    def check(calls: list[PredicateCall], bindings: dict[str, str], why: list[str]) -> bool:
+        for call in calls:
+            result = evaluate(call, graph, bindings)
+            if not result.holds:
+                return False
+            why.append(result.explanation)  # already describes the actual state, negated or not
+        return True
+
+    def extend(depth: int, bindings: dict[str, str], why: list[str]) -> None:
+        if depth == len(order):
+            matches.append(Match(bindings=dict(bindings), explanation="; ".join(why), score=hc.severity))
+            return
+        var = order[depth]
+        for name in names:
+            if name in bindings.values():
+                continue
+            bindings[var] = name
+            local = list(why)
+            if check(staged[depth + 1], bindings, local):
+                extend(depth + 1, bindings, local)
+            del bindings[var]
+
+    start = dict(fixed or {})
+    why0: list[str] = []
+    if check(staged[0], start, why0):
+        extend(0, start, why0)
+    return matches
+
+
+def iter_calls(hc) -> itertools.chain:
+    return itertools.chain(hc.preconditions, hc.success)
