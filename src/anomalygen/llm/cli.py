@@ -57,14 +57,23 @@ def llm_settings(
 
 
 def schema_by_name(name: str):
-    from anomalygen.schema import ARTEFACTS
+    """An artefact class (``TaskProposal``) or a nested record (``Scenario``) of ``anomalygen.schema``."""
+    from pydantic import BaseModel
 
-    if name in ARTEFACTS:
-        return ARTEFACTS[name]
-    lowered = {k.lower(): v for k, v in ARTEFACTS.items()}
-    if name.lower() in lowered:
-        return lowered[name.lower()]
-    raise UserError(f"unknown schema {name!r}; choose one of: {', '.join(sorted(ARTEFACTS))}")
+    from anomalygen import schema as schema_module
+
+    known = dict(schema_module.ARTEFACTS)
+    for attr, value in vars(schema_module).items():
+        if (
+            isinstance(value, type)
+            and issubclass(value, BaseModel)
+            and value.__module__ == schema_module.__name__
+        ):
+            known.setdefault(attr, value)
+    for key in (name, *(k for k in known if k.lower() == name.lower())):
+        if key in known and key not in ("Artefact", "Strict"):
+            return known[key]
+    raise UserError(f"unknown schema {name!r}; choose one of: {', '.join(sorted(schema_module.ARTEFACTS))}")
 
 
 @app.command()

@@ -9,7 +9,7 @@ from anomalygen.llm.client import LLMClient
 
 NO_BACKEND_HINT = (
     "no LLM configured: pass --backend openai|anthropic|llamacpp, set ANOMALYGEN_LLM__BACKEND, "
-    "or add 'backend = \"llamacpp\"' under [llm] in the config file"
+    'or set backend = "llamacpp" in the llm section of the config file'
 )
 
 
