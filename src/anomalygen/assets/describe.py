@@ -1,0 +1,102 @@
+"""Retrieval text for an asset: what it is, how big, what moves, and why it can be dangerous.
+
+Sentence-BERT retrieval only finds what the text says, so descriptions spell out the facts queries
+ask about ("small enough to choke on", "sharp blade", "hot surface") rather than just a name.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from anomalygen.assets.core import object_table, vocabulary
+
+if TYPE_CHECKING:
+    from anomalygen.assets.core import Asset
+
+_TAG_TEXT = {
+    "choking_size": "small enough for a toddler to put in the mouth and choke on",
+    "small_parts": "has small parts a young child could swallow",
+    "medication": "medicine that is poisonous if a child swallows it",
+    "toxic": "toxic if swallowed",
+    "chemical": "household chemical, poisonous",
+    "corrosive": "corrosive, burns skin",
+    "sharp": "sharp edge or blade that can cut",
+    "pointed": "pointed tips that can poke or stab",
+    "fragile": "fragile, breaks into sharp pieces if dropped",
+    "hot": "can be hot and cause burns",
+    "fire": "fire and burn risk",
+    "heavy": "heavy, can hurt if it falls",
+    "trip": "trip hazard when left on the floor",
+    "slip": "slip hazard on the floor",
+    "electrical": "electrical appliance with a cable",
+    "suffocation": "suffocation risk for small children",
+    "strangulation": "long cord, strangulation risk for children",
+    "food": "food",
+    "spoiled": "spoiled, unhygienic, should be thrown away",
+    "perishable": "perishable, must be kept refrigerated",
+    "litter": "litter that belongs in the trash",
+    "toy": "child's toy",
+    "tip_over": "can tip over if climbed or pulled",
+    "large_furniture": "large piece of furniture or appliance with doors",
+    "pinch": "can pinch fingers",
+    "moving_blades": "moving blades",
+    "drowning_risk": "can hold water, drowning risk for toddlers",
+    "climbable": "children can climb on it",
+    "lockable": "lockable storage for dangerous items",
+    "lidded": "has a lid, safe storage container",
+    "hygiene": "hygiene-related",
+    "contains_battery": "contains button or AA batteries",
+    "entrapment": "a child could get trapped inside",
+    "fall_risk": "fall risk for children when open",
+    "wheeled": "rolls on wheels",
+}
+
+
+def size_words(size: float) -> str:
+    if size < 0.03:
+        return "tiny"
+    if size < 0.1:
+        return "small"
+    if size < 0.4:
+        return "hand-sized" if size < 0.25 else "medium-sized"
+    if size < 1.0:
+        return "large"
+    return "very large"
+
+
+def describe(name: str, asset: Asset, features: list[str]) -> str:
+    _, _, group, tag_list = object_table()[name]
+    vocab = vocabulary()
+    blurb = vocab["household"].get(name) or f"{name} ({group})"
+    size = asset.size
+    dims = asset.aabb[1] - asset.aabb[0]
+    parts = [f"{size_words(size)} {name.replace('_', ' ')}: {blurb}"]
+    d = ".1f" if size < 0.1 else ".0f"
+    mass = f"{asset.mass * 1000:.0f} g" if asset.mass < 0.5 else f"{asset.mass:.1f} kg"
+    parts.append(f"about {size * 100:{d}} cm across ({dims[0] * 100:{d}} x {dims[1] * 100:{d}} x {dims[2] * 100:{d}} cm), {mass}")
+    if features:
+        parts.append(", ".join(features))
+    labels = sorted({j.label for j in asset.joints})
+    if labels:
+        parts.append("movable parts: " + ", ".join(labels))
+    if asset.cavities:
+        parts.append("can hold things inside")
+    if asset.surfaces:
+        parts.append("has surfaces to put things on")
+    all_tags = set(tag_list)
+    if size < 0.045:
+        all_tags.add("choking_size")
+    for t in sorted(all_tags):
+        if t in _TAG_TEXT and t != "food":
+            parts.append(_TAG_TEXT[t])
+    if size >= 0.06 and "choking_size" not in all_tags:
+        parts.append("too big to swallow")
+    return "; ".join(parts)
+
+
+def properties(name: str, size: float) -> list[str]:
+    """Property tags for the catalogue (the same words the knowledge base uses where they overlap)."""
+    t = set(object_table()[name][3])
+    if size < 0.045:
+        t.add("choking_size")
+    return sorted(t)

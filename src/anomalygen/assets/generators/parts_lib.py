@@ -1,0 +1,83 @@
+"""Articulated building blocks shared by the target generators: doors, drawers, knobs, lids.
+
+Every asset faces -y (its front). Each joint's closed value sits at one end of its range, on the side
+gravity pushes towards, so a part left alone rests closed against its limit instead of drifting.
+Doors and drawers are children of the body they close; MuJoCo already ignores parent-child contacts,
+and ``core.finalize`` excludes contacts between an asset's own moving parts, so parts never lock up on
+their own cabinet.
+"""
+
+from __future__ import annotations
+
+from anomalygen.assets.core import Cavity
+from anomalygen.assets.generators.common import D_METAL, METAL, open_box
+from anomalygen.assets.parts import Part
+
+
+def side_door(parent: Part, name: str, x0, x1, z0, z1, y, hinge_left: bool, rgba, density, thick=0.018, handle=True, open_angle=1.9):
+    """A door on a vertical hinge covering x0..x1, z0..z1, its back face at y (the cabinet front)."""
+    w, hz, zc = x1 - x0, (z1 - z0) / 2, (z0 + z1) / 2
+    if hinge_left:
+        d = parent.child(name, (x0, y - 0.002, zc))
+        d.hinge(f"{name}_hinge", (0, 0, 1), (-open_angle, 0), "door", 0.0)
+        sx = 1
+    else:
+        d = parent.child(name, (x1, y - 0.002, zc))
+        d.hinge(f"{name}_hinge", (0, 0, 1), (0, open_angle), "door", 0.0)
+        sx = -1
+    d.box((w / 2 - 0.002, thick / 2, hz - 0.002), (sx * w / 2, -thick / 2, 0), rgba, density)
+    if handle:
+        hl = min(0.12, hz * 0.6)
+        d.box((0.008, 0.012, hl / 2), (sx * (w - 0.04), -thick - 0.012, 0), METAL[0], D_METAL)
+    return d
+
+
+def drop_door(parent: Part, name: str, x0, x1, z0, z1, y, rgba, density, thick=0.03, handle=True, window=None):
+    """A door hinged along its bottom edge that falls open forward (oven, dishwasher)."""
+    w, h = x1 - x0, z1 - z0
+    d = parent.child(name, ((x0 + x1) / 2, y - 0.002, z0))
+    d.hinge(f"{name}_hinge", (1, 0, 0), (0, 1.55), "door", 0.0)
+    d.box((w / 2 - 0.002, thick / 2, h / 2 - 0.002), (0, -thick / 2, h / 2), rgba, density)
+    if window is not None:
+        d.box((w * 0.35, 0.001, h * 0.25), (0, -thick - 0.001, h * 0.5), window, 100, collide=False)
+    if handle:
+        d.segment((-w * 0.35, -thick - 0.025, h * 0.88), (w * 0.35, -thick - 0.025, h * 0.88), 0.008, METAL[0], D_METAL)
+        for sx in (-1, 1):
+            d.segment((sx * w * 0.33, -thick, h * 0.88), (sx * w * 0.33, -thick - 0.025, h * 0.88), 0.006, METAL[0], D_METAL)
+    return d
+
+
+def drawer(parent: Part, name: str, x0, x1, z0, z1, y, depth, rgba, density, t=0.012):
+    """A drawer front plus an open bin behind it, sliding out along -y; returns (part, bin cavity)."""
+    w, h = x1 - x0, z1 - z0
+    dr = parent.child(name, ((x0 + x1) / 2, y - 0.002, z0))
+    travel = depth * 0.8
+    dr.slide(f"{name}_slide", (0, -1, 0), (0, travel), "drawer", 0.0)
+    dr.box((w / 2 - 0.002, 0.009, h / 2 - 0.002), (0, -0.009, h / 2), rgba, density)
+    dr.box((min(0.06, w * 0.25), 0.01, 0.008), (0, -0.03, h * 0.6), METAL[0], D_METAL)
+    bh = h / 2 * 0.75
+    open_box(dr, w / 2 - 0.02, depth / 2 - 0.01, bh, t, rgba, density, z0=0.012, center=(0, depth / 2 + 0.005))
+    cav = Cavity(f"{name}_bin", (0, 0, 0), (w / 2 - 0.02 - t * 1.5, depth / 2 - 0.01 - t * 1.5, bh - t), "top", f"{name}_slide")
+    # cavity centre in the parent frame (closed state)
+    cav = Cavity(cav.name, ((x0 + x1) / 2, y - 0.002 + depth / 2 + 0.005, z0 + 0.012 + bh + t / 2), cav.half_extents, "top", cav.joint)
+    return dr, cav
+
+
+def knob(parent: Part, name: str, pos, r, rgba, axis=(0, -1, 0), label="knob", rng_max=4.7):
+    """A round knob turning about its own axis (front-facing by default)."""
+    k = parent.child(name, pos)
+    k.hinge(f"{name}_joint", axis, (0, rng_max), label, 0.0)
+    ax = "y" if abs(axis[1]) > 0.5 else "x" if abs(axis[0]) > 0.5 else "z"
+    off = [0.0, 0.0, 0.0]
+    off["xyz".index(ax)] = r * 0.6 * (1 if sum(axis) > 0 else -1)
+    k.cyl(r, r * 0.6, off, rgba, 900, axis=ax)
+    k.box((r * 0.15, r * 0.3, r * 0.8) if ax == "y" else (r * 0.8, r * 0.15, r * 0.3), [2 * o for o in off], (0.9, 0.9, 0.9, 1), 900, collide=False)
+    return k
+
+
+def top_lid(parent: Part, name: str, hx, hy, z, rgba, density, thick=0.01, open_angle=1.9, label="lid"):
+    """A flat lid hinged along the back (+y) edge at height z, opening upwards."""
+    lid = parent.child(name, (0, hy, z))
+    lid.hinge(f"{name}_hinge", (1, 0, 0), (-open_angle, 0), label, 0.0)
+    lid.box((hx, hy, thick / 2), (0, -hy, thick / 2), rgba, density)
+    return lid
