@@ -20,14 +20,22 @@ from anomalygen.schema import (
 )
 
 
-def obj(name, category, props=(), *, pos=(0.5, 0.5, 0.0), size=(0.1, 0.1, 0.1), height=None, on_floor=None,
+def kb_props(category: str) -> list[str]:
+    """The properties the scene builder would attach: the knowledge base's, none for unknown objects."""
+    from anomalygen.knowledge import load_kb
+
+    info = load_kb().objects.get(category)
+    return list(info.properties) if info else []
+
+
+def obj(name, category, props=None, *, pos=(0.5, 0.5, 0.0), size=(0.1, 0.1, 0.1), height=None, on_floor=None,
         edge=None, reach=None, joints=()):
     h = pos[2] - size[2] / 2 if height is None else height
     h = max(0.0, h)
     return GraphObject(
         name=name,
         category=category,
-        properties=list(props),
+        properties=kb_props(category) if props is None else list(props),
         position=list(pos),
         size=list(size),
         height_above_floor=h,
@@ -45,11 +53,11 @@ def door(name, fraction, label="door"):
 def kitchen_furniture():
     """Counter along the wall, a dining table, a closed fridge and a closed cabinet."""
     return [
-        obj("counter_0", "counter", ["furniture"], pos=(0.5, 1.6, 0.45), size=(1.8, 0.6, 0.9)),
-        obj("table_0", "Table", ["furniture"], pos=(1.6, 0.5, 0.375), size=(1.0, 0.8, 0.75)),
-        obj("refrigerator_0", "Refrigerator", ["appliance", "furniture"], pos=(-0.6, 1.6, 0.9), size=(0.7, 0.7, 1.8),
+        obj("counter_0", "counter", None, pos=(0.5, 1.6, 0.45), size=(1.8, 0.6, 0.9)),
+        obj("table_0", "Table", None, pos=(1.6, 0.5, 0.375), size=(1.0, 0.8, 0.75)),
+        obj("refrigerator_0", "Refrigerator", None, pos=(-0.6, 1.6, 0.9), size=(0.7, 0.7, 1.8),
             joints=[door("refrigerator_0_door", 0.0)]),
-        obj("storage_0", "StorageFurniture", ["furniture"], pos=(2.6, 1.6, 0.45), size=(0.8, 0.5, 0.9),
+        obj("storage_0", "StorageFurniture", None, pos=(2.6, 1.6, 0.45), size=(0.8, 0.5, 0.9),
             joints=[door("storage_0_door", 0.0)]),
     ]
 
@@ -78,7 +86,7 @@ def add_clutter(graph: SceneGraph, n: int) -> SceneGraph:
     for i in range(n):
         cat, top, xy = CLUTTER[i % len(CLUTTER)]
         name = f"{cat}_c{i}"
-        objs.append(on_surface(name, cat, [], top, xy, edge=0.2))
+        objs.append(on_surface(name, cat, None, top, xy, edge=0.2))
         rels.append(Relation(subject=name, predicate="on", object="table_0" if top < 0.8 else "counter_0"))
     return graph.model_copy(update={"objects": objs, "relations": rels})
 
@@ -90,8 +98,8 @@ def scene(scene_id, room, objects, relations=()):
 def knife_on_counter_edge():
     """store_sharp_objects: a kitchen knife 4 cm from the counter's front edge."""
     objs = kitchen_furniture() + [
-        on_surface("kitchen_knife_0", "kitchen_knife", ["sharp"], 0.9, (0.6, 1.33), edge=0.04, size=(0.3, 0.04, 0.02)),
-        on_surface("mug_0", "mug", [], 0.9, (0.1, 1.7), edge=0.2),
+        on_surface("kitchen_knife_0", "kitchen_knife", None, 0.9, (0.6, 1.33), edge=0.04, size=(0.3, 0.04, 0.02)),
+        on_surface("mug_0", "mug", None, 0.9, (0.1, 1.7), edge=0.2),
     ]
     rels = [Relation(subject="kitchen_knife_0", predicate="on", object="counter_0"),
             Relation(subject="mug_0", predicate="on", object="counter_0")]
@@ -101,10 +109,10 @@ def knife_on_counter_edge():
 def pill_on_floor():
     """secure_medications: a pill bottle on the open floor of the living room."""
     objs = [
-        obj("sofa_0", "sofa", ["furniture"], pos=(0.0, 2.0, 0.4), size=(2.0, 0.9, 0.8)),
-        obj("low_table_0", "low_table", ["furniture"], pos=(0.0, 0.8, 0.2), size=(1.0, 0.6, 0.4)),
-        obj("pill_bottle_0", "pill_bottle", ["medication", "choking_size"], pos=(1.5, -0.5, 0.04), size=(0.04, 0.04, 0.08)),
-        on_surface("remote_0", "Remote", ["electrical"], 0.4, (0.1, 0.8), edge=0.2),
+        obj("chair_0", "Chair", None, pos=(0.0, 2.0, 0.45), size=(0.5, 0.5, 0.9)),
+        obj("coffee_table_0", "Table", None, pos=(0.0, 0.8, 0.2), size=(1.0, 0.6, 0.4)),
+        obj("pill_bottle_0", "pill_bottle", None, pos=(1.5, -0.5, 0.04), size=(0.04, 0.04, 0.08)),
+        on_surface("remote_0", "Remote", None, 0.4, (0.1, 0.8), edge=0.2),
     ]
     return scene("s-pill", "living_room", objs, [Relation(subject="pill_bottle_0", predicate="on_floor")])
 
@@ -113,15 +121,15 @@ def open_fridge():
     """close_open_refrigerator: the fridge door stands 80 % open."""
     objs = kitchen_furniture()
     objs[2] = objs[2].model_copy(update={"joints": [door("refrigerator_0_door", 0.8)]})
-    objs.append(on_surface("apple_0", "apple", [], 0.75, (1.5, 0.5), edge=0.3))
+    objs.append(on_surface("apple_0", "apple", None, 0.75, (1.5, 0.5), edge=0.3))
     return scene("s-fridge", "kitchen", objs)
 
 
 def two_hazards():
-    """A knife at the counter edge and marbles on the floor in front of the sofa."""
+    """A knife at the counter edge and marbles on the floor in front of the table."""
     base = knife_on_counter_edge()
     objs = list(base.objects) + [
-        obj("marble_0", "marble", ["choking_size"], pos=(1.0, -0.8, 0.008), size=(0.016, 0.016, 0.016)),
+        obj("marble_0", "marble", None, pos=(1.0, -0.8, 0.008), size=(0.016, 0.016, 0.016)),
     ]
     return scene("s-two", "kitchen", objs, list(base.relations))
 

@@ -50,7 +50,7 @@ def test_exact_hit_needs_object_and_class():
 
 def test_another_instance_of_the_same_category_is_not_the_hazard():
     graph = g.knife_on_counter_edge()
-    graph = graph.model_copy(update={"objects": graph.objects + [g.obj("kitchen_knife_1", "kitchen_knife", ["sharp"])]})
+    graph = graph.model_copy(update={"objects": graph.objects + [g.obj("kitchen_knife_1", "kitchen_knife")]})
     truth = ground_truth(g.KNIFE_TASK, spec_for(graph, **{"$hazard": "kitchen_knife_0"}), graph)
     js = Judge(threshold=0.6).judge([hyp(1, "kitchen_knife_1", "store_sharp_objects")], truth, graph)
     assert not js[0].hit and "right class, wrong object" in js[0].reason

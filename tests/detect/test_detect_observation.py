@@ -57,7 +57,7 @@ def test_text_states_what_matters_for_hazards():
 def test_joint_states_read_like_speech():
     text = observation_text(g.open_fridge())
     assert "door 80% open" in text
-    assert "storage_0 (StorageFurniture [furniture])" in text and "door closed" in text
+    assert "storage_0 (StorageFurniture [furniture, container])" in text and "door closed" in text
     knob = g.door("stove_knob", 0.7, label="knob")
     assert joint_phrase(knob) == "knob on"
     assert joint_phrase(g.door("k", 0.0, label="knob")) == "knob off"

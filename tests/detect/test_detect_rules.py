@@ -40,7 +40,7 @@ def test_two_hazards_are_both_in_the_top3(kb):
 
 def test_knife_on_the_floor_is_a_child_hazard_not_a_trip_hazard(kb):
     base = g.kitchen_furniture()
-    knife = g.obj("kitchen_knife_0", "kitchen_knife", ["sharp"], pos=(1.0, -0.5, 0.01), size=(0.3, 0.04, 0.02))
+    knife = g.obj("kitchen_knife_0", "kitchen_knife", pos=(1.0, -0.5, 0.01), size=(0.3, 0.04, 0.02))
     hyps = RuleDetector(kb).detect(g.scene("s", "kitchen", base + [knife]), 3)
     assert hyps[0].hazard_class == "keep_sharp_away_from_children"
     assert all(h.hazard_class != "reduce_tripping_hazards" for h in hyps)
@@ -57,7 +57,7 @@ def test_five_clutter_objects_do_not_change_the_answer(kb, graph_fn):
 def test_deterministic_and_deduplicated(kb):
     graph = g.two_hazards()
     # a second container candidate must not give a second hypothesis for the same object and class
-    graph = graph.model_copy(update={"relations": graph.relations + [Relation(subject="marble_0", predicate="near", object="sofa_0")]})
+    graph = graph.model_copy(update={"relations": graph.relations + [Relation(subject="marble_0", predicate="near", object="table_0")]})
     runs = [RuleDetector(kb).detect(graph, 10) for _ in range(3)]
     assert runs[0] == runs[1] == runs[2]
     keys = [(h.target_object, h.hazard_class) for h in runs[0]]

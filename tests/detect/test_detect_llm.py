@@ -1,0 +1,141 @@
+"""LLM and hybrid detectors end to end against the scripted OpenAI-compatible server (real HTTP)."""
+
+from __future__ import annotations
+
+import json
+
+import detect_graphs as g
+from support.fixtures import llm_config_for, scripted_server  # noqa: F401
+from support.openai_server import status, text
+from test_detect_observation import assert_no_leak
+from test_detect_stage import standard_run
+
+from anomalygen.config import load_settings
+from anomalygen.detect.hybrid import HybridDetector
+from anomalygen.detect.report import DetectionReport
+from anomalygen.detect.stage import run_stage, summary_path
+from anomalygen.llm import get_client
+from anomalygen.runfolder import read_jsonl, read_model
+from anomalygen.schema import Detection
+
+
+def _user(req) -> str:
+    return next(m["content"] for m in req["messages"] if m["role"] == "user")
+
+
+def _system(req) -> str:
+    return next((m["content"] for m in req["messages"] if m["role"] == "system"), "")
+
+
+def reply(*hyps):
+    return text(json.dumps({"hypotheses": [
+        {"problem": p, "solution": s, "target_object": o, "hazard_class": c} for o, c, p, s in hyps]}))
+
+
+def llm_settings(srv, tmp_path, **over):
+    s = load_settings(None, {"quiet": True, "workers": 1, "detect.detector": "llm", "detect.llm_judge": False, **over})
+    s.llm = llm_config_for(srv, tmp_path, cache=False)
+    return s
+
+
+def scene_responder(req):
+    """Answers like a sensible model, per scene; the fridge scene first names an object that is not there."""
+    user = _user(req)
+    repaired = any(m["role"] == "assistant" for m in req["messages"])
+    if "pill_bottle_0" in user:  # free text (no class): judged by SBERT
+        return reply(("pill_bottle_0", None,
+                      "A bottle of tablets lies on the carpet where small children crawl and could swallow them",
+                      "Put the tablet bottle in the medicine cabinet"))
+    if "kitchen_knife_0" in user:
+        return reply(("mug_0", None, "The mug is in the way", "Move the mug"),
+                     ("kitchen_knife_0", "store_sharp_objects", "Knife at the counter edge", "Store the knife"))
+    if not repaired:
+        return reply(("fridge", "close_open_refrigerator", "Fridge open", "Close it"))
+    return reply(("refrigerator_0", "close_open_refrigerator", "The fridge door is open", "Close the fridge door"))
+
+
+def test_llm_detector_end_to_end(scripted_server, tmp_path):
+    srv = scripted_server(scene_responder)
+    run = standard_run(tmp_path)
+    summary = run_stage(run, llm_settings(srv, tmp_path))
+    assert (summary.done, summary.failed) == (3, 0)
+    dets = {d.task_id: d for d in read_jsonl(run.detections_path, Detection)}
+    assert dets["t-knife"].hit_rank == 2 and dets["t-knife"].judgements[1].method == "exact"
+    assert dets["t-pill"].hit_rank == 1 and dets["t-pill"].judgements[0].method == "sbert"
+    assert dets["t-fridge"].hit_rank == 1 and dets["t-fridge"].hypotheses[0].target_object == "refrigerator_0"
+    # the bad object name went back to the model with the validation error, once
+    fridge_reqs = [r for r in srv.requests if "refrigerator_0" in _user(r) and "kitchen_knife_0" not in _user(r)]
+    assert len(fridge_reqs) == 2 and "target_object" in fridge_reqs[1]["messages"][-1]["content"]
+    # the model sees the scene and the class menu, never the task
+    for req in srv.requests:
+        body = " ".join(m["content"] for m in req["messages"])
+        assert "Known hazard classes" in body
+        for task in (g.KNIFE_TASK, g.PILL_TASK, g.FRIDGE_TASK):
+            assert_no_leak(_user(req).split("Known hazard classes")[0], task)
+    report = read_model(summary_path(run), DetectionReport)
+    assert report.overall.rate[1] == round(2 / 3, 4) and report.overall.rate[2] == 1.0
+    assert report.judge_methods == {"exact": 2, "sbert": 1}
+    manifest = run.load_manifest()
+    assert manifest.llm_usage.requests == 4
+
+
+def test_a_scene_whose_replies_never_validate_fails_alone(scripted_server, tmp_path):
+    def responder(req):
+        if "pill_bottle_0" in _user(req):
+            return text("I think the pills are dangerous!")  # never JSON
+        return scene_responder(req)
+
+    srv = scripted_server(responder)
+    run = standard_run(tmp_path)
+    summary = run_stage(run, llm_settings(srv, tmp_path))
+    assert summary.done == 3  # recorded as a detection with an error, not a crashed batch
+    dets = {d.task_id: d for d in read_jsonl(run.detections_path, Detection)}
+    assert dets["t-pill"].error and dets["t-pill"].hit_rank is None and dets["t-pill"].hypotheses == []
+    assert dets["t-pill"].miss_reason.startswith("detector failed:")
+    assert dets["t-fridge"].hit_rank == 1
+    report = read_model(summary_path(run), DetectionReport)
+    assert report.errors == 1 and report.overall.n == 3
+    # a re-run retries only the failed scene
+    again = run_stage(run, llm_settings(srv, tmp_path))
+    assert (again.done, again.skipped) == (1, 2)
+
+
+def test_llm_judge_is_asked_about_misses(scripted_server, tmp_path):
+    def responder(req):
+        if "grade a household robot" in _system(req):
+            return text(json.dumps({"same_problem": "medicine" in _user(req), "reason": "same pills"}))
+        if "pill_bottle_0" in _user(req):
+            return reply(("pill_bottle_0", None, "medicine bottle", "tidy"))  # too terse for SBERT
+        return scene_responder(req)
+
+    srv = scripted_server(responder)
+    run = standard_run(tmp_path)
+    run_stage(run, llm_settings(srv, tmp_path, **{"detect.llm_judge": True}), only=["t-pill"])
+    (det,) = read_jsonl(run.detections_path, Detection)
+    assert det.hit_rank == 1 and det.judgements[0].method == "llm" and "same pills" in det.judgements[0].reason
+
+
+def test_hybrid_llm_reorders_rule_candidates(scripted_server, tmp_path):
+    def responder(req):
+        listing = _user(req).split("Candidates:")[1]
+        assert "1. remove_choking_hazards on marble_0" in listing
+        return text(json.dumps({"ranking": [
+            {"candidate": 2, "problem": "A knife lies at the counter edge", "solution": "Put it in the cabinet"},
+            {"candidate": 1, "problem": "A marble on the floor", "solution": "Pick it up"}]}))
+
+    srv = scripted_server(responder)
+    det = HybridDetector(get_client(llm_config_for(srv, tmp_path, cache=False)))
+    hyps = det.detect(g.two_hazards(), 3)
+    assert [(h.target_object, h.hazard_class) for h in hyps] == [
+        ("kitchen_knife_0", "store_sharp_objects"), ("marble_0", "remove_choking_hazards")]
+    assert hyps[0].problem == "A knife lies at the counter edge" and "ranked by LLM" in hyps[0].explanation
+    assert det.fell_back is None
+
+
+def test_hybrid_falls_back_to_rule_order_and_says_so(scripted_server, tmp_path):
+    srv = scripted_server([status(500)])
+    det = HybridDetector(get_client(llm_config_for(srv, tmp_path, cache=False, http_retries=0), backoff_base_s=0.0))
+    hyps = det.detect(g.two_hazards(), 3)
+    assert [h.hazard_class for h in hyps] == ["remove_choking_hazards", "store_sharp_objects"]
+    assert all("rule order kept" in h.explanation for h in hyps)
+    assert det.fell_back
