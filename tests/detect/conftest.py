@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import pytest
 
+from support.fixtures import scripted_server  # noqa: F401  (fixture for the LLM detector tests)
+
 
 @pytest.fixture(scope="session")
 def kb():

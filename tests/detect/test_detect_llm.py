@@ -5,8 +5,6 @@ from __future__ import annotations
 import json
 
 import detect_graphs as g
-from support.fixtures import llm_config_for, scripted_server  # noqa: F401
-from support.openai_server import status, text
 from test_detect_observation import assert_no_leak
 from test_detect_stage import standard_run
 
@@ -17,6 +15,8 @@ from anomalygen.detect.stage import run_stage, summary_path
 from anomalygen.llm import get_client
 from anomalygen.runfolder import read_jsonl, read_model
 from anomalygen.schema import Detection
+from support.fixtures import llm_config_for
+from support.openai_server import status, text
 
 
 def _user(req) -> str:
