@@ -271,3 +271,41 @@ def test_images_are_sent_as_data_uris(scripted_server, tmp_path):
     assert client.complete(USER, images=[png]) == "a red cube"
     parts = srv.requests[0]["messages"][-1]["content"]
     assert parts[0]["type"] == "text" and parts[1]["image_url"]["url"].startswith("data:image/png;base64,")
+
+
+def test_failed_conversation_is_not_cached_but_repaired_one_replays(scripted_server, tmp_path):
+    srv = scripted_server([text("nonsense"), text("nonsense")])
+    with pytest.raises(LLMItemError):
+        client_for(srv, tmp_path, repair_retries=1).complete(USER, schema=Scenario)
+    assert len(srv.requests) == 2
+
+    srv2 = scripted_server([text("still nonsense"), text(VALID_TEXT)])
+    client = client_for(srv2, tmp_path, repair_retries=1)
+    assert client.complete(USER, schema=Scenario).room == "kitchen"  # asked afresh, repaired
+    assert len(srv2.requests) == 2
+
+    replay = client_for(srv2, tmp_path, repair_retries=1)
+    assert replay.complete(USER, schema=Scenario).room == "kitchen"
+    assert len(srv2.requests) == 2  # the whole repair conversation came from the cache
+    assert (replay.usage.cache_hits, replay.usage.requests) == (2, 0)
+
+
+def test_images_need_a_vision_endpoint(scripted_server, tmp_path):
+    srv = scripted_server([text("x")])
+    with pytest.raises(UserError, match="does not take images"):
+        client_for(srv, tmp_path).complete(USER, images=[b"\x89PNG\r\n\x1a\n"])
+    assert srv.requests == []
+
+
+def test_unrelated_400_does_not_downgrade_structured_mode(scripted_server, tmp_path):
+    srv = scripted_server([status(400), status(400), status(400), text(VALID_TEXT)])
+    client = client_for(srv, tmp_path, cache=False)
+    with pytest.raises(LLMItemError, match="HTTP 400"):
+        client.complete(USER, schema=Scenario)
+    assert [r.get("response_format", {}).get("type") for r in srv.requests] == [
+        "json_schema",
+        "json_object",
+        None,
+    ]
+    assert client.complete(USER, schema=Scenario).room == "kitchen"
+    assert srv.requests[-1]["response_format"]["type"] == "json_schema"

@@ -21,7 +21,7 @@ import numpy as np
 from pydantic import BaseModel, ValidationError
 from pydantic_core import PydanticSerializationError
 
-from anomalygen.errors import ItemFailed
+from anomalygen.errors import ItemFailed, UserError
 from anomalygen.llm.backends import Backend, PermanentError, RawReply, Request, TransientError
 from anomalygen.llm.cache import ReplyCache, cache_key
 from anomalygen.llm.jsonextract import JSONExtractError, extract_json
@@ -118,6 +118,10 @@ class LLMClient:
     ) -> str | BaseModel:
         """One completion: the reply text, or with ``schema`` a validated instance (repaired if needed)."""
         _check_messages(messages)
+        if images and not self.supports_images:
+            raise UserError(
+                f"the configured LLM ({self.backend.name}) does not take images; use a vision endpoint and set llm.vision = true"
+            )
         temp = self.config.temperature if temperature is None else float(temperature)
         limit = self.config.max_tokens if max_tokens is None else int(max_tokens)
         use_cache = self.config.cache if cache is None else (cache and self._cache is not None)
@@ -136,13 +140,17 @@ class LLMClient:
         conversation = with_system(list(messages), schema_instruction(schema, schema_json))
         attempts = self.config.repair_retries + 1
         last_error = ""
+        pending: list[tuple[str, RawReply]] = []  # cached only if the conversation ends valid
         for attempt in range(attempts):
             req = Request(conversation, schema.__name__, schema_json, temp, seed, limit, images)
-            raw = self._request(req, schema, use_cache)
+            raw = self._request(req, schema, use_cache, pending)
             try:
-                return parse_reply(raw.text, schema)
+                result = parse_reply(raw.text, schema)
             except ReplyInvalid as exc:
                 last_error = str(exc)
+            else:
+                self._store(pending)
+                return result
             if attempt + 1 < attempts:
                 with self._lock:
                     self.usage.retries += 1
@@ -180,7 +188,18 @@ class LLMClient:
         return taken
 
     # ------------------------------------------------------------------ internals
-    def _request(self, req: Request, schema: type[BaseModel] | None, use_cache: bool) -> RawReply:
+    def _request(
+        self,
+        req: Request,
+        schema: type[BaseModel] | None,
+        use_cache: bool,
+        pending: list[tuple[str, RawReply]] | None = None,
+    ) -> RawReply:
+        """One reply, from the cache or the backend. With ``pending`` the cache write is deferred.
+
+        Why defer: a repair conversation is replayed from the cache only if it ended in a valid object;
+        an item that failed is asked afresh on the next run rather than frozen into its failure.
+        """
         key = None
         if use_cache and self._cache is not None:
             key = cache_key(
@@ -204,9 +223,17 @@ class LLMClient:
             if hit is not None:
                 return RawReply(*hit)
         raw = self._call_with_retries(req)
-        if key is not None and self._cache is not None:
-            self._cache.put(key, raw.text, raw.prompt_tokens, raw.completion_tokens)
+        if key is not None:
+            if pending is None:
+                self._store([(key, raw)])
+            else:
+                pending.append((key, raw))
         return raw
+
+    def _store(self, entries: list[tuple[str, RawReply]]) -> None:
+        if self._cache is not None:
+            for key, raw in entries:
+                self._cache.put(key, raw.text, raw.prompt_tokens, raw.completion_tokens)
 
     def _call_with_retries(self, req: Request) -> RawReply:
         attempts = self.config.http_retries + 1

@@ -2,6 +2,8 @@
 
 Structured output degrades gracefully: ``json_schema`` response format first; a server that answers
 400 to it gets ``json_object`` (JSON mode) instead; one that rejects that too gets a plain request.
+The weaker mode is remembered only once it has worked, so a 400 for another reason (say, a prompt
+too long) does not downgrade later requests.
 The schema is also in the prompt, and the client validates every reply, so each level is safe.
 The SDK's own retries are off: ``anomalygen.llm.client`` owns retry, backoff and their counting.
 """
@@ -76,8 +78,10 @@ class OpenAIBackend:
         messages = request.messages
         if request.images:
             messages = with_images_openai(messages, request.images)
+        structured = request.schema_json is not None
+        index = self._mode_index if structured else len(_MODES) - 1
         while True:
-            mode = _MODES[self._mode_index] if request.schema_json is not None else "plain"
+            mode = _MODES[index]
             kwargs: dict[str, Any] = {
                 "model": self.model,
                 "messages": messages,
@@ -100,10 +104,8 @@ class OpenAIBackend:
             try:
                 resp = self._client.chat.completions.create(**kwargs)
             except self._openai.BadRequestError as exc:
-                if mode != "plain":
-                    with self._lock:  # remember for later requests: this server lacks the mode
-                        if _MODES[self._mode_index] == mode:
-                            self._mode_index += 1
+                if index + 1 < len(_MODES):  # maybe the server lacks this structured-output mode
+                    index += 1
                     continue
                 raise PermanentError(f"HTTP 400 bad request: {_short(exc)}") from None
             except (self._openai.RateLimitError, self._openai.InternalServerError) as exc:
@@ -116,6 +118,9 @@ class OpenAIBackend:
                 if exc.status_code in (408, 409) or exc.status_code >= 500:
                     raise TransientError(f"HTTP {exc.status_code}: {_short(exc)}") from None
                 raise PermanentError(f"HTTP {exc.status_code}: {_short(exc)}") from None
+            if structured and index > self._mode_index:
+                with self._lock:  # a weaker mode worked where a stronger one got 400: remember it
+                    self._mode_index = max(self._mode_index, index)
             choices = getattr(resp, "choices", None) or []
             text = (choices[0].message.content if choices and choices[0].message else None) or ""
             usage = getattr(resp, "usage", None)
