@@ -9,6 +9,7 @@ so the caps only shape generation, never what is accepted.
 from __future__ import annotations
 
 import copy
+import functools
 import json
 from typing import Any
 
@@ -16,14 +17,21 @@ from pydantic import BaseModel
 
 
 def response_schema(schema: type[BaseModel]) -> dict[str, Any]:
+    """The class's JSON schema (a fresh copy: callers may mutate it)."""
+    return copy.deepcopy(_cached_schema(schema))
+
+
+@functools.lru_cache(maxsize=256)
+def _cached_schema(schema: type[BaseModel]) -> dict[str, Any]:
     return schema.model_json_schema()
 
 
+@functools.lru_cache(maxsize=256)
 def schema_fingerprint(schema: type[BaseModel] | None) -> str | None:
     """Canonical JSON of the schema, part of the cache key (a changed class invalidates old replies)."""
     if schema is None:
         return None
-    return json.dumps(response_schema(schema), sort_keys=True, separators=(",", ":"))
+    return json.dumps(_cached_schema(schema), sort_keys=True, separators=(",", ":"))
 
 
 def inline_refs(node: Any, defs: dict[str, Any], depth: int = 0) -> Any:
