@@ -1,0 +1,651 @@
+"""From a TaskProposal to a physically valid MuJoCo scene in which the hazard really exists.
+
+Pipeline of one attempt (all randomness from ``item_rng(seed, task.id, attempt)``):
+
+1. select assets (select.py): hazard, target, the object the hazard sits in/on, the container of the
+   fix, task co-objects, unrelated clutter; sizes from the knowledge base, clamped by spatial rules;
+   initial joint states that make the hazard real;
+2. place them (layout.py) and move the robot base within reach;
+3. compose one MjSpec (robot + room + objects), compile, reject initial interpenetration;
+4. settle the physics for ``settings.build.settle_s``;
+5. validate (validate.py): interpenetration <= 1 mm, velocities settled, and the hazard class's
+   preconditions hold on the scene graph of the settled state.
+
+A failed attempt is repaired by re-sampling (``settings.build.repair_attempts`` times); then the item
+fails with the last one-line reason. Outputs are written only for a valid scene.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+import shutil
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from anomalygen.errors import ItemFailed
+from anomalygen.rng import item_rng, stable_hash
+from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
+from anomalygen.schema import (
+    AssetRef,
+    AssetSource,
+    JointState,
+    ObjectRole,
+    PlacedObject,
+    SceneSpec,
+    TaskProposal,
+    ValidationReport,
+)
+from anomalygen.scene import furniture, layout, robot, select
+from anomalygen.scene.layout import Layout, Placed
+
+log = logging.getLogger(__name__)
+SURFACE_PLACEMENTS = {"table", "low_table", "table_edge", "counter", "counter_edge", "shelf"}
+CAMERAS = ("front", "top", "wrist")
+MAX_AUX = 3
+CLUTTER_MAX_SIZE = 0.3
+
+
+@lru_cache(maxsize=1)
+def _kb():
+    from anomalygen.knowledge import load_kb
+
+    return load_kb()
+
+
+@dataclass
+class Built:
+    """A compiled, settled scene in memory (what the outputs are written from)."""
+
+    spec: SceneSpec
+    mjspec: object
+    model: object
+    data: object
+    report: ValidationReport
+    graph: object
+
+
+# ============================================================================ selection
+
+
+def _instance_name(catalogue: str, used: set[str]) -> str:
+    base = catalogue.lower()
+    i = 0
+    while f"{base}_{i}" in used:
+        i += 1
+    name = f"{base}_{i}"
+    used.add(name)
+    return name
+
+
+def _parse_placement(placement: str) -> tuple[str, str | None]:
+    for prefix in ("inside:", "on:"):
+        if placement.startswith(prefix):
+            return prefix[:-1], placement[len(prefix) :]
+    return placement, None
+
+
+def _front(asset) -> np.ndarray | None:
+    """Local direction the asset's doors/drawers open to (the catalogue convention is -y)."""
+    if any(j.label in ("door", "drawer", "window", "sash", "lid") for j in asset.joints) or asset.cavities:
+        return np.array([0.0, -1.0])
+    return None
+
+
+def _sweep(asset, values: dict[str, float]) -> float:
+    """How far open doors/drawers reach out of the closed bounding box, conservatively."""
+    ext = asset.aabb[1] - asset.aabb[0]
+    out = 0.0
+    for j in asset.joints:
+        v = values.get(j.name)
+        if v is None or abs(v - j.closed_value) < 1e-6:
+            continue
+        if j.type == "slide":
+            out = max(out, abs(v - j.closed_value) + 0.02)
+        elif j.label in ("door", "lid", "window", "sash"):
+            out = max(out, min(float(max(ext[0], ext[2] if abs(j.axis[2]) < 0.5 else ext[0])), 1.0))
+    return out
+
+
+def _placed(chosen: select.Chosen) -> Placed:
+    lo, hi = (np.asarray(v, float) for v in chosen.asset.aabb)
+    p = Placed(
+        name=chosen.name,
+        catalogue=chosen.catalogue,
+        role=chosen.role,
+        lo=lo,
+        hi=hi,
+        fixed=chosen.fixed,
+        asset=chosen.asset,
+        joint_values=dict(chosen.joint_values),
+        front=_front(chosen.asset),
+    )
+    p.sweep = _sweep(chosen.asset, chosen.joint_values)
+    return p
+
+
+def _support_placed(kind: str, name: str, rng, role=ObjectRole.SUPPORT) -> Placed:
+    sup = furniture.sample_support(kind, rng)
+    lo, hi = sup.aabb()
+    return Placed(name=name, catalogue=sup.category, role=role, lo=lo, hi=hi, fixed=True, support_geom=sup, front=np.array([-1.0, 0.0]))
+
+
+def _surface_of(holder: Placed):
+    """The top surface of a holder in world coordinates: (lo_xy, hi_xy, top_z)."""
+    if holder.support_geom is not None:
+        s = holder.support_geom
+        return layout.surface_world(holder, (0.0, 0.0, s.top), s.half)
+    surfaces = list(holder.asset.surfaces)
+    if not surfaces:
+        lo, hi = holder.asset.aabb
+        return layout.surface_world(holder, (0.0, 0.0, float(hi[2])), (float(hi[0] - lo[0]) / 2 * 0.8, float(hi[1] - lo[1]) / 2 * 0.8))
+    best = max(surfaces, key=lambda s: s.half_size[0] * s.half_size[1])
+    return layout.surface_world(holder, best.center, best.half_size)
+
+
+def _cavity_world(holder: Placed):
+    asset = holder.asset
+    if not asset.cavities:
+        raise ItemFailed(f"{holder.catalogue} has no interior to put things in")
+    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+    center = np.asarray(cav.center, float).copy()
+    if cav.joint is not None:
+        j = asset.joint(cav.joint)
+        if j.type == "slide":
+            v = holder.joint_values.get(j.name, j.closed_value)
+            center += np.asarray(j.axis) * (v - 0.0)
+    c, s = math.cos(holder.yaw), math.sin(holder.yaw)
+    wc = holder.pos + np.array([c * center[0] - s * center[1], s * center[0] + c * center[1], center[2]])
+    h = np.asarray(cav.half_extents, float)
+    wh = np.array([abs(c) * h[0] + abs(s) * h[1], abs(s) * h[0] + abs(c) * h[1], h[2]])
+    return wc - wh, wc + wh, cav
+
+
+def _cavity_cap(asset) -> float:
+    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+    return 0.8 * 2 * float(min(cav.half_extents))
+
+
+def _clutter_names(kb, exclude: set[str], rng, n: int) -> list[str]:
+    from anomalygen.knowledge.models import HAZARD_PROPERTIES
+
+    names = []
+    for name in select._catalogue():
+        info = kb.objects.get(name)
+        if info is None or info.kind != "household" or name in exclude:
+            continue
+        if set(info.properties) & (HAZARD_PROPERTIES | {"furniture", "appliance"}):
+            continue
+        if info.size_range[0] > CLUTTER_MAX_SIZE:
+            continue
+        names.append(name)
+    if not names or n <= 0:
+        return []
+    idx = rng.choice(len(names), size=min(n, len(names)), replace=False)
+    return [names[i] for i in sorted(idx)]
+
+
+def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], dict[str, Placed]]:
+    """Choose and place every object; returns the layout, bindings and instances by role variable."""
+    kb = _kb()
+    hc = kb.hazard_classes.get(task.hazard_class)
+    sc = task.scenario
+    kind, parent_raw = _parse_placement(sc.placement)
+    used: set[str] = set()
+    by_catalogue: dict[str, select.Chosen] = {}
+
+    def choose(raw: str, role: ObjectRole, *, cap=None, rank=False) -> select.Chosen:
+        cat = select.resolve_name(raw)
+        if cat in by_catalogue:
+            return by_catalogue[cat]
+        asset = select.pick_asset(cat, role=role, kb=kb, task=task, hc=hc, rng=rng, cap=cap, rank=rank)
+        ch = select.Chosen(_instance_name(cat, used), cat, role, asset)
+        by_catalogue[cat] = ch
+        return ch
+
+    hazard_is_target = select.resolve_name(sc.hazard_object) == select.resolve_name(task.target_asset)
+    # Big things first: they bound what fits in/on them.
+    target = choose(task.target_asset, ObjectRole.HAZARD if hazard_is_target else ObjectRole.TARGET, rank=True)
+    parent = choose(parent_raw, ObjectRole.AUXILIARY) if parent_raw else None
+
+    support_kind = kind if kind in SURFACE_PLACEMENTS else None
+    cap = None
+    if kind == "inside" and parent is not None:
+        if not parent.asset.cavities:
+            raise ItemFailed(f"placement inside:{parent_raw} but {parent.catalogue} has no interior")
+        cap = _cavity_cap(parent.asset)
+    hazard = choose(sc.hazard_object, ObjectRole.HAZARD, cap=cap)
+    if hazard is target:
+        target.role = ObjectRole.HAZARD
+
+    container = None
+    variables = set(hc.variables) if hc is not None else set()
+    container_name = sc.container or (_first_known(hc.default_containers) if "$container" in variables else None)
+    if container_name:
+        container = choose(container_name, ObjectRole.CONTAINER)
+    support_var = None
+    if "$support" in variables:
+        sname = _first_known(hc.default_supports)
+        if sname:
+            support_var = choose(sname, ObjectRole.SUPPORT)
+
+    aux: list[select.Chosen] = []
+    extra = list(sc.co_objects) + [a.name for a in task.auxiliary_items if a.relevant]
+    for raw in extra:
+        if len(aux) >= MAX_AUX:
+            break
+        try:
+            cat = select.resolve_name(raw)
+        except ItemFailed:
+            continue  # an unknown co-object is decoration, not the hazard: leave it out
+        if cat in by_catalogue:
+            continue
+        aux.append(choose(cat, ObjectRole.AUXILIARY))
+
+    # Initial joint states: the task's articulations and the class template.
+    uses: dict[str, list[tuple[str, str]]] = {}
+    for a in task.articulations:
+        try:
+            uses.setdefault(select.resolve_name(a.object), []).append((a.part, a.initial_state))
+        except ItemFailed:
+            continue
+    if hc is not None and hc.articulation is not None:
+        var_obj = {"$target": target, "$hazard": hazard}.get(hc.articulation.variable)
+        if var_obj is not None:
+            uses.setdefault(var_obj.catalogue, []).append((hc.articulation.part, hc.articulation.initial_state))
+    if kind == "inside" and parent is not None:
+        cav = max(parent.asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+        if cav.joint is not None and not any(p in ("door", "drawer", "lid") and s == "closed" for p, s in uses.get(parent.catalogue, [])):
+            label = parent.asset.joint(cav.joint).label
+            uses.setdefault(parent.catalogue, []).append((label, "open"))
+    for cat, pairs in uses.items():
+        if cat in by_catalogue:
+            select.set_articulations(by_catalogue[cat], pairs, rng)
+    _check_articulations(task, hc, by_catalogue, target)
+
+    # ------------------------------------------------------------------ placement
+    lay = Layout(rng, relevant_in_cube=settings.build.relevant_in_unit_cube)
+    placed: dict[str, Placed] = {}
+    support: Placed | None = None
+    if support_kind is not None:
+        base_kind = support_kind.replace("_edge", "")
+        if target.catalogue == "Table" and base_kind in ("table", "low_table") and not hazard_is_target:
+            support = placed.setdefault(target.name, _placed(target))
+        else:
+            support = _support_placed(base_kind, _instance_name(furniture.CATEGORY[base_kind], used), rng)
+        lay.place_on_floor(support, relevant=True, face=True)
+        placed[support.name] = support
+    side: Placed | None = None
+    clutter = _clutter_names(kb, set(by_catalogue), rng, settings.build.clutter)
+    if clutter:
+        side = _support_placed("table", _instance_name("Table", used), rng)
+        lay.place_on_floor(side, relevant=False, face=True)
+        placed[side.name] = side
+
+    # Fixed (furniture-sized) objects stand on the floor facing the robot.
+    for ch in [target, parent, container, support_var, *aux]:
+        if ch is None or ch.name in placed or not ch.fixed or ch is hazard:
+            continue
+        p = placed[ch.name] = _placed(ch)
+        lay.place_on_floor(p, relevant=True, face=True)
+    if hazard.fixed and hazard.name not in placed:
+        p = placed[hazard.name] = _placed(hazard)
+        lay.place_on_floor(p, relevant=True, face=True)
+
+    # The hazard object, where the scenario says.
+    if hazard.name not in placed:
+        hp = placed[hazard.name] = _placed(hazard)
+        if kind == "floor":
+            lay.place_on_floor(hp, relevant=True, face=False)
+        elif kind == "walkway":
+            fixtures = [p for p in lay.items if p.fixed]
+            lay.place_on_floor(hp, relevant=True, face=False, clear_of=fixtures)
+        elif support is not None:
+            edge = support_kind.endswith("_edge")
+            lay.place_on_surface(hp, support, _surface_of(support), edge=edge, inward=0.0 if edge else 0.13)
+        elif kind == "inside" and parent is not None:
+            ppl = placed.get(parent.name)
+            if ppl is None:
+                ppl = placed[parent.name] = _placed(parent)
+                lay.place_on_floor(ppl, relevant=True, face=True)
+            lo, hi, _ = _cavity_world(ppl)
+            lay.place_in_cavity(hp, ppl, (lo, hi))
+        elif kind == "on" and parent is not None:
+            ppl = placed.get(parent.name)
+            if ppl is None:
+                ppl = placed[parent.name] = _placed(parent)
+                lay.place_on_floor(ppl, relevant=True, face=True)
+            lay.place_on_surface(hp, ppl, _surface_of(ppl), inward=0.0)
+        else:
+            raise ItemFailed(f"unsupported placement {sc.placement!r}")
+
+    # Remaining loose task objects: on the support (away from its edge) or on the floor.
+    for ch in [target, parent, container, support_var, *aux]:
+        if ch is None or ch.name in placed:
+            continue
+        p = placed[ch.name] = _placed(ch)
+        if support is not None and ch.size < 0.35:
+            try:
+                lay.place_on_surface(p, support, _surface_of(support), inward=0.13)
+                continue
+            except ItemFailed:
+                pass
+        lay.place_on_floor(p, relevant=True, face=True)
+
+    # Clutter on the side table, away from its edges; an item that does not fit is left out.
+    if side is not None:
+        for cat in clutter:
+            asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=kb, task=task, hc=None, rng=rng)
+            ch = select.Chosen(_instance_name(cat, used), cat, ObjectRole.CLUTTER, asset)
+            p = _placed(ch)
+            try:
+                lay.place_on_surface(p, side, _surface_of(side), inward=0.13)
+            except ItemFailed:
+                continue
+            placed[p.name] = p
+
+    focus = placed[hazard.name]
+    lay.fit_base(focus, holder=placed.get(focus.inside) if focus.inside else None)
+    bindings = {"$hazard": hazard.name, "$target": target.name}
+    if container is not None:
+        bindings["$container"] = container.name
+    if support_var is not None:
+        bindings["$support"] = support_var.name
+    elif support is not None:
+        bindings["$support"] = support.name
+    elif kind == "on" and parent is not None:
+        bindings["$support"] = parent.name
+    if kind == "inside" and parent is not None and container is None:
+        bindings["$container"] = parent.name
+    return lay, bindings, placed
+
+
+def _first_known(names: list[str]) -> str | None:
+    for n in names:
+        try:
+            return select.resolve_name(n)
+        except ItemFailed:
+            continue
+    return None
+
+
+def _check_articulations(task, hc, by_catalogue, target) -> None:
+    """The joint the hazard class is about must exist on its object (else the hazard cannot be real)."""
+    if hc is None or hc.articulation is None:
+        return
+    ch = target if hc.articulation.variable == "$target" else None
+    if ch is None:
+        return
+    part = hc.articulation.part
+    if not select.joints_with_label(ch.asset, part) and not (part == "knob" and select.joints_with_label(ch.asset, "switch")):
+        raise ItemFailed(f"{ch.catalogue} has no '{part}' joint for a {hc.id} scene")
+
+
+# ============================================================================ composition
+
+
+def _look_at_xyaxes(eye, target) -> list[float]:
+    """Camera xyaxes (MuJoCo cameras look along -z) for a camera at ``eye`` looking at ``target``."""
+    fwd = np.asarray(target, float) - np.asarray(eye, float)
+    fwd /= np.linalg.norm(fwd)
+    right = np.cross(fwd, [0.0, 0.0, 1.0])
+    if np.linalg.norm(right) < 1e-6:
+        right = np.array([0.0, -1.0, 0.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, fwd)
+    return [*right.tolist(), *up.tolist()]
+
+
+def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
+    import mujoco
+
+    spec = robot.build_robot_spec(tuple(lay.base))
+    spec.modelname = "anomalygen_scene"
+    spec.option.timestep = 0.002
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.visual.global_.offwidth = max(640, settings.build.render_width)
+    spec.visual.global_.offheight = max(480, settings.build.render_height)
+    spec.visual.quality.shadowsize = 1024
+    tex = spec.add_texture(name="floor_tex", type=mujoco.mjtTexture.mjTEXTURE_2D, builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
+                           rgb1=[0.62, 0.58, 0.52], rgb2=[0.55, 0.5, 0.45], width=256, height=256)
+    mat = spec.add_material(name="floor_mat", texrepeat=[6, 6], reflectance=0.05)
+    mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = tex.name
+    center = layout.ROOM_CENTER
+    half = layout.ROOM_HALF + 0.6
+    spec.worldbody.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[half[0], half[1], 0.05],
+                            pos=[center[0], center[1], 0], material="floor_mat")
+    wall_rgba = [0.86, 0.85, 0.8, 1]
+    spec.worldbody.add_geom(name="wall_back", type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.05, half[1], 1.3],
+                            pos=[center[0] + half[0] + 0.05, center[1], 1.3], rgba=wall_rgba)
+    spec.worldbody.add_geom(name="wall_left", type=mujoco.mjtGeom.mjGEOM_BOX, size=[half[0], 0.05, 1.3],
+                            pos=[center[0], center[1] + half[1] + 0.05, 1.3], rgba=wall_rgba)
+    spec.worldbody.add_light(name="sun", pos=[center[0], center[1], 3.5], dir=[0.2, 0.1, -1], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
+                             diffuse=[0.6, 0.6, 0.6], specular=[0.1, 0.1, 0.1], castshadow=True)
+    spec.worldbody.add_light(name="fill", pos=[-1.0, -1.0, 2.5], dir=[0.5, 0.4, -0.6], diffuse=[0.35, 0.35, 0.35], castshadow=False)
+
+    focus = np.mean([p.world_center() for p in placed.values() if p.role != ObjectRole.CLUTTER] or [np.array([1.0, 0, 0.4])], axis=0)
+    focus[2] = min(max(focus[2], 0.2), 0.8)
+    # Front camera: behind the robot as seen from the task objects, raised, turned 30 degrees, so
+    # the robot stands in the foreground and the scene behind it.
+    away = lay.base[:2] - focus[:2]
+    dist = float(np.linalg.norm(away))
+    away = away / dist if dist > 1e-6 else np.array([-1.0, 0.0])
+    c, s = math.cos(0.5), math.sin(0.5)
+    away = np.array([c * away[0] - s * away[1], s * away[0] + c * away[1]])
+    eye = np.r_[focus[:2] + away * (dist + 1.0), 1.9]
+    spec.worldbody.add_camera(name="front", pos=eye.tolist(), xyaxes=_look_at_xyaxes(eye, focus), fovy=60)
+    top_eye = np.array([focus[0], focus[1] - 0.01, 3.3])
+    spec.worldbody.add_camera(name="top", pos=top_eye.tolist(), xyaxes=[0, -1, 0, 1, 0, 0], fovy=55)
+
+    loose = []
+    for p in placed.values():
+        body = spec.worldbody.add_body(name=p.name, pos=p.pos.tolist(), quat=p.quat)
+        if p.support_geom is not None:
+            furniture.emit(p.support_geom, body, rng)
+            continue
+        if not p.fixed:
+            body.add_freejoint(name=f"{p.name}/free")
+            loose.append(p.name)
+        p.asset.attach(body, f"{p.name}/")
+    robot.add_suction_welds(spec, loose)
+    spec.add_key(name="init")
+    return spec
+
+
+def _hold_gravity_hinges(model, placed: dict[str, Placed], mjspec) -> None:
+    """Give horizontal-axis hinges (lids, laptop screens) enough friction to stay where they are set.
+
+    Real lids and oven doors are stiff enough to stay open; a frictionless model would slam shut
+    during settling and the hazard would vanish. The friction is 1.3x the gravity torque of the
+    moving part, so the robot can still close it.
+    """
+    import mujoco
+
+    g = abs(model.opt.gravity[2])
+    for p in placed.values():
+        if p.asset is None:
+            continue
+        for j in p.asset.joints:
+            if j.type != "hinge" or abs(j.axis[2]) > 0.7:
+                continue
+            jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{p.name}/{j.name}")
+            if jid < 0:
+                continue
+            body = model.jnt_bodyid[jid]
+            mass = model.body_subtreemass[body]
+            lever = float(np.linalg.norm(model.body_ipos[body])) + 0.5 * float(np.max(model.body_inertia[body]) / max(mass, 1e-6)) ** 0.5
+            friction = 1.3 * mass * g * max(lever, 0.02)
+            dof = model.jnt_dofadr[jid]
+            model.dof_frictionloss[dof] = max(model.dof_frictionloss[dof], friction)
+            mjspec.joint(f"{p.name}/{j.name}").frictionloss = float(model.dof_frictionloss[dof])
+
+
+def _set_joints(model, data, placed: dict[str, Placed]) -> None:
+    for p in placed.values():
+        for jname, value in p.joint_values.items():
+            data.joint(f"{p.name}/{jname}").qpos[0] = value
+
+
+# ============================================================================ attempt
+
+
+def _attempt(task: TaskProposal, seed: int, settings, attempt: int) -> Built:
+    import mujoco
+
+    from anomalygen.scene import validate as val
+    from anomalygen.scene.graph import scene_graph
+
+    rng = item_rng(seed, task.id, attempt)
+    lay, bindings, placed = _plan(task, settings, rng)
+    mjspec = _compose(lay, placed, settings, rng)
+    model = mjspec.compile()
+    data = mujoco.MjData(model)
+    _hold_gravity_hinges(model, placed, mjspec)
+    robot.set_home(model, data, tuple(lay.base))
+    _set_joints(model, data, placed)
+    mujoco.mj_forward(model, data)
+    spec = _scene_spec(task, seed, lay, placed, bindings, model, data)
+    overlap = val.initial_overlap(model, data, spec)
+    if overlap is not None:
+        report = ValidationReport(ok=False, reason=overlap, checks=[])
+        return Built(spec, mjspec, model, data, report, None)
+    nsteps = max(1, int(round(settings.build.settle_s / model.opt.timestep)))
+    mujoco.mj_step(model, data, nstep=nsteps)
+    mujoco.mj_forward(model, data)
+    spec = _scene_spec(task, seed, lay, placed, bindings, model, data)
+    graph = scene_graph(model, data, spec)
+    hc = _kb().hazard_classes.get(task.hazard_class)
+    report = val.validate(model, data, spec, graph, hc)
+    return Built(spec, mjspec, model, data, report, graph)
+
+
+def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, model, data) -> SceneSpec:
+    objects = []
+    for p in placed.values():
+        body = data.body(p.name)
+        if p.asset is not None:
+            ref = p.asset.ref
+            size = float(p.asset.size)
+            joints = [
+                JointState(
+                    name=f"{p.name}/{j.name}",
+                    label=j.label,
+                    type=j.type,
+                    value=float(data.joint(f"{p.name}/{j.name}").qpos[0]),
+                    range=(float(j.range[0]), float(j.range[1])),
+                    closed_value=float(j.closed_value),
+                )
+                for j in p.asset.joints
+            ]
+        else:
+            s = p.support_geom
+            ref = AssetRef(
+                asset_id=f"support-{s.kind}-{s.top:.3f}",
+                category=s.category,
+                source=AssetSource.PROCEDURAL,
+                params={"kind": s.kind, "half": list(s.half), "top": s.top, "thickness": s.thickness},
+            )
+            size = s.size
+            joints = []
+        objects.append(
+            PlacedObject(
+                name=p.name,
+                asset=ref,
+                role=p.role,
+                size=size,
+                pos=[float(v) for v in body.xpos],
+                quat=[float(v) for v in body.xquat],
+                support=p.support,
+                inside=p.inside,
+                joint_states=joints,
+                fixed=p.fixed,
+            )
+        )
+    return SceneSpec(
+        scene_id=scene_id_for(task.id),
+        task_id=task.id,
+        room=task.scenario.room,
+        seed=seed,
+        objects=objects,
+        robot_base=[float(v) for v in lay.base],
+        bindings=bindings,
+    )
+
+
+def scene_id_for(task_id: str) -> str:
+    """An opaque scene id: task ids may carry words of the task, which detection must not see."""
+    return f"scene_{stable_hash('scene', task_id) & 0xFFFFFFFFFF:010x}"
+
+
+# ============================================================================ public entry
+
+
+def build_scene(task: TaskProposal, *, seed: int, settings, out_dir: Path) -> SceneSpec:
+    """Build, settle, validate, repair and write one scene; raises ItemFailed with a one-line reason."""
+    attempts = settings.build.repair_attempts + 1
+    reason = "no attempt made"
+    built = None
+    for attempt in range(attempts):
+        try:
+            built = _attempt(task, seed, settings, attempt)
+        except ItemFailed as exc:
+            reason = str(exc)
+            log.debug("%s attempt %d: %s", task.id, attempt, reason)
+            continue
+        if built.report.ok:
+            built.report.repairs = attempt
+            break
+        reason = built.report.reason
+        log.debug("%s attempt %d: %s", task.id, attempt, reason)
+        built = None
+    if built is None:
+        raise ItemFailed(f"no valid scene after {attempts} attempt(s): {reason}")
+    return write_outputs(built, settings, Path(out_dir))
+
+
+def write_outputs(built: Built, settings, out_dir: Path) -> SceneSpec:
+    from anomalygen.scene.render import SceneRenderer, png_bytes
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    model, data, mjspec = built.model, built.data, built.mjspec
+    key = mjspec.key("init")
+    key.qpos = data.qpos.copy()
+    key.qvel = np.zeros(model.nv)
+    key.ctrl = data.ctrl.copy()
+    if model.nmocap:
+        key.mpos = data.mocap_pos.flatten().copy()
+        key.mquat = data.mocap_quat.flatten().copy()
+    files = {"xml": "scene.xml", "spec": "scene.json", "graph": "scene_graph.json"}
+    _write_xml(mjspec, out_dir)
+    with SceneRenderer(model, settings.build.render_width, settings.build.render_height) as r:
+        for cam in CAMERAS:
+            atomic_write_bytes(out_dir / f"render_{cam}.png", png_bytes(r.render(data, cam)))
+            files[f"render_{cam}"] = f"render_{cam}.png"
+    spec = built.spec.model_copy(update={"validation": built.report, "files": files})
+    write_model(out_dir / "scene_graph.json", built.graph)
+    write_model(out_dir / "scene.json", spec)  # last: its presence marks the scene done
+    return spec
+
+
+def _write_xml(mjspec, out_dir: Path) -> None:
+    """scene.xml with robot meshes under assets/franka, loadable from any working directory."""
+    src = robot.franka_assets_dir() / "meshes"
+    dst = out_dir / "assets" / "franka"
+    for rel in robot.mesh_files():
+        target = dst / rel
+        if target.exists():
+            continue
+        target.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            os.link(src / rel, target)  # hard link: no copy of the 6 MB of meshes per scene
+        except OSError:
+            shutil.copyfile(src / rel, target)
+    xml = mjspec.to_xml()
+    xml = xml.replace(f'meshdir="{src}"', 'meshdir="assets/franka"', 1)
+    if 'meshdir="assets/franka"' not in xml:  # pragma: no cover - MuJoCo changed its XML writer
+        raise RuntimeError("could not relocate the robot mesh folder in scene.xml")
+    atomic_write_text(out_dir / "scene.xml", xml)

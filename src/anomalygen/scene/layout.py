@@ -1,0 +1,300 @@
+"""Placement: proposals in a unit cube, then a solver for support, non-overlap and reach.
+
+As in the paper, task-relevant objects are proposed at (x, y, z) inside the cube (0..1)^3 and
+unrelated clutter outside it. The cube is mapped onto the floor area in front of the robot
+(``REGION_ORIGIN`` .. + ``REGION_SIZE``). The solver then snaps each proposal onto its support (the
+floor, a support's top surface, a container's cavity, an edge band for ``*_edge`` placements),
+rejects proposals whose footprints overlap already placed objects (oriented boxes in the plane plus a
+height test), and moves the robot base so the hazard is within the arm's reach. MuJoCo contacts
+re-check the result after compiling (build.py), so this solver only has to be conservative.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from anomalygen.errors import ItemFailed
+from anomalygen.schema import ObjectRole
+from anomalygen.scene.furniture import Support
+from anomalygen.scene.robot import BASE_RADIUS
+
+REGION_ORIGIN = np.array([0.8, -0.6, 0.0])  # world position of the cube corner (0, 0, 0)
+REGION_SIZE = np.array([1.1, 1.2, 1.0])
+ROOM_HALF = np.array([1.9, 2.0])  # floor area used, around ROOM_CENTER
+ROOM_CENTER = np.array([1.0, 0.0])
+DROP_GAP = 0.002  # objects start this far above their support and settle onto it
+EDGE_BAND = (0.015, 0.07)  # metres from the edge for *_edge placements (KB threshold: 0.12)
+WALKWAY_CLEAR = 0.42  # > the KB's 0.3 m walkway clearance, with margin
+ARM_REACH = 0.95  # horizontal reach from the base centre to an object, with the arm's offset
+TRIES = 60
+
+
+@dataclass
+class Placed:
+    """A planned object: what it is, where its origin goes and what holds it."""
+
+    name: str
+    catalogue: str
+    role: ObjectRole
+    lo: np.ndarray  # local AABB (asset frame, bottom at z = lo[2])
+    hi: np.ndarray
+    fixed: bool
+    asset: object | None = None
+    support_geom: Support | None = None
+    joint_values: dict[str, float] = field(default_factory=dict)
+    front: np.ndarray | None = None  # local xy unit vector of the side doors/drawers open to
+    pos: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    yaw: float = 0.0
+    support: str = "floor"
+    inside: str | None = None
+    sweep: float = 0.0  # extra clearance in front for open doors/drawers
+
+    def world_half(self) -> np.ndarray:
+        c, s = abs(math.cos(self.yaw)), abs(math.sin(self.yaw))
+        h = (self.hi - self.lo) / 2
+        return np.array([c * h[0] + s * h[1], s * h[0] + c * h[1], h[2]])
+
+    def world_center(self) -> np.ndarray:
+        cl = (self.hi + self.lo) / 2
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        return self.pos + np.array([c * cl[0] - s * cl[1], s * cl[0] + c * cl[1], cl[2]])
+
+    def footprint(self) -> tuple[np.ndarray, np.ndarray]:
+        """World AABB (lo, hi) including the sweep of open doors/drawers."""
+        center, half = self.world_center(), self.world_half()
+        lo, hi = center - half, center + half
+        if self.sweep > 0 and self.front is not None:
+            c, s = math.cos(self.yaw), math.sin(self.yaw)
+            f = np.array([c * self.front[0] - s * self.front[1], s * self.front[0] + c * self.front[1], 0.0])
+            lo = np.minimum(lo, lo + f * self.sweep)
+            hi = np.maximum(hi, hi + f * self.sweep)
+        return lo, hi
+
+    @property
+    def quat(self) -> list[float]:
+        return [math.cos(self.yaw / 2), 0.0, 0.0, math.sin(self.yaw / 2)]
+
+
+def face_robot_yaw(front: np.ndarray | None, target_dir: np.ndarray) -> float:
+    """Yaw that turns the local ``front`` direction towards ``target_dir`` (both xy)."""
+    if front is None:
+        return 0.0
+    return math.atan2(target_dir[1], target_dir[0]) - math.atan2(front[1], front[0])
+
+
+def overlaps(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], margin: float = 0.02) -> bool:
+    return bool(np.all(a[0] < b[1] + margin) and np.all(b[0] < a[1] + margin))
+
+
+class Layout:
+    """The solver state: placed objects and the robot base."""
+
+    def __init__(self, rng: np.random.Generator, *, relevant_in_cube: bool = True):
+        self.rng = rng
+        self.relevant_in_cube = relevant_in_cube
+        self.items: list[Placed] = []
+        self.base = np.array([0.0, 0.0, 0.0])
+
+    # ---------------------------------------------------------------- proposals
+    def propose_xy(self, relevant: bool) -> np.ndarray:
+        """A proposal in the unit cube (relevant) or outside it (unrelated), mapped to the floor."""
+        if relevant or not self.relevant_in_cube:
+            u = self.rng.uniform(0.0, 1.0, size=2)
+            return REGION_ORIGIN[:2] + u * REGION_SIZE[:2]
+        for _ in range(100):
+            p = ROOM_CENTER + self.rng.uniform(-1, 1, size=2) * ROOM_HALF
+            u = (p - REGION_ORIGIN[:2]) / REGION_SIZE[:2]
+            if not np.all((u >= 0) & (u <= 1)) and np.linalg.norm(p - self.base[:2]) > BASE_RADIUS + 0.4:
+                return p
+        return ROOM_CENTER + np.array([1.2, 0.0])
+
+    # ---------------------------------------------------------------- checks
+    def collides(self, obj: Placed, *, ignore: tuple[str, ...] = ()) -> bool:
+        box = obj.footprint()
+        if np.any(box[0][:2] < ROOM_CENTER - ROOM_HALF - 0.3) or np.any(box[1][:2] > ROOM_CENTER + ROOM_HALF + 0.3):
+            return True
+        for other in self.items:
+            if other.name in ignore or other.name == obj.name:
+                continue
+            if overlaps(box, other.footprint()):
+                return True
+        return self._hits_base(box)
+
+    def _hits_base(self, box) -> bool:
+        """Does a world AABB intrude on the robot: its base disc, or the arm's box at the home pose?"""
+        if box[0][2] < 0.35:
+            closest = np.clip(self.base[:2], box[0][:2], box[1][:2])
+            if float(np.linalg.norm(closest - self.base[:2])) < BASE_RADIUS + 0.08:
+                return True
+        return overlaps(box, self.arm_box(), margin=0.03)
+
+    def arm_box(self) -> tuple[np.ndarray, np.ndarray]:
+        """World AABB of the arm at its home pose (forward of the base, raised)."""
+        c, s = math.cos(self.base[2]), math.sin(self.base[2])
+        corners = [np.array([self.base[0] + c * x - s * y, self.base[1] + s * x + c * y]) for x in (-0.2, 0.42) for y in (-0.15, 0.15)]
+        xy = np.array(corners)
+        return np.r_[xy.min(0), 0.35], np.r_[xy.max(0), 1.2]
+
+    # ---------------------------------------------------------------- placing
+    def place_on_floor(self, obj: Placed, *, relevant: bool, face: bool = True, clear_of: list[Placed] | None = None) -> None:
+        """Stand ``obj`` on the floor at a proposal that overlaps nothing (furniture faces the robot)."""
+        for attempt in range(2 * TRIES):
+            # a crowded cube: fall back to anywhere in the room rather than fail the scene
+            xy = self.propose_xy(relevant and attempt < TRIES)
+            if face and obj.front is not None:
+                # furniture faces the robot, square to the room (multiples of 90 degrees)
+                yaw = face_robot_yaw(obj.front, self.base[:2] - xy)
+                yaw = round(yaw / (math.pi / 2)) * (math.pi / 2)
+            else:
+                yaw = float(self.rng.uniform(-math.pi, math.pi))
+            obj.yaw = yaw
+            if obj.support_geom is not None:
+                z = 0.0  # built from floor level
+            else:
+                z = -obj.lo[2] + (0.0 if obj.fixed else DROP_GAP)
+            obj.pos = np.array([xy[0], xy[1], z])
+            obj.pos[:2] -= obj.world_center()[:2] - obj.pos[:2]  # centre the footprint on the proposal
+            if clear_of is not None and any(_h_gap(obj.footprint(), f.footprint()) < WALKWAY_CLEAR for f in clear_of):
+                continue
+            if not self.collides(obj):
+                obj.support = "floor"
+                self.items.append(obj)
+                return
+        raise ItemFailed(f"no free floor spot for {obj.name}")
+
+    def place_on_surface(
+        self,
+        obj: Placed,
+        holder: Placed,
+        surface: tuple[np.ndarray, np.ndarray, float],
+        *,
+        edge: bool = False,
+        inward: float = 0.0,
+        label: str | None = None,
+    ) -> None:
+        """Rest ``obj`` on a rectangle (world lo_xy, hi_xy, top z) of ``holder``.
+
+        ``edge``: the footprint ends 1.5-7 cm from the surface edge that faces the robot (the
+        knowledge base counts <= 12 cm as "near the edge"). ``inward``: keep this far from all edges.
+        """
+        lo_xy, hi_xy, top = surface
+        for _ in range(TRIES):
+            obj.yaw = float(self.rng.choice([0.0, math.pi / 2, math.pi, -math.pi / 2]) + self.rng.uniform(-0.15, 0.15))
+            half = obj.world_half()
+            room = (hi_xy - lo_xy) / 2 - half[:2] - inward
+            if np.any(room < 0):
+                obj.yaw = 0.0 if (obj.hi - obj.lo)[0] <= (obj.hi - obj.lo)[1] else math.pi / 2
+                half = obj.world_half()
+                room = (hi_xy - lo_xy) / 2 - half[:2] - inward
+                if np.any(room < -1e-6):
+                    raise ItemFailed(f"{obj.name} ({2 * half[0]:.2f}x{2 * half[1]:.2f} m) does not fit on {holder.name}")
+            center = (lo_xy + hi_xy) / 2 + self.rng.uniform(-1, 1, size=2) * np.maximum(room, 0)
+            if edge:
+                # The robot-facing edge of the surface: the side whose outward normal points to the base.
+                to_base = self.base[:2] - (lo_xy + hi_xy) / 2
+                axis = int(np.argmax(np.abs(to_base)))
+                sign = np.sign(to_base[axis]) or -1.0
+                gap = self.rng.uniform(*EDGE_BAND)
+                bound = hi_xy[axis] if sign > 0 else lo_xy[axis]
+                center[axis] = bound - sign * (half[axis] + gap)
+            cl = (obj.hi + obj.lo) / 2
+            c, s = math.cos(obj.yaw), math.sin(obj.yaw)
+            offset = np.array([c * cl[0] - s * cl[1], s * cl[0] + c * cl[1]])
+            obj.pos = np.array([center[0] - offset[0], center[1] - offset[1], top - obj.lo[2] + DROP_GAP])
+            if not self.collides(obj, ignore=(holder.name,)):
+                obj.support = label or holder.name
+                self.items.append(obj)
+                return
+        raise ItemFailed(f"no free spot for {obj.name} on {holder.name}")
+
+    def place_in_cavity(self, obj: Placed, holder: Placed, cavity_world: tuple[np.ndarray, np.ndarray]) -> None:
+        """Put ``obj`` on the floor of a cavity (world AABB), centred with a little jitter."""
+        lo, hi = cavity_world
+        obj.yaw = holder.yaw
+        half = obj.world_half()
+        room = (hi[:2] - lo[:2]) / 2 - half[:2] - 0.01
+        if np.any(room < 0) or (hi[2] - lo[2]) < 2 * half[2] + 0.01:
+            raise ItemFailed(f"{obj.name} does not fit inside {holder.name}")
+        center = (lo[:2] + hi[:2]) / 2 + self.rng.uniform(-0.5, 0.5, size=2) * room
+        cl = (obj.hi + obj.lo) / 2
+        c, s = math.cos(obj.yaw), math.sin(obj.yaw)
+        offset = np.array([c * cl[0] - s * cl[1], s * cl[0] + c * cl[1]])
+        obj.pos = np.array([center[0] - offset[0], center[1] - offset[1], lo[2] - obj.lo[2] + DROP_GAP])
+        obj.support = holder.name
+        obj.inside = holder.name
+        self.items.append(obj)
+
+    # ---------------------------------------------------------------- reach
+    def fit_base(self, focus: Placed, holder: Placed | None = None) -> None:
+        """Move the base so ``focus`` is within reach, facing it, clear of every footprint.
+
+        Loose objects: the base centre within 0.35-0.85 m (horizontally) of the object's centre.
+        Furniture: 0.45-0.9 m from its footprint (doors swept open included), so the arm's home
+        pose clears it and the arm still reaches the door edge or handle. An object inside
+        furniture (``holder``): the furniture rule, and the object within 1.05 m. Among valid poses the one
+        closest to the room's robot home (the origin) wins, so scenes look alike.
+        """
+        target = focus.world_center()
+        if target[2] > 1.45 and not focus.fixed:
+            raise ItemFailed(f"the robot cannot reach {focus.name} at {target[2]:.2f} m")
+        inner = None
+        if holder is not None and holder.fixed:
+            inner, focus = target, holder
+        box = focus.footprint()
+        best, best_cost = None, np.inf
+        lo = ROOM_CENTER - ROOM_HALF + BASE_RADIUS
+        hi = ROOM_CENTER + ROOM_HALF - BASE_RADIUS
+        for x in np.arange(lo[0], hi[0] + 1e-9, 0.1):
+            for y in np.arange(lo[1], hi[1] + 1e-9, 0.1):
+                xy = np.array([x, y])
+                if focus.fixed:
+                    closest = np.clip(xy, box[0][:2], box[1][:2])
+                    gap = float(np.linalg.norm(closest - xy))
+                    if not 0.45 <= gap <= 0.9:
+                        continue
+                    if inner is not None and np.linalg.norm(inner[:2] - xy) > 1.05:
+                        continue
+                    aim = closest if inner is None else inner[:2]
+                else:
+                    d = float(np.linalg.norm(target[:2] - xy))
+                    if not 0.35 <= d <= 0.85:
+                        continue
+                    aim = target[:2]
+                cost = float(np.linalg.norm(xy))
+                if cost >= best_cost:
+                    continue
+                if self._base_ok(xy, aim):
+                    best, best_cost = (xy, aim), cost
+        if best is None:
+            raise ItemFailed(f"the robot cannot reach {focus.name}: no free base pose")
+        xy, aim = best
+        self.base = np.array([xy[0], xy[1], math.atan2(aim[1] - xy[1], aim[0] - xy[0])])
+
+    def _base_ok(self, xy: np.ndarray, aim: np.ndarray) -> bool:
+        old = self.base.copy()
+        self.base = np.array([xy[0], xy[1], math.atan2(aim[1] - xy[1], aim[0] - xy[0])])
+        try:
+            return not any(self._hits_base(o.footprint()) for o in self.items)
+        finally:
+            self.base = old
+
+
+def _h_gap(a, b) -> float:
+    gap = np.maximum(0.0, np.maximum(a[0][:2] - b[1][:2], b[0][:2] - a[1][:2]))
+    return float(np.linalg.norm(gap))
+
+
+def surface_world(holder: Placed, center_local, half_size) -> tuple[np.ndarray, np.ndarray, float]:
+    """A holder's local surface rectangle in world coordinates (yaw multiples of 90 deg handled exactly)."""
+    c, s = math.cos(holder.yaw), math.sin(holder.yaw)
+    cx, cy, top = center_local
+    center = holder.pos[:2] + np.array([c * cx - s * cy, s * cx + c * cy])
+    hx, hy = half_size
+    half = np.array([abs(c) * hx + abs(s) * hy, abs(s) * hx + abs(c) * hy])
+    # a rotated rectangle's axis-aligned box is larger than the rectangle: shrink to stay on it
+    if abs(math.sin(2 * holder.yaw)) > 1e-3:
+        half = np.minimum(half, np.array([min(hx, hy)] * 2))
+    return center - half, center + half, float(holder.pos[2] + top)

@@ -1,0 +1,100 @@
+"""Validation of a settled scene: physics first, then the hazard itself.
+
+The paper's VLM check let 4 of 111 scenes with overlapping assets through. Here a scene is valid only
+if MuJoCo says so: no contact penetrates more than 1 mm, every loose object has come to rest, nothing
+fell out of the room, and the hazard class's detection preconditions from the knowledge base hold on
+the scene graph of the settled state (so the hazard is real, not just intended).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from anomalygen.schema import SceneSpec, ValidationCheck, ValidationReport
+
+MAX_PENETRATION = 0.001  # m
+MAX_LIN_VEL = 0.02  # m/s
+MAX_ANG_VEL = 0.3  # rad/s
+INITIAL_OVERLAP = 0.004  # m: deeper than this before settling means the layout overlaps
+
+
+def _owners(model, spec: SceneSpec) -> np.ndarray:
+    """Geom -> object index (robot = -2, room = -1)."""
+    from anomalygen.scene.graph import _index
+    from anomalygen.scene.robot import robot_geom_ids
+
+    owner = _index(model, spec).geom_owner.copy()
+    owner[robot_geom_ids(model)] = -2
+    return owner
+
+
+def _contacts(model, data):
+    n = data.ncon
+    return np.asarray(data.contact.geom1[:n]), np.asarray(data.contact.geom2[:n]), np.asarray(data.contact.dist[:n])
+
+
+def initial_overlap(model, data, spec: SceneSpec) -> str | None:
+    """A reason when two different things interpenetrate before any physics ran, else None."""
+    owner = _owners(model, spec)
+    g1, g2, dist = _contacts(model, data)
+    for a, b, d in zip(g1, g2, dist, strict=True):
+        if d < -INITIAL_OVERLAP and owner[a] != owner[b]:
+            return f"initial overlap of {_who(model, spec, owner, a)} and {_who(model, spec, owner, b)} ({-d * 1000:.0f} mm)"
+    return None
+
+
+def _who(model, spec, owner, geom) -> str:
+    o = owner[geom]
+    if o >= 0:
+        return spec.objects[o].name
+    return "the robot" if o == -2 else "the room"
+
+
+def validate(model, data, spec: SceneSpec, graph, hc) -> ValidationReport:
+    """Physics and hazard checks of the current (settled) state."""
+    owner = _owners(model, spec)
+    checks: list[ValidationCheck] = []
+    g1, g2, dist = _contacts(model, data)
+    pen, worst, self_pen, self_worst = 0.0, "", 0.0, ""
+    for a, b, d in zip(g1, g2, dist, strict=True):
+        if owner[a] == owner[b] and owner[a] >= 0:
+            # parts of one articulated asset touching each other: the asset's own business
+            if -d > self_pen:
+                self_pen, self_worst = float(-d), _who(model, spec, owner, a)
+        elif -d > pen:
+            pen, worst = float(-d), f"{_who(model, spec, owner, a)} / {_who(model, spec, owner, b)}"
+    checks.append(ValidationCheck(name="max_penetration", passed=pen <= MAX_PENETRATION, value=pen, limit=MAX_PENETRATION, detail=worst))
+    checks.append(ValidationCheck(name="self_contact_penetration", passed=True, value=self_pen, detail=f"informational: {self_worst}" if self_worst else "informational"))
+
+    lin, ang = 0.0, 0.0
+    for o in spec.objects:
+        if o.fixed:
+            continue
+        v = data.joint(f"{o.name}/free").qvel
+        lin, ang = max(lin, float(np.linalg.norm(v[:3]))), max(ang, float(np.linalg.norm(v[3:])))
+    checks.append(ValidationCheck(name="settled_linear_velocity", passed=lin <= MAX_LIN_VEL, value=lin, limit=MAX_LIN_VEL))
+    checks.append(ValidationCheck(name="settled_angular_velocity", passed=ang <= MAX_ANG_VEL, value=ang, limit=MAX_ANG_VEL))
+
+    lost = [g.name for g in graph.objects if g.position[2] < -0.02 or not np.all(np.isfinite(g.position))]
+    checks.append(ValidationCheck(name="objects_in_room", passed=not lost, detail=", ".join(lost)))
+
+    if hc is not None:
+        from anomalygen.knowledge.predicates import PredicateError, evaluate
+
+        for call in hc.preconditions:
+            try:
+                res = evaluate(call, graph, spec.bindings)
+                passed, detail = res.holds, res.explanation
+            except PredicateError as exc:
+                passed, detail = False, str(exc)
+            name = ("not " if call.negate else "") + call.name
+            checks.append(ValidationCheck(name=f"precondition:{name}", passed=passed, detail=detail))
+    else:
+        checks.append(ValidationCheck(name="precondition:none", passed=True, detail="hazard class 'other': no machine-checkable preconditions"))
+
+    failed = [c for c in checks if not c.passed]
+    reason = ""
+    if failed:
+        c = failed[0]
+        reason = f"{c.name} failed" + (f": {c.detail}" if c.detail else "") + (f" ({c.value:.4g} > {c.limit:.4g})" if c.value is not None and c.limit is not None else "")
+    return ValidationReport(ok=not failed, checks=checks, reason=reason)
