@@ -56,7 +56,7 @@ def _hazard_instance(hc, bindings: dict[str, str]) -> str:
 
 def candidates(graph: SceneGraph, kb=None) -> list[Candidate]:
     """Every (object, class) hit in the scene, de-duplicated (best match kept), unranked."""
-    from anomalygen.knowledge.predicates import PredicateError, match_class
+    from anomalygen.knowledge.predicates import PredicateError, evaluate, match_class
 
     kb = kb if kb is not None else _kb()
     by_name = {o.name: o for o in graph.objects}
@@ -85,13 +85,27 @@ def candidates(graph: SceneGraph, kb=None) -> list[Candidate]:
                 score=round(score, 6),
                 problem=f"{hc.name}: {obj} ({category.replace('_', ' ')}) — {hc.why}",
                 solution=solution,
-                explanation=f"{hc.id} holds because {m.explanation}",
+                explanation=f"{hc.id} holds because {_because(hc, graph, m.bindings, evaluate)}",
                 bindings=tuple(sorted(m.bindings.items())),
             )
             key = (obj, hc.id)
             if key not in best or (cand.score, cand.bindings) > (best[key].score, best[key].bindings):
                 best[key] = cand
     return list(best.values())
+
+
+def _because(hc, graph: SceneGraph, bindings: dict[str, str], evaluate) -> str:
+    """The preconditions' own descriptions of the scene state, de-duplicated, in class order.
+
+    Each predicate describes what it saw ("knife_0 is 0.90 m above the floor", "knife_0 is not
+    inside anything"), which reads correctly whether or not the call was negated.
+    """
+    parts: list[str] = []
+    for call in hc.preconditions:
+        text = evaluate(call, graph, bindings).explanation
+        if text and text not in parts:
+            parts.append(text)
+    return "; ".join(parts)
 
 
 def rank(cands: list[Candidate], k: int) -> list[Candidate]:
