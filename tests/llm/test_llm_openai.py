@@ -8,7 +8,7 @@ import time
 
 import numpy as np
 import pytest
-from llm_helpers import USER, VALID, VALID_TEXT
+from llm_helpers import USER, VALID, VALID_TEXT, complete_in_child
 
 from anomalygen.config import LLMConfig, Settings
 from anomalygen.errors import ItemFailed, UserError
@@ -309,3 +309,36 @@ def test_unrelated_400_does_not_downgrade_structured_mode(scripted_server, tmp_p
     ]
     assert client.complete(USER, schema=Scenario).room == "kitchen"
     assert srv.requests[-1]["response_format"]["type"] == "json_schema"
+
+
+def test_switches_to_max_completion_tokens_when_asked(scripted_server, tmp_path):
+    msg = json.dumps(
+        {"error": {"message": "Unsupported parameter: 'max_tokens'. Use 'max_completion_tokens' instead."}}
+    )
+
+    def responder(body):
+        return status(400, msg) if "max_tokens" in body else text(VALID_TEXT)
+
+    srv = scripted_server(responder)
+    client = client_for(srv, tmp_path, cache=False)
+    assert client.complete(USER, schema=Scenario, max_tokens=77).room == "kitchen"
+    assert srv.requests[-1]["max_completion_tokens"] == 77
+    assert srv.requests[-1]["response_format"]["type"] == "json_schema"
+
+
+def test_client_pickles_into_spawn_workers_and_usage_adds_up(scripted_server, tmp_path):
+    import multiprocessing as mp
+    import pickle
+
+    srv = scripted_server([text(VALID_TEXT, prompt_tokens=3, completion_tokens=2)])
+    client = client_for(srv, tmp_path, api_key="sk-pickle-secret")
+    clone = pickle.loads(pickle.dumps(client))
+    assert clone.config == client.config and clone.usage.requests == 0
+    with mp.get_context("spawn").Pool(2) as pool:
+        rooms = pool.starmap(complete_in_child, [(client, 0, 2), (client, 2, 2)])
+    assert rooms == [["kitchen"] * 2] * 2 and len(srv.requests) == 4
+    assert complete_in_child(client, 0, 4) == ["kitchen"] * 4 and len(srv.requests) == 4  # their cache writes
+    run = RunFolder.create(tmp_path / "run")
+    for _ in range(3):
+        record_usage(run, client.usage.model_copy(update={"requests": 1, "prompt_tokens": 3}))
+    assert run.load_manifest().llm_usage.requests == 3

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -27,6 +28,8 @@ from anomalygen.llm.cache import ReplyCache, cache_key
 from anomalygen.llm.jsonextract import JSONExtractError, extract_json
 from anomalygen.llm.schema_tools import bounded_schema, response_schema, schema_fingerprint
 from anomalygen.schema import LLMUsage, format_validation_error
+
+log = logging.getLogger("anomalygen.llm")
 
 MAX_ECHO_CHARS = 2000  # how much of a bad reply is echoed back in a repair turn
 MAX_ERROR_CHARS = 300
@@ -187,6 +190,10 @@ class LLMClient:
             taken, self.usage = self.usage, LLMUsage()
         return taken
 
+    def __reduce__(self):
+        """Pickle as "rebuild from config" so a client can travel to spawn-pool workers (usage starts at 0)."""
+        return (_rebuild_client, (self.config, self._rng, self._backoff_base_s, self._backoff_max_s))
+
     # ------------------------------------------------------------------ internals
     def _request(
         self,
@@ -243,6 +250,9 @@ class LLMClient:
                     raw = self.backend.complete_raw(req)
             except TransientError as exc:
                 if attempt + 1 >= attempts:
+                    log.warning(
+                        self._scrub(f"{self.backend.name}: giving up after {attempts} attempt(s): {exc}")
+                    )
                     raise LLMItemError(
                         self._scrub(
                             f"{self.backend.name} request failed after {attempts} attempt(s): {_one_line(str(exc))}"
@@ -250,7 +260,13 @@ class LLMClient:
                     ) from None
                 with self._lock:
                     self.usage.retries += 1
-                self._sleep(self._backoff(attempt))
+                delay = self._backoff(attempt)
+                log.info(
+                    self._scrub(
+                        f"{self.backend.name}: {exc}; retry {attempt + 1}/{attempts - 1} in {delay:.2f}s"
+                    )
+                )
+                self._sleep(delay)
                 continue
             except PermanentError as exc:
                 raise LLMItemError(
@@ -282,6 +298,14 @@ class LLMClient:
         for secret in self._secrets:
             text = text.replace(secret, "***")
         return text
+
+
+def _rebuild_client(config, rng, backoff_base_s, backoff_max_s) -> LLMClient:
+    from anomalygen.llm.factory import make_backend
+
+    return LLMClient(
+        config, make_backend(config), rng=rng, backoff_base_s=backoff_base_s, backoff_max_s=backoff_max_s
+    )
 
 
 class ReplyInvalid(ValueError):

@@ -67,7 +67,8 @@ class OpenAIBackend:
         self._client = openai.OpenAI(
             api_key=key or "not-needed", base_url=config.base_url, timeout=config.timeout_s, max_retries=0
         )
-        self._mode_index = 0  # moves down _MODES when a server rejects a structured-output mode
+        self._mode_index = 0
+        self._limit_param = "max_tokens"  # local servers know it; OpenAI's newer models want max_completion_tokens  # moves down _MODES when a server rejects a structured-output mode
         self._lock = threading.Lock()
 
     @property
@@ -86,7 +87,7 @@ class OpenAIBackend:
                 "model": self.model,
                 "messages": messages,
                 "temperature": request.temperature,
-                "max_tokens": request.max_tokens,
+                self._limit_param: request.max_tokens,
             }
             if request.seed is not None:
                 kwargs["seed"] = request.seed
@@ -104,6 +105,9 @@ class OpenAIBackend:
             try:
                 resp = self._client.chat.completions.create(**kwargs)
             except self._openai.BadRequestError as exc:
+                if "max_completion_tokens" in _short(exc) and self._limit_param == "max_tokens":
+                    self._limit_param = "max_completion_tokens"  # newer OpenAI models reject max_tokens
+                    continue
                 if index + 1 < len(_MODES):  # maybe the server lacks this structured-output mode
                     index += 1
                     continue
