@@ -16,6 +16,7 @@ from anomalygen.llm import LLMItemError, get_client, make_backend, record_usage
 from anomalygen.llm.client import LLMClient
 from anomalygen.runfolder import RunFolder
 from anomalygen.schema import Scenario
+from support.fixtures import llm_config_for
 from support.openai_server import hang, status, text
 
 
@@ -342,3 +343,15 @@ def test_client_pickles_into_spawn_workers_and_usage_adds_up(scripted_server, tm
     for _ in range(3):
         record_usage(run, client.usage.model_copy(update={"requests": 1, "prompt_tokens": 3}))
     assert run.load_manifest().llm_usage.requests == 3
+
+
+def test_shared_client_is_per_config_and_keeps_the_real_key(scripted_server, tmp_path):
+    from anomalygen.llm import shared_client
+
+    srv = scripted_server([text("pong")])
+    a = shared_client(llm_config_for(srv, tmp_path, api_key="sk-one"))
+    assert shared_client(llm_config_for(srv, tmp_path, api_key="sk-one")) is a
+    b = shared_client(llm_config_for(srv, tmp_path, api_key="sk-two"))
+    assert b is not a
+    b.complete(USER, cache=False)
+    assert srv.headers[-1]["authorization"] == "Bearer sk-two"

@@ -11,7 +11,15 @@ SDKs are imported only when a backend is built, so importing this package is che
 from __future__ import annotations
 
 from anomalygen.llm.client import LLMClient, LLMItemError, parse_reply
-from anomalygen.llm.factory import get_client, make_backend
+from anomalygen.llm.factory import get_client, make_backend, shared_client
 from anomalygen.llm.usage import record_usage
 
-__all__ = ["LLMClient", "LLMItemError", "get_client", "make_backend", "parse_reply", "record_usage"]
+__all__ = [
+    "LLMClient",
+    "LLMItemError",
+    "get_client",
+    "make_backend",
+    "parse_reply",
+    "record_usage",
+    "shared_client",
+]
