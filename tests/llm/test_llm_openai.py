@@ -355,3 +355,14 @@ def test_shared_client_is_per_config_and_keeps_the_real_key(scripted_server, tmp
     assert b is not a
     b.complete(USER, cache=False)
     assert srv.headers[-1]["authorization"] == "Bearer sk-two"
+
+
+def test_key_from_environment_is_scrubbed_too(scripted_server, tmp_path, monkeypatch):
+    secret = "sk-from-env-987654321"
+    monkeypatch.setenv("OPENAI_API_KEY", secret)
+    srv = scripted_server([status(403, json.dumps({"error": {"message": f"key {secret} is blocked"}}))])
+    client = client_for(srv, tmp_path, api_key=None)
+    with pytest.raises(LLMItemError) as info:
+        client.complete(USER)
+    assert srv.headers[0]["authorization"] == f"Bearer {secret}"
+    assert secret not in str(info.value) and "HTTP 403" in str(info.value)

@@ -93,7 +93,8 @@ class LLMClient:
         self._slots = threading.BoundedSemaphore(config.concurrency)
         self._cache = ReplyCache(config.cache_path) if config.cache else None
         secret = config.api_key.get_secret_value() if config.api_key else None
-        self._secrets = [s for s in (secret,) if s]
+        # scrub the configured key and one the backend took from the environment (OPENAI_API_KEY, ...)
+        self._secrets = [s for s in {secret, getattr(backend, "api_key_in_use", None)} if s and len(s) >= 4]
 
     # ------------------------------------------------------------------ public API
     @property
@@ -279,7 +280,8 @@ class LLMClient:
     def _backoff(self, attempt: int) -> float:
         delay = min(self._backoff_max_s, self._backoff_base_s * (2**attempt))
         if self._rng is not None:
-            delay *= 1.0 + 0.25 * float(self._rng.random())
+            with self._lock:  # a Generator is not thread-safe
+                delay *= 1.0 + 0.25 * float(self._rng.random())
         return delay
 
     def _account(self, raw: RawReply) -> None:

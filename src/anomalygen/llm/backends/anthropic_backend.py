@@ -42,6 +42,7 @@ class AnthropicBackend:
         if base and base.endswith("/v1"):
             base = base[: -len("/v1")]  # the SDK appends /v1/messages itself
         self.model = config.model
+        self.api_key_in_use = key  # only so the client can scrub it from error text
         self.supports_images = bool(config.vision)
         self._anthropic = anthropic
         # Recent SDKs dropped sampling parameters from ``messages.create``; send them only where accepted.

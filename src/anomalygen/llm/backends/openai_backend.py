@@ -62,6 +62,7 @@ class OpenAIBackend:
                 "no OpenAI API key: set OPENAI_API_KEY or ANOMALYGEN_LLM__API_KEY (or --base-url for a local server)"
             )
         self.model = config.model
+        self.api_key_in_use = key  # only so the client can scrub it from error text
         self.supports_images = bool(config.vision)
         self._openai = openai
         self._client = openai.OpenAI(
