@@ -134,8 +134,28 @@ def household_names() -> list[str]:
     return list(vocabulary()["household"])
 
 
+@functools.cache
+def _knowledge_sizes() -> dict[str, tuple[float, float]]:
+    """``size_range`` of every object in the knowledge base, the project's single source of sizes."""
+    try:
+        raw = json.loads(resources.files("anomalygen.data").joinpath("knowledge/objects.json").read_text())
+    except (FileNotFoundError, json.JSONDecodeError):
+        return {}
+    objs = raw.get("objects", {})
+    items = objs.items() if isinstance(objs, dict) else ((o.get("name"), o) for o in objs)
+    out = {}
+    for name, info in items:
+        sr = info.get("size_range") if isinstance(info, dict) else None
+        if name and sr and len(sr) == 2 and 0 < sr[0] <= sr[1]:
+            out[name] = (float(sr[0]), float(sr[1]))
+    return out
+
+
 def size_range(name: str) -> tuple[float, float]:
-    """Plausible largest dimension (metres) for a vocabulary name."""
+    """Plausible largest dimension (metres) for a vocabulary name: the knowledge base's
+    ``ObjectInfo.size_range`` when it has one, else the asset table's."""
+    if name in _knowledge_sizes():
+        return _knowledge_sizes()[name]
     try:
         lo, hi, _, _ = object_table()[name]
     except KeyError:
@@ -227,15 +247,12 @@ def _emit(mujoco, part: Part, body, scale: float, offset: np.ndarray, joints: li
 
 def _exclude_self_contacts(spec, root: Part) -> None:
     """No contacts between an asset's own bodies: a door must swing past its neighbours, a seat
-    through its lid's space. Parent-child pairs are already filtered by MuJoCo."""
+    through its lid's space. Parent-child pairs need excluding too: MuJoCo's parent filter does not
+    apply once furniture is welded to the world, and then a door would jam on its own cabinet."""
     names = [p.name for p, _, _ in root.walk()]
     names[0] = "root"
-    parent = {c.name: p.name for p, _, _ in root.walk() for c in p.children}
-    parent = {k: ("root" if v == root.name else v) for k, v in parent.items()}
     for i, a in enumerate(names):
         for b in names[i + 1 :]:
-            if parent.get(a) == b or parent.get(b) == a:
-                continue
             ex = spec.add_exclude()
             ex.bodyname1, ex.bodyname2 = a, b
 

@@ -298,7 +298,7 @@ def chair(rng):
     leg_c = colour(rng, WOOD + [METAL[2]])
     _chair_frame(r, hw, hd, seat_h, c, leg_c, bool(rng.random() < 0.5))
     back = r.child("backrest", (0, hd - 0.02, seat_h))
-    back.hinge("backrest_hinge", (1, 0, 0), (-1.3, 0), "backrest", 0.0)
+    back.hinge("backrest_hinge", (1, 0, 0), (0, 1.3), "backrest", 0.0)
     tilt = 0.12
     back.box((hw - 0.01, 0.015, back_h / 2), (0, 0.015 + back_h / 2 * math.sin(tilt), back_h / 2 + 0.01), c, D_WOOD, quat=(math.cos(tilt / 2), math.sin(tilt / 2), 0, 0))
     return Draft(r, {"back_height": back_h}, [Surface("seat", (0, -0.02, seat_h), (hw - 0.02, hd - 0.04))], [], [colour_name(c), "folding backrest", "children climb on it to reach high places"])
@@ -316,7 +316,7 @@ def folding_chair(rng):
         r.segment((sx * hw, hd, seat_h - 0.03), (sx * hw, hd + 0.03, seat_h + back_h), 0.012, fr, D_METAL)
     r.box((hw, 0.012, back_h * 0.3), (0, hd + 0.025, seat_h + back_h * 0.65), c, 700)
     seat = r.child("seat", (0, hd - 0.01, seat_h - 0.015))
-    seat.hinge("seat_hinge", (1, 0, 0), (0, 1.5), "seat", 0.0)
+    seat.hinge("seat_hinge", (1, 0, 0), (-1.5, 0), "seat", 0.0)
     seat.box((hw - 0.02, hd - 0.01, 0.012), (0, -hd + 0.01, 0.012), c, 700)
     return Draft(r, {}, [Surface("seat", (0, 0, seat_h + 0.01), (hw - 0.03, hd - 0.03))], [], [colour_name(c), "folding seat", "scissor metal frame", "can pinch fingers when folded"])
 
@@ -359,7 +359,7 @@ def trash_can(rng):
     feats = [colour_name(c), "hinged lid"]
     if pedal:
         p = r.child("pedal", (0, -rad + 0.02, 0.04))
-        p.hinge("pedal_hinge", (1, 0, 0), (0, 0.35), "pedal", 0.0)
+        p.hinge("pedal_hinge", (1, 0, 0), (0, 0.35), "pedal", 0.0, spring=True)
         p.box((rad * 0.35, 0.04, 0.006), (0, -0.04, 0), DARK, 1500)
         feats.append("foot pedal")
     cav = [Cavity("inside", (0, 0, h / 2 + 0.006), (rad * 0.68, rad * 0.68, h / 2 - 0.02), "top", "lid_hinge")]

@@ -583,8 +583,9 @@ def matches(rng):
 def plastic_bag(rng):
     r = Part("root")
     c = colour(rng, [WHITE, (0.9, 0.9, 0.8, 0.9), (0.3, 0.5, 0.8, 0.9)])
-    for _ in range(4):
-        r.ellipsoid((u(rng, 0.06, 0.12), u(rng, 0.05, 0.09), u(rng, 0.006, 0.015)), (u(rng, -0.05, 0.05), u(rng, -0.04, 0.04), 0.012), c, 20)
+    for k in range(4):  # flat overlapping folds: a crumpled bag lying flat, stable on the floor
+        hz = u(rng, 0.003, 0.008)
+        r.box((u(rng, 0.06, 0.12), u(rng, 0.05, 0.09), hz), (u(rng, -0.05, 0.05), u(rng, -0.04, 0.04), hz), c, 20, quat=axis_angle((0, 0, 1), u(rng, 0, math.pi)))
     return _d(r, ["thin crumpled plastic"], pieces=4)
 
 
@@ -699,11 +700,11 @@ def paper_ball(rng):
     r = Part("root")
     rad = u(rng, 0.025, 0.035)
     c = colour(rng, [WHITE, (0.95, 0.93, 0.8, 1)])
-    r.sphere(rad, (0, 0, rad), c, 80)
+    r.ellipsoid((rad, rad * 0.95, rad * 0.8), (0, 0, rad * 0.8), c, 80)  # flattened so it lies still
     for _ in range(5):
         d = rng.normal(size=3)
         d = d / np.linalg.norm(d) * rad * 0.6
-        r.sphere(rad * 0.5, (d[0], d[1], rad + d[2] * 0.6), c, 80, collide=False)
+        r.sphere(rad * 0.45, (d[0], d[1], rad * 0.8 + d[2] * 0.5), c, 1e-3, collide=False)
     return _d(r, ["crumpled paper"], radius=rad)
 
 
