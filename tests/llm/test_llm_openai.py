@@ -366,3 +366,14 @@ def test_key_from_environment_is_scrubbed_too(scripted_server, tmp_path, monkeyp
         client.complete(USER)
     assert srv.headers[0]["authorization"] == f"Bearer {secret}"
     assert secret not in str(info.value) and "HTTP 403" in str(info.value)
+
+
+def test_unreachable_endpoint_is_retried_then_an_item_error(tmp_path):
+    from support.openai_server import ScriptedOpenAIServer
+
+    with ScriptedOpenAIServer([text("x")]) as srv:
+        pass  # now nothing listens on its port
+    client = client_for(srv, tmp_path, http_retries=2, timeout_s=2.0)
+    with pytest.raises(LLMItemError, match=r"after 3 attempt\(s\): cannot connect to http://127.0.0.1:\d+"):
+        client.complete(USER)
+    assert client.usage.retries == 2 and client.usage.requests == 0

@@ -251,7 +251,7 @@ class LLMClient:
                     raw = self.backend.complete_raw(req)
             except TransientError as exc:
                 if attempt + 1 >= attempts:
-                    log.warning(
+                    log.debug(
                         self._scrub(f"{self.backend.name}: giving up after {attempts} attempt(s): {exc}")
                     )
                     raise LLMItemError(

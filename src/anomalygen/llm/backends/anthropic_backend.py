@@ -15,7 +15,7 @@ from typing import Any
 
 from anomalygen.errors import UserError
 from anomalygen.llm.backends import PermanentError, RawReply, Request, TransientError
-from anomalygen.llm.backends.openai_backend import _short, image_mime
+from anomalygen.llm.backends.openai_backend import _origin, _short, image_mime
 
 
 def split_system(messages: list[dict[str, Any]]) -> tuple[str, list[dict[str, Any]]]:
@@ -42,6 +42,7 @@ class AnthropicBackend:
         if base and base.endswith("/v1"):
             base = base[: -len("/v1")]  # the SDK appends /v1/messages itself
         self.model = config.model
+        self._where = _origin(config.base_url) if config.base_url else "the default endpoint"
         self.api_key_in_use = key  # only so the client can scrub it from error text
         self.supports_images = bool(config.vision)
         self._anthropic = anthropic
@@ -85,7 +86,7 @@ class AnthropicBackend:
         except a.APITimeoutError:
             raise TransientError("request timed out") from None
         except a.APIConnectionError as exc:
-            raise TransientError(f"connection failed: {type(exc).__name__}") from None
+            raise TransientError(f"cannot connect to {self._where}: {type(exc).__name__}") from None
         except a.APIStatusError as exc:
             if exc.status_code in (408, 409, 529) or exc.status_code >= 500:
                 raise TransientError(f"HTTP {exc.status_code}: {_short(exc)}") from None

@@ -62,6 +62,7 @@ class OpenAIBackend:
                 "no OpenAI API key: set OPENAI_API_KEY or ANOMALYGEN_LLM__API_KEY (or --base-url for a local server)"
             )
         self.model = config.model
+        self._where = _origin(config.base_url) if config.base_url else "the default endpoint"
         self.api_key_in_use = key  # only so the client can scrub it from error text
         self.supports_images = bool(config.vision)
         self._openai = openai
@@ -118,7 +119,7 @@ class OpenAIBackend:
             except self._openai.APITimeoutError:
                 raise TransientError("request timed out") from None
             except self._openai.APIConnectionError as exc:
-                raise TransientError(f"connection failed: {type(exc).__name__}") from None
+                raise TransientError(f"cannot connect to {self._where}: {type(exc).__name__}") from None
             except self._openai.APIStatusError as exc:
                 if exc.status_code in (408, 409) or exc.status_code >= 500:
                     raise TransientError(f"HTTP {exc.status_code}: {_short(exc)}") from None
@@ -153,3 +154,12 @@ def _short(exc: Exception) -> str:
         msg = err.get("message") if isinstance(err, dict) else str(err)
     text = str(msg or getattr(exc, "message", None) or exc)
     return " ".join(text.split())[:200]
+
+
+def _origin(url: str) -> str:
+    """scheme://host:port of an endpoint, for error messages (no path, no user:password)."""
+    from urllib.parse import urlsplit
+
+    parts = urlsplit(url)
+    host = parts.hostname or "?"
+    return f"{parts.scheme}://{host}" + (f":{parts.port}" if parts.port else "")
