@@ -29,7 +29,7 @@ def test_llamacpp_cli_ask_returns_schema_valid_task_proposal(tmp_path, monkeypat
     proposal = TaskProposal.model_validate_json(result.stdout)
     assert isinstance(proposal.scenario.room, str) and proposal.provenance.engine in ("knowledge", "llm")
     assert "llamacpp:SmolLM2-135M-Instruct" in result.stderr
-    assert first_s < 120
+    assert first_s < 300  # generous: a loaded 2-core CI box; ~10-25 s when quiet
 
     # same request again: served from the cache, identical object, no model call
     again = CliRunner().invoke(app, args)

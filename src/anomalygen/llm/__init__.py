@@ -5,14 +5,24 @@ in-process llama.cpp backends.
     client = get_client(settings.llm)
     proposal = client.complete(messages, schema=TaskProposal)   # a validated TaskProposal
 
-SDKs are imported only when a backend is built, so importing this package is cheap.
+Names are resolved lazily (PEP 562) so that ``anomalygen --help``, which imports ``anomalygen.llm.cli``,
+does not pay for numpy, pydantic models or any SDK.
 """
 
 from __future__ import annotations
 
-from anomalygen.llm.client import LLMClient, LLMItemError, parse_reply
-from anomalygen.llm.factory import get_client, make_backend, shared_client
-from anomalygen.llm.usage import record_usage
+import importlib
+from typing import TYPE_CHECKING, Any
+
+_EXPORTS = {
+    "LLMClient": "anomalygen.llm.client",
+    "LLMItemError": "anomalygen.llm.client",
+    "parse_reply": "anomalygen.llm.client",
+    "get_client": "anomalygen.llm.factory",
+    "make_backend": "anomalygen.llm.factory",
+    "shared_client": "anomalygen.llm.factory",
+    "record_usage": "anomalygen.llm.usage",
+}
 
 __all__ = [
     "LLMClient",
@@ -23,3 +33,21 @@ __all__ = [
     "record_usage",
     "shared_client",
 ]
+
+if TYPE_CHECKING:  # pragma: no cover
+    from anomalygen.llm.client import LLMClient, LLMItemError, parse_reply
+    from anomalygen.llm.factory import get_client, make_backend, shared_client
+    from anomalygen.llm.usage import record_usage
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'anomalygen.llm' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(list(globals()) + list(_EXPORTS))
