@@ -16,13 +16,16 @@ def _ngrams(text: str, n: int) -> set[tuple[str, ...]]:
     return {tuple(words[i : i + n]) for i in range(len(words) - n + 1)}
 
 
-def assert_no_leak(text: str, task) -> None:
-    """No 3-word phrase of the task's name/description/solution and no class id appear in the text."""
+def assert_no_leak(text: str, task, n: int = 4) -> None:
+    """No n-word phrase of the task's texts and no hazard-class id appear in the text.
+
+    n = 4: on real scenes, 3-word overlaps are generic phrases both sides use ("from the edge").
+    """
     lowered = text.lower()
     assert task.hazard_class not in lowered
     assert task.hazard_class.replace("_", " ") not in lowered
     for field in (task.name, task.description, task.solution, task.explanation):
-        shared = _ngrams(field, 3) & _ngrams(text, 3)
+        shared = _ngrams(field, n) & _ngrams(text, n)
         assert not shared, f"task phrase leaked into the observation: {shared}"
 
 

@@ -148,7 +148,13 @@ def run_stage(run: RunFolder, settings, *, force: bool = False, only: list[str] 
             raise UserError(f"unknown task id(s): {', '.join(unknown)}")
     make_detector(settings)  # fail fast (no LLM for llm/hybrid) before any item runs
     chosen = [t for t in tasks if not only or t.id in only]
-    items = [(t.id, t.model_dump(mode="json")) for t in chosen]
+    # A task whose scene was never built (or failed to build) is the build stage's failure, already
+    # recorded there; detection lists it in the report instead of failing it a second time.
+    built = [t for t in chosen if (run.scene_dir(t.id) / "scene_graph.json").is_file()]
+    if only and len(built) < len(chosen):
+        missing = sorted({t.id for t in chosen} - {t.id for t in built})
+        raise UserError(f"no built scene for: {', '.join(missing)} (run 'anomalygen build' first)")
+    items = [(t.id, t.model_dump(mode="json")) for t in built]
     summary = run_items(run, STAGE, items, _item, settings=settings, is_done=_is_done_for(run, settings), force=force,
                         description=f"detect ({settings.detect.detector})")
     _record_llm_usage(run, summary)
