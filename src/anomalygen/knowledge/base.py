@@ -210,7 +210,7 @@ def _call_problems(call: PredicateCall, predicates, names: set[str], declared: s
     if spec is None:
         return [f"unknown predicate {call.name}"]
     out = [f"{call.name}: unknown argument {a}" for a in call.args if a not in spec.args]
-    for a, v in call.args.items():
+    for v in call.args.values():
         if isinstance(v, str) and v.startswith("$") and v not in declared:
             out.append(f"{call.name}: undeclared variable {v}")
     if call.name == "has_property":

@@ -1,0 +1,153 @@
+"""The structured core of a brainstormed scenario, and its conversion into a TaskProposal.
+
+Agents (offline or LLM) think in *ideas*: a hazard class grounded in catalogue objects, a place, a
+room and a person at risk. Keeping that structure separate from the wording lets recombination work
+on meaning (borrow a location, a mechanism, a person) and lets every proposal be checked against
+the knowledge base before any text is written.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from anomalygen.knowledge import KnowledgeBase
+from anomalygen.schema import (
+    ArticulationUse,
+    AuxiliaryItem,
+    BrainstormMode,
+    Engine,
+    Provenance,
+    Scenario,
+    TaskProposal,
+)
+
+#: Aspects an agent can borrow from another agent's proposal in rounds >= 2.
+ASPECTS = ("mechanism", "location", "co_objects", "person_at_risk")
+
+
+@dataclass(frozen=True)
+class Idea:
+    class_id: str
+    target: str
+    hazard: str
+    placement: str
+    room: str
+    person: str
+    container: str | None = None
+    support: str | None = None
+    co_objects: tuple[str, ...] = ()
+    agent: str | None = None
+    agent_index: int = 0
+    round: int = 1
+    builds_on: tuple[str, ...] = ()
+    borrowed: tuple[str, ...] = ()
+
+    def key(self) -> tuple:
+        """What makes two ideas the same scenario (texts aside)."""
+        return (self.class_id, self.hazard, self.placement, self.room)
+
+
+@dataclass
+class Texts:
+    name: str
+    explanation: str
+    description: str
+    solution: str
+    success_condition: str
+    extra: dict[str, str] = field(default_factory=dict)
+
+
+def slugify(text: str, limit: int = 40) -> str:
+    slug = re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-")
+    return slug[:limit].rstrip("-") or "task"
+
+
+def task_id(index: int, name: str) -> str:
+    """Stable, readable ids: ``t0001-store-the-knife-left-on-the-counter``."""
+    return f"t{index:04d}-{slugify(name)}"
+
+
+def articulations_for(idea: Idea, kb: KnowledgeBase) -> list[ArticulationUse]:
+    """Articulated parts the task involves: the class's own one, and a container door the fix opens."""
+    hc = kb.hazard_classes[idea.class_id]
+    out: list[ArticulationUse] = []
+    if hc.articulation is not None:
+        obj = idea.hazard if hc.articulation.variable == hc.hazard_variable else idea.target
+        part = kb.articulation_part(hc, obj)
+        if part:
+            out.append(
+                ArticulationUse(
+                    object=obj,
+                    part=part,
+                    function=hc.articulation.function,
+                    initial_state=hc.articulation.initial_state,
+                    target_state=hc.articulation.target_state,
+                )
+            )
+    if idea.container and any(s.action == "open_joint" and s.args.get("object") == "$container" for s in hc.recipe):
+        part = next((s.args["label"] for s in hc.recipe if s.action == "open_joint"), "door")
+        out.append(
+            ArticulationUse(
+                object=idea.container,
+                part=part,
+                function="opened to put the item inside, then shut again",
+                initial_state="closed",
+                target_state="closed",
+            )
+        )
+    return out
+
+
+def auxiliary_items(idea: Idea, kb: KnowledgeBase) -> list[AuxiliaryItem]:
+    items: list[AuxiliaryItem] = []
+    seen = {idea.target}
+
+    def add(name: str | None, purpose: str) -> None:
+        if name and name not in seen:
+            seen.add(name)
+            items.append(AuxiliaryItem(name=name, description=kb.objects[name].description, purpose=purpose))
+
+    add(idea.hazard, "the hazard itself")
+    add(idea.container, "where the robot puts the item away")
+    add(idea.support, "the surface the item is moved onto")
+    for co in idea.co_objects:
+        add(co, "part of the everyday setting")
+    return items
+
+
+def to_proposal(
+    idea: Idea, texts: Texts, index: int, kb: KnowledgeBase, *, engine: Engine, mode: BrainstormMode, seed: int | None, model: str | None = None
+) -> TaskProposal:
+    hc = kb.hazard_classes[idea.class_id]
+    return TaskProposal(
+        id=task_id(index, texts.name),
+        name=texts.name,
+        explanation=texts.explanation,
+        description=texts.description,
+        category=hc.category,
+        hazard_class=hc.id,
+        target_asset=idea.target,
+        scenario=Scenario(
+            hazard_object=idea.hazard,
+            room=idea.room,
+            placement=idea.placement,
+            person_at_risk=idea.person,
+            container=idea.container or idea.support,
+            co_objects=list(idea.co_objects),
+        ),
+        auxiliary_items=auxiliary_items(idea, kb),
+        articulations=articulations_for(idea, kb),
+        solution=texts.solution,
+        success_condition=texts.success_condition,
+        provenance=Provenance(
+            engine=engine,
+            mode=mode,
+            agent_role=idea.agent,
+            round=idea.round,
+            builds_on=list(idea.builds_on),
+            borrowed=list(idea.borrowed),
+            seed=seed,
+            model=model,
+        ),
+    )

@@ -1,0 +1,197 @@
+"""The offline brainstorming engine: role-playing agents, recombination rounds, a novelty filter.
+
+It mirrors the paper's group brainstorming without an LLM. Round 1: every agent picks a target
+asset by its interests and grounds a scenario around it. Rounds >= 2: every agent reads the other
+agents' proposals from the previous round and recombines them (borrowing a mechanism, a location,
+co-objects or a person at risk) with its own interests. A Sentence-BERT novelty filter rejects
+near-duplicates of what the group has already proposed.
+
+Ablation modes (same realiser for all, so differences come from the method, not the wording code):
+- ``plain``: one role-less generator, one pass; uniform choices, no people, co-objects or perspective.
+- ``roleplay``: the role agents, one pass, no rounds and no novelty filter.
+- ``brainstorm``: role agents, R rounds of recombination, novelty filter.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from anomalygen.brainstorm.grounding import Grounder
+from anomalygen.brainstorm.idea import Idea, Texts, task_id, to_proposal
+from anomalygen.brainstorm.realise import realise
+from anomalygen.knowledge import KnowledgeBase, load_kb
+from anomalygen.rng import item_rng
+from anomalygen.schema import BrainstormMode, Engine, TaskProposal
+
+EmbedFn = Callable[[list[str]], np.ndarray]
+
+
+def proposal_text(name: str, description: str) -> str:
+    """The text diversity is measured on (as in the paper: name and description together)."""
+    return f"{name}. {description}"
+
+
+def agent_roles(kb: KnowledgeBase, n_agents: int) -> list[str]:
+    """Role ids for N agents: the ten roles in order, cycling when N > 10."""
+    roles = list(kb.roles)
+    return [roles[i % len(roles)] for i in range(n_agents)]
+
+
+def split_quota(total: int, parts: int, offset: int = 0) -> list[int]:
+    base, extra = divmod(total, parts)
+    return [base + (1 if (i - offset) % parts < extra else 0) for i in range(parts)]
+
+
+@dataclass
+class Accepted:
+    index: int
+    id: str
+    idea: Idea
+    texts: Texts
+    vector: np.ndarray | None
+
+
+class KnowledgeEngine:
+    """Generates TaskProposals from the knowledge base; deterministic for a seed."""
+
+    def __init__(
+        self,
+        *,
+        seed: int = 0,
+        mode: BrainstormMode = BrainstormMode.BRAINSTORM,
+        agents: int = 10,
+        rounds: int = 3,
+        novelty_threshold: float = 0.92,
+        unique: bool = True,
+        targets: list[str] | None = None,
+        embed_fn: EmbedFn | None = None,
+        kb: KnowledgeBase | None = None,
+        id_offset: int = 0,
+        max_extra_rounds: int = 3,
+    ):
+        self.kb = kb or load_kb()
+        self.seed = seed
+        self.mode = BrainstormMode(mode)
+        self.n_agents = 1 if self.mode == BrainstormMode.PLAIN else agents
+        self.rounds = rounds if self.mode == BrainstormMode.BRAINSTORM else 1
+        self.threshold = novelty_threshold
+        self.use_novelty = self.mode == BrainstormMode.BRAINSTORM
+        self.unique = unique or self.mode == BrainstormMode.BRAINSTORM
+        self.targets = targets
+        self.id_offset = id_offset
+        self.max_extra_rounds = max_extra_rounds if self.mode == BrainstormMode.BRAINSTORM else 3
+        if embed_fn is None and self.use_novelty:
+            from anomalygen.embedding import embed
+
+            embed_fn = embed
+        self.embed_fn = embed_fn
+        roles = agent_roles(self.kb, self.n_agents) if self.mode != BrainstormMode.PLAIN else [None]
+        self.agents: list[str | None] = roles
+        rich = self.mode != BrainstormMode.PLAIN
+        self.grounders = [
+            Grounder(self.kb, self.kb.roles[r] if r else None, targets=targets, rich=rich) for r in roles
+        ]
+        self.accepted: list[Accepted] = []
+        self.rejected_near_duplicates = 0
+        self.rejected_same_scenario = 0
+
+    # ------------------------------------------------------------------ public
+    def run(self, n: int) -> list[TaskProposal]:
+        quotas = split_quota(n, self.rounds)
+        carry = 0
+        r = 0
+        while True:
+            r += 1
+            want = (quotas[r - 1] if r <= self.rounds else 0) + carry
+            if want <= 0 and r >= self.rounds:
+                break
+            if r > self.rounds + self.max_extra_rounds:
+                break
+            previous = [a for a in self.accepted if a.idea.round == r - 1]
+            got = self._round(r, want, previous)
+            carry = want - got
+            if r >= self.rounds and carry <= 0:
+                break
+        return [self._proposal(a) for a in self.accepted]
+
+    # ------------------------------------------------------------------ rounds
+    def _round(self, r: int, want: int, previous: list[Accepted]) -> int:
+        """One round: every agent proposes its share; candidates are embedded in one batch per attempt.
+
+        Agents in a round do not see each other's same-round ideas (as in the paper), so all of a
+        round's candidates can be drafted first and filtered afterwards, in agent order.
+        """
+        needs = split_quota(want, self.n_agents, offset=r - 1)
+        seen = self._usage_counts() if self.mode == BrainstormMode.BRAINSTORM else {}
+        got_total = 0
+        for attempt in range(8):
+            drafts: list[tuple[int, Idea, Texts]] = []
+            for i, need in enumerate(needs):
+                if need <= 0:
+                    continue
+                grounder = self.grounders[i]
+                grounder.seen = seen
+                others = [(a.id, a.idea) for a in previous if a.idea.agent_index != i]
+                rng = item_rng(self.seed, "brainstorm", self.mode.value, r, i, attempt)
+                for _ in range(need + (1 if attempt == 0 else 2)):
+                    idea = None
+                    if r >= 2 and others:
+                        idea = grounder.recombine(rng, others, agent=self.agents[i], agent_index=i, round_=r)
+                    if idea is None:
+                        idea = grounder.fresh(rng, agent=self.agents[i], agent_index=i, round_=r)
+                    texts = realise(idea, self.kb, rng, perspective=self.mode != BrainstormMode.PLAIN)
+                    drafts.append((i, idea, texts))
+            if not drafts:
+                break
+            vectors = self._embed([t for _, _, t in drafts])
+            for k, (i, idea, texts) in enumerate(drafts):
+                if needs[i] <= 0:
+                    continue
+                if self._accept(idea, texts, None if vectors is None else vectors[k]):
+                    needs[i] -= 1
+                    got_total += 1
+            if attempt >= 2:  # an agent that keeps repeating the group hands its share on
+                leftover = sum(n for n in needs if n > 0)
+                needs = split_quota(leftover, self.n_agents, offset=r + attempt) if leftover else needs
+        return got_total
+
+    def _usage_counts(self) -> dict[str, int]:
+        """What the group has proposed so far (agents in a session see the shared pool)."""
+        counts: dict[str, int] = {}
+        for a in self.accepted:
+            i = a.idea
+            for key in {i.class_id, i.hazard, i.target, i.room, i.placement}:
+                counts[key] = counts.get(key, 0) + 1
+        return counts
+
+    def _embed(self, texts: list[Texts]) -> np.ndarray | None:
+        if not self.use_novelty or self.embed_fn is None:
+            return None
+        return np.asarray(self.embed_fn([proposal_text(t.name, t.description) for t in texts]), dtype=np.float32)
+
+    def _accept(self, idea: Idea, texts: Texts, vec: np.ndarray | None) -> bool:
+        if self.unique:
+            keys = {a.idea.key() for a in self.accepted}
+            names = {a.texts.name.lower() for a in self.accepted}
+            if idea.key() in keys or texts.name.lower() in names:
+                self.rejected_same_scenario += 1
+                return False
+        if vec is not None and self.accepted:
+            pool = np.stack([a.vector for a in self.accepted if a.vector is not None])
+            if float((pool @ vec).max()) >= self.threshold:
+                self.rejected_near_duplicates += 1
+                return False
+        index = self.id_offset + len(self.accepted) + 1
+        self.accepted.append(Accepted(index=index, id=task_id(index, texts.name), idea=idea, texts=texts, vector=vec))
+        return True
+
+    def _proposal(self, a: Accepted) -> TaskProposal:
+        return to_proposal(a.idea, a.texts, a.index, self.kb, engine=Engine.KNOWLEDGE, mode=self.mode, seed=self.seed)
+
+
+def generate(n: int, **kwargs) -> list[TaskProposal]:
+    """Convenience: ``KnowledgeEngine(**kwargs).run(n)``."""
+    return KnowledgeEngine(**kwargs).run(n)

@@ -1,0 +1,133 @@
+"""Stage 1 entry point: write ``tasks.jsonl`` from an engine, or from the user's own file.
+
+Resumable like every stage: an existing, valid tasks.jsonl is kept unless ``force``. The output is
+written atomically in one go (proposals of a brainstorm depend on each other, so there is no
+meaningful per-item resume), then the category and class distribution is printed.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import Counter
+from pathlib import Path
+
+from anomalygen.errors import UserError
+from anomalygen.runfolder import RunFolder, now_iso, read_jsonl, write_jsonl
+from anomalygen.runner import StageSummary
+from anomalygen.schema import Engine, StageRecord, TaskProposal
+
+STAGE = "brainstorm"
+
+
+def load_user_tasks(path: str | Path) -> list[TaskProposal]:
+    """A user's tasks.jsonl: schema-checked per line, then checked against the catalogue, ids unique."""
+    from anomalygen.brainstorm.validate import proposal_problems
+    from anomalygen.knowledge import load_kb
+
+    path = Path(path)
+    tasks = read_jsonl(path, TaskProposal)  # raises UserError listing every malformed line
+    if not tasks:
+        raise UserError(f"{path}: no tasks in the file")
+    kb = load_kb()
+    problems: list[str] = []
+    seen: set[str] = set()
+    lines = [i for i, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1) if line.strip()]
+    for lineno, task in zip(lines, tasks, strict=True):
+        if task.id in seen:
+            problems.append(f"line {lineno}: duplicate id '{task.id}'")
+        seen.add(task.id)
+        problems += [f"line {lineno} ({task.id}): {p}" for p in proposal_problems(task, kb)]
+    if problems:
+        shown = "\n  ".join(problems[:20])
+        more = f"\n  ... and {len(problems) - 20} more" if len(problems) > 20 else ""
+        raise UserError(f"{path}: {len(problems)} problem(s) with the tasks:\n  {shown}{more}")
+    return tasks
+
+
+def generate(settings, run: RunFolder | None = None) -> tuple[list[TaskProposal], dict[str, str]]:
+    """Proposals from the configured engine, and per-item errors (LLM engine only)."""
+    cfg = settings.brainstorm
+    engine = settings.engine_for("brainstorm")
+    if engine == Engine.LLM:
+        from anomalygen.brainstorm.llm_engine import LLMEngine
+
+        llm = LLMEngine.from_settings(settings)
+        tasks = llm.run(cfg.n)
+        if run is not None:
+            from anomalygen.llm import record_usage
+
+            record_usage(run, llm.client.reset_usage())
+        return tasks, llm.errors
+    from anomalygen.brainstorm.knowledge_engine import KnowledgeEngine
+
+    eng = KnowledgeEngine(
+        seed=settings.seed, mode=cfg.mode, agents=cfg.agents, rounds=cfg.rounds, novelty_threshold=cfg.novelty_threshold
+    )
+    return eng.run(cfg.n), {}
+
+
+def run_stage(run: RunFolder, settings, *, force: bool = False) -> StageSummary:
+    started = time.perf_counter()
+    record = StageRecord(started=now_iso())
+    summary = StageSummary(STAGE)
+    cfg = settings.brainstorm
+    errors: dict[str, str] = {}
+    if cfg.tasks_file:
+        tasks = load_user_tasks(cfg.tasks_file)
+        write_jsonl(run.tasks_path, tasks)
+        summary.done = len(tasks)
+    elif not force and run.tasks_path.is_file() and _valid_existing(run):
+        tasks = run.load_tasks()
+        summary.skipped = len(tasks)
+    else:
+        tasks, errors = generate(settings, run)
+        if not tasks:
+            raise UserError("brainstorming produced no valid proposals" + (f": {next(iter(errors.values()))}" if errors else ""))
+        write_jsonl(run.tasks_path, tasks)
+        summary.done = len(tasks)
+        if len(tasks) < cfg.n:
+            errors.setdefault("shortfall", f"only {len(tasks)} of {cfg.n} proposals could be made")
+    for item_id, reason in errors.items():
+        run.record_error(STAGE, item_id, reason)
+    summary.errors = dict(errors)
+    summary.failed = len(errors)
+    summary.results = {"categories": dict(Counter(t.category.value for t in tasks)), "classes": dict(Counter(t.hazard_class for t in tasks))}
+    summary.wall_s = time.perf_counter() - started
+    record.finished = now_iso()
+    record.wall_s = round(summary.wall_s, 3)
+    record.done, record.skipped, record.failed = summary.done, summary.skipped, summary.failed
+    run.record_stage(STAGE, record)
+    if not settings.quiet:
+        print_distribution(tasks)
+    return summary
+
+
+def _valid_existing(run: RunFolder) -> bool:
+    try:
+        return bool(run.load_tasks())
+    except UserError:
+        return False
+
+
+def print_distribution(tasks: list[TaskProposal]) -> None:
+    """Category and class counts as a rich table on stderr."""
+    from rich.console import Console
+    from rich.table import Table
+
+    from anomalygen.knowledge import load_kb
+
+    kb = load_kb()
+    table = Table(title=f"{len(tasks)} proposals", show_lines=False)
+    table.add_column("category")
+    table.add_column("hazard class")
+    table.add_column("paper", justify="center")
+    table.add_column("count", justify="right")
+    by_class = Counter((t.category.value, t.hazard_class) for t in tasks)
+    by_cat = Counter(t.category.value for t in tasks)
+    for cat in sorted(by_cat):
+        table.add_row(f"[bold]{cat}[/bold]", "", "", f"[bold]{by_cat[cat]}[/bold]")
+        for (c, hc), count in sorted(by_class.items(), key=lambda kv: (-kv[1], kv[0])):
+            if c == cat:
+                paper = "✓" if hc in kb.hazard_classes and kb.hazard_classes[hc].paper_class else ""
+                table.add_row("", hc, paper, str(count))
+    Console(stderr=True).print(table)

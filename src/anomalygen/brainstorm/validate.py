@@ -1,0 +1,48 @@
+"""Checks a TaskProposal against the catalogue and the knowledge base, beyond its pydantic schema.
+
+Schema validation says a proposal is well-formed; these checks say it can be *built*: every object
+is a catalogue name, the hazard class exists, the placement is one the scene builder implements.
+Used for LLM output (the problems go back to the model as a repair prompt) and for a user's own
+tasks.jsonl (the problems are reported per line).
+"""
+
+from __future__ import annotations
+
+from anomalygen.knowledge import PLACEMENTS, ROOMS, KnowledgeBase
+from anomalygen.schema import TaskProposal
+
+
+def placement_ok(placement: str, names: set[str]) -> bool:
+    if placement in PLACEMENTS:
+        return True
+    for prefix in ("inside:", "on:"):
+        if placement.startswith(prefix) and placement[len(prefix):] in names:
+            return True
+    return False
+
+
+def proposal_problems(p: TaskProposal, kb: KnowledgeBase) -> list[str]:
+    """Human-readable problems; empty when the proposal can be built."""
+    names = set(kb.objects)
+    out: list[str] = []
+    if p.target_asset not in kb.targets:
+        out.append(f"target_asset '{p.target_asset}' is not one of the 44 target categories")
+    if p.hazard_class == "other":
+        if not p.hazard_other:
+            out.append("hazard_class 'other' needs hazard_other text")
+    elif p.hazard_class not in kb.hazard_classes:
+        out.append(f"hazard_class '{p.hazard_class}' is unknown (use a knowledge-base class id or 'other')")
+    elif kb.hazard_classes[p.hazard_class].category != p.category:
+        out.append(f"category '{p.category.value}' does not match class {p.hazard_class} ({kb.hazard_classes[p.hazard_class].category.value})")
+    s = p.scenario
+    for label, name in [("scenario.hazard_object", s.hazard_object), ("scenario.container", s.container)]:
+        if name is not None and name not in names:
+            out.append(f"{label} '{name}' is not a catalogue object")
+    out += [f"scenario.co_objects: '{c}' is not a catalogue object" for c in s.co_objects if c not in names]
+    out += [f"auxiliary_items: '{a.name}' is not a catalogue object" for a in p.auxiliary_items if a.name not in names]
+    out += [f"articulations: '{a.object}' is not a catalogue object" for a in p.articulations if a.object not in names]
+    if not placement_ok(s.placement, names):
+        out.append(f"scenario.placement '{s.placement}' is not one of {', '.join(PLACEMENTS)}, inside:<object>, on:<object>")
+    if s.room not in ROOMS:
+        out.append(f"scenario.room '{s.room}' is not one of {', '.join(ROOMS)}")
+    return out
