@@ -64,8 +64,8 @@ class LlamaCppBackend:
     prompt_schema_style = "bounded"
     supports_images = False
     # generation caps for grammar-constrained JSON (see module docstring)
-    max_string = 100
-    max_items = 3
+    max_string = 80
+    max_items = 2
 
     def __init__(self, config):
         path = Path(config.model_path).expanduser() if config.model_path else bundled_model_path()
