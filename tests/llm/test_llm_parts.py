@@ -93,3 +93,17 @@ def test_cache_is_safe_across_processes(tmp_path):
     cache = ReplyCache(path)
     assert len(cache) == 300
     assert cache.get(cache_key({"w": 1, "i": 149})) == ("reply 1/149", 149, 1)
+
+
+@pytest.mark.parametrize("name", sorted(__import__("anomalygen.schema", fromlist=["ARTEFACTS"]).ARTEFACTS))
+def test_every_artefact_schema_compiles_to_a_llama_grammar(name):
+    """Any stage may ask the llamacpp backend for any artefact: its bounded schema must become a grammar."""
+    import json
+
+    grammar_mod = pytest.importorskip("llama_cpp.llama_grammar")
+    from anomalygen.schema import ARTEFACTS
+
+    schema = bounded_schema(ARTEFACTS[name], max_string=80, max_items=2, required_only=False)
+    gbnf = grammar_mod.json_schema_to_gbnf(json.dumps(schema))
+    assert "root ::=" in gbnf
+    grammar_mod.LlamaGrammar.from_string(gbnf, verbose=False)
