@@ -114,19 +114,17 @@ def _item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str,
     task = TaskProposal.model_validate(payload)
     detector = make_detector(settings)
     judge = make_judge(settings)
-    usage_before = None
     client = getattr(detector, "client", None) or judge.llm
     if client is not None:
-        client.reset_usage()
+        client.reset_usage()  # count this scene's requests only (the client is shared per process)
     det = detect_scene(task, graph, spec, settings, detector=detector, judge=judge)
     write_model(detection_path(run, task_id), det)
-    if client is not None:
-        usage_before = client.reset_usage().model_dump()
+    usage = client.reset_usage().model_dump() if client is not None else None
     return {
         "hit_rank": det.hit_rank,
         "error": det.error,
         "fallback": getattr(detector, "fell_back", None),
-        "usage": usage_before,
+        "usage": usage,
     }
 
 
