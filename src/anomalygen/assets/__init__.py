@@ -17,16 +17,18 @@ from anomalygen.assets.core import (
     size_range,
     target_names,
 )
+from anomalygen.assets.retrieval import CatalogueEntry
+from anomalygen.assets.validate import ValidationResult, validate_asset
 
 
 def catalogue(variants_per_name: int = 3):
-    from anomalygen.assets.catalogue import catalogue as _catalogue
+    from anomalygen.assets.retrieval import catalogue as _catalogue
 
     return _catalogue(variants_per_name)
 
 
 def retrieve(query: str, k: int = 5, category: str | None = None, *, variants_per_name: int = 3):
-    from anomalygen.assets.catalogue import retrieve as _retrieve
+    from anomalygen.assets.retrieval import retrieve as _retrieve
 
     return _retrieve(query, k, category, variants_per_name=variants_per_name)
 
@@ -39,6 +41,6 @@ def from_ref(ref):
 
 
 __all__ = [
-    "Asset", "AssetJoint", "Cavity", "Surface", "available_names", "catalogue", "from_ref", "generate",
+    "Asset", "AssetJoint", "CatalogueEntry", "Cavity", "Surface", "ValidationResult", "validate_asset", "available_names", "catalogue", "from_ref", "generate",
     "household_names", "retrieve", "size_range", "target_names",
 ]

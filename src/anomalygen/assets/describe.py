@@ -52,6 +52,22 @@ _TAG_TEXT = {
 }
 
 
+TARGET_BLURBS = {
+    "Bottle": "bottle with a cap", "Box": "storage box", "Bucket": "open bucket with a handle",
+    "Camera": "photo camera", "Cart": "wheeled trolley cart with shelves", "Chair": "chair",
+    "Clock": "desk clock", "CoffeeMachine": "coffee machine", "Dishwasher": "kitchen dishwasher",
+    "Dispenser": "soap or lotion pump dispenser", "Display": "computer monitor screen", "Door": "room door",
+    "Eyeglasses": "pair of glasses", "Fan": "electric fan", "FoldingChair": "folding chair", "Globe": "desk globe",
+    "Kettle": "electric kettle", "Keyboard": "computer keyboard", "KitchenPot": "cooking pot with a lid",
+    "Knife": "folding pocket knife", "Lamp": "desk lamp", "Laptop": "laptop computer", "Microwave": "microwave oven",
+    "Mouse": "computer mouse", "Oven": "kitchen oven and stove", "Pen": "pen", "Phone": "mobile phone",
+    "Pliers": "pliers", "Printer": "printer", "Refrigerator": "fridge / refrigerator", "Remote": "TV remote control",
+    "Safe": "safe", "Scissors": "scissors", "Stapler": "stapler", "StorageFurniture": "cabinet / storage furniture",
+    "Suitcase": "suitcase", "Table": "table", "Toaster": "toaster", "Toilet": "toilet", "TrashCan": "trash can / rubbish bin",
+    "USB": "USB stick", "WashingMachine": "washing machine", "Window": "window", "Lighter": "cigarette lighter",
+}
+
+
 def size_words(size: float) -> str:
     if size < 0.03:
         return "tiny"
@@ -67,7 +83,7 @@ def size_words(size: float) -> str:
 def describe(name: str, asset: Asset, features: list[str]) -> str:
     _, _, group, tag_list = object_table()[name]
     vocab = vocabulary()
-    blurb = vocab["household"].get(name) or f"{name} ({group})"
+    blurb = vocab["household"].get(name) or TARGET_BLURBS.get(name) or f"{name} ({group})"
     size = asset.size
     dims = asset.aabb[1] - asset.aabb[0]
     parts = [f"{size_words(size)} {name.replace('_', ' ')}: {blurb}"]
