@@ -139,3 +139,11 @@ def test_hybrid_falls_back_to_rule_order_and_says_so(scripted_server, tmp_path):
     assert [h.hazard_class for h in hyps] == ["remove_choking_hazards", "store_sharp_objects"]
     assert all("rule order kept" in h.explanation for h in hyps)
     assert det.fell_back
+
+
+def test_hybrid_fills_what_the_llm_left_out_in_rule_order(scripted_server, tmp_path):
+    srv = scripted_server([text(json.dumps({"ranking": [
+        {"candidate": 2, "problem": "Knife at the edge", "solution": "Store it"}]}))])
+    hyps = HybridDetector(get_client(llm_config_for(srv, tmp_path, cache=False))).detect(g.two_hazards(), 3)
+    assert [h.target_object for h in hyps] == ["kitchen_knife_0", "marble_0"]
+    assert hyps[1].explanation.startswith("not ranked by the LLM; rule order")

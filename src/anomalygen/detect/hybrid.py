@@ -77,18 +77,18 @@ class HybridDetector:
             for h in hyps:
                 h.explanation = f"LLM ranking failed ({exc}); rule order kept. {h.explanation}"
             return hyps
-        order: list[tuple[rules.Candidate, str, str]] = []
+        order: list[tuple[rules.Candidate, str, str, str]] = []
         used: set[int] = set()
         for pick in reply.ranking:
             if pick.candidate in used:
                 continue
             used.add(pick.candidate)
-            order.append((cands[pick.candidate - 1], pick.problem, pick.solution))
+            order.append((cands[pick.candidate - 1], pick.problem, pick.solution, f"ranked by LLM ({self.client.model})"))
         for i, c in enumerate(cands, 1):  # the LLM may list fewer than k: fill in rule order
             if len(order) >= k:
                 break
             if i not in used:
-                order.append((c, c.problem, c.solution))
+                order.append((c, c.problem, c.solution, "not ranked by the LLM; rule order"))
         return [
             Hypothesis(
                 rank=r,
@@ -97,7 +97,7 @@ class HybridDetector:
                 target_object=c.object,
                 hazard_class=c.hazard_class,
                 score=c.score,
-                explanation=f"ranked by LLM ({self.client.model}); {c.explanation}",
+                explanation=f"{how}; {c.explanation}",
             )
-            for r, (c, problem, solution) in enumerate(order[:k], start=1)
+            for r, (c, problem, solution, how) in enumerate(order[:k], start=1)
         ]
