@@ -63,3 +63,12 @@ def test_usage_errors_exit_non_zero_without_traceback(args):
     result = cli(*args)
     assert result.returncode == 2
     assert "Traceback" not in result.stderr
+
+
+def test_error_text_with_brackets_is_printed_verbatim_on_one_line(tmp_path):
+    bad = tmp_path / "b.toml"
+    bad.write_text("[llm]\nbackend = [1, 2]\n" + "# padding " * 20)
+    result = cli("config", "show", "--config", str(bad), env={"COLUMNS": "60"})
+    _one_line_error(result)
+    assert len(result.stderr.strip().splitlines()) == 1
+    assert "llm.backend" in result.stderr

@@ -86,6 +86,7 @@ def _stage(module: str, func: str = "run_stage"):
 
 
 def _finish(summary, as_json: bool) -> None:
+    from rich.markup import escape
     if as_json:
         payload = {
             "stage": summary.stage,
@@ -99,7 +100,7 @@ def _finish(summary, as_json: bool) -> None:
     else:
         err.print(summary.line())
         for item_id, reason in list(summary.errors.items())[:10]:
-            err.print(f"  [red]✗[/red] {item_id}: {reason}", highlight=False)
+            err.print(f"  [red]✗[/red] {item_id}: {escape(reason)}", highlight=False, soft_wrap=True)
         if len(summary.errors) > 10:
             err.print(f"  ... {len(summary.errors) - 10} more in errors/{summary.stage}/")
     if summary.failed and not summary.done and not summary.skipped:
@@ -346,17 +347,18 @@ def main(argv: list[str] | None = None) -> None:
     os.environ.setdefault("TRANSFORMERS_OFFLINE", "1")
     os.environ.setdefault("TOKENIZERS_PARALLELISM", "false")
     from pydantic import ValidationError
+    from rich.markup import escape
 
     from anomalygen.schema import format_validation_error
 
     try:
         app(args=argv, standalone_mode=False)
     except NotImplementedYet as exc:
-        err.print(f"[yellow]not implemented yet:[/yellow] {exc}", highlight=False)
+        err.print(f"[yellow]not implemented yet:[/yellow] {escape(str(exc))}", highlight=False, soft_wrap=True)
         sys.exit(3)
     except (AnomalygenError, ValidationError) as exc:
         msg = format_validation_error(exc) if isinstance(exc, ValidationError) else str(exc)
-        err.print(f"[red]error:[/red] {msg}", highlight=False)
+        err.print(f"[red]error:[/red] {escape(msg)}", highlight=False, soft_wrap=True)
         sys.exit(2)
     except typer.Exit as exc:
         sys.exit(exc.exit_code)

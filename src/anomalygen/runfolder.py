@@ -248,11 +248,18 @@ class RunFolder:
 
     @contextlib.contextmanager
     def update_manifest(self) -> Iterator[RunManifest]:
-        """Read-modify-write the manifest under a lock (threads of one process share a run)."""
-        with _MANIFEST_LOCK:
-            manifest = self.load_manifest()
-            yield manifest
-            self.save_manifest(manifest)
+        """Read-modify-write the manifest under a thread lock and a file lock (workers are processes)."""
+        import fcntl
+
+        self.root.mkdir(parents=True, exist_ok=True)
+        with _MANIFEST_LOCK, open(self.root / ".manifest.lock", "a+") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            try:
+                manifest = self.load_manifest()
+                yield manifest
+                self.save_manifest(manifest)
+            finally:
+                fcntl.flock(lock, fcntl.LOCK_UN)
 
     def record_stage(self, stage: str, record: StageRecord) -> None:
         with self.update_manifest() as m:
