@@ -158,3 +158,16 @@ def test_killed_stage_resumes_with_every_item_present_exactly_once(tmp_path):
     log = (root / "log.txt").read_text().split()
     assert sorted(set(log)) == files
     assert all(log.count(i) == 1 for i in before)
+
+
+def _report_key(item_id, payload, ctx):
+    return ctx.settings.llm.api_key.get_secret_value()
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_item_functions_see_the_real_secret_not_a_masked_copy(tmp_path, workers):
+    settings = load_settings(overrides={"quiet": True, "workers": workers, "llm.api_key": "sk-real"})
+    run = RunFolder.create(tmp_path / "r", settings=settings)
+    summary = run_items(run, "demo", [("a", 0), ("b", 0)], _report_key, settings=settings)
+    assert summary.results == {"a": "sk-real", "b": "sk-real"}
+    assert "sk-real" not in run.manifest_path.read_text()

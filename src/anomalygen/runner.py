@@ -26,21 +26,19 @@ ItemFn = Callable[[str, Any, "StageContext"], Any]
 
 @dataclass(frozen=True)
 class StageContext:
-    """What an item function needs besides its item: picklable, so it crosses process boundaries."""
+    """What an item function needs besides its item: picklable, so it crosses process boundaries.
+
+    The settings object itself travels (pickle keeps ``SecretStr`` values); a JSON dump would replace
+    an API key with asterisks and workers would send those to the endpoint.
+    """
 
     run_root: str
-    settings_json: str
+    settings: Any
     stage: str
 
     @property
     def run(self) -> RunFolder:
         return RunFolder(self.run_root)
-
-    @property
-    def settings(self):
-        from anomalygen.config import Settings
-
-        return Settings.model_validate_json(self.settings_json)
 
 
 @dataclass
@@ -81,7 +79,7 @@ def run_items(
     started = time.perf_counter()
     summary = StageSummary(stage)
     record = StageRecord(started=now_iso())
-    ctx = StageContext(str(run.root), settings.model_dump_json(), stage)
+    ctx = StageContext(str(run.root), settings, stage)
     todo: list[tuple[str, Any]] = []
     for item_id, payload in items:
         if not force and is_done is not None and is_done(item_id):
