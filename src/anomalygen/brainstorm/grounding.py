@@ -25,8 +25,18 @@ def weighted(rng: np.random.Generator, options: list[str], weights: dict[str, fl
     return options[int(rng.choice(len(options), p=w / w.sum()))]
 
 
+_CLASS_TARGETS: dict[tuple[int, str], list[str]] = {}
+
+
 def class_targets(kb: KnowledgeBase, hc: HazardClass) -> list[str]:
     """Target categories a proposal of ``hc`` can be built around: named ones, hazards, containers."""
+    key = (id(kb), hc.id)
+    if key not in _CLASS_TARGETS:
+        _CLASS_TARGETS[key] = _class_targets(kb, hc)
+    return _CLASS_TARGETS[key]
+
+
+def _class_targets(kb: KnowledgeBase, hc: HazardClass) -> list[str]:
     targets = set(kb.targets)
     out = list(hc.target_assets)
     for name in [*kb.hazard_candidates(hc), *hc.default_containers, *hc.default_supports]:

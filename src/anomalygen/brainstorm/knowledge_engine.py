@@ -144,8 +144,11 @@ class KnowledgeEngine:
                         idea = grounder.fresh(rng, agent=self.agents[i], agent_index=i, round_=r)
                     texts = realise(idea, self.kb, rng, perspective=self.mode != BrainstormMode.PLAIN)
                     drafts.append((i, idea, texts))
+            drafts = self._prefilter(drafts, needs)
             if not drafts:
-                break
+                if all(n <= 0 for n in needs):
+                    break
+                continue
             vectors = self._embed([t for _, _, t in drafts])
             for k, (i, idea, texts) in enumerate(drafts):
                 if needs[i] <= 0:
@@ -157,6 +160,29 @@ class KnowledgeEngine:
                 leftover = sum(n for n in needs if n > 0)
                 needs = split_quota(leftover, self.n_agents, offset=r + attempt) if leftover else needs
         return got_total
+
+    def _prefilter(self, drafts: list[tuple[int, Idea, Texts]], needs: list[int]) -> list[tuple[int, Idea, Texts]]:
+        """Drop drafts that repeat a scenario or name before paying for their embeddings.
+
+        Keeps at most need + 1 drafts per agent, so the costly Sentence-BERT pass sees few spares.
+        """
+        if not self.unique:
+            return drafts
+        keys = {a.idea.key() for a in self.accepted}
+        names = {a.texts.name.lower() for a in self.accepted}
+        kept: list[tuple[int, Idea, Texts]] = []
+        per_agent: dict[int, int] = {}
+        for i, idea, texts in drafts:
+            if idea.key() in keys or texts.name.lower() in names:
+                self.rejected_same_scenario += 1
+                continue
+            if per_agent.get(i, 0) >= needs[i] + 1:
+                continue
+            keys.add(idea.key())
+            names.add(texts.name.lower())
+            per_agent[i] = per_agent.get(i, 0) + 1
+            kept.append((i, idea, texts))
+        return kept
 
     def _usage_counts(self) -> dict[str, int]:
         """What the group has proposed so far (agents in a session see the shared pool)."""

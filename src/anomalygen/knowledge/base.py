@@ -56,6 +56,7 @@ class KnowledgeBase:
         self.hazard_classes: dict[str, HazardClass] = {hc.id: hc for hc in hazard_classes}
         self.objects: dict[str, ObjectInfo] = {o.name: o for o in objects}
         self.roles: dict[str, RoleProfile] = {r.id: r for r in roles}
+        self._candidates: dict[tuple[str, str], list[str]] = {}
 
     # ------------------------------------------------------------------ simple views
     @property
@@ -91,12 +92,18 @@ class KnowledgeBase:
         Intrinsic means decidable from the object alone (``has_property``, ``category_is``); the
         situational ones (height, joints, walkway) are what a scenario sets up.
         """
-        calls = [
-            c
-            for c in hc.preconditions
-            if c.name in ("has_property", "category_is", "joint_open", "joint_closed") and c.args.get("object") == variable
-        ]
-        return [name for name, info in self.objects.items() if all(_static_holds(c, info) for c in calls)]
+        key = (hc.id, variable)
+        if key not in self._candidates or hc is not self.hazard_classes.get(hc.id):
+            calls = [
+                c
+                for c in hc.preconditions
+                if c.name in ("has_property", "category_is", "joint_open", "joint_closed") and c.args.get("object") == variable
+            ]
+            found = [name for name, info in self.objects.items() if all(_static_holds(c, info) for c in calls)]
+            if hc is not self.hazard_classes.get(hc.id):
+                return found  # a class built outside this knowledge base: do not cache
+            self._candidates[key] = found
+        return list(self._candidates[key])
 
     def hazard_candidates(self, hc: HazardClass) -> list[str]:
         """Catalogue objects that can be the hazard of ``hc`` (the curated list, if any, filtered)."""

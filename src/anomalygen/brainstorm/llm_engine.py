@@ -1,0 +1,287 @@
+"""LLM group brainstorming (the paper's method): N role-playing agents, R rounds, any N and R.
+
+Round 1: each agent is given a random target asset and proposes scenarios around it from its role's
+point of view. Round r >= 2: each agent is shown every *other* agent's round r-1 proposals, told it
+is in a collaborative session, and asked to build on them (citing what it builds on). Replies are
+structured (``AgentReply``), validated against the catalogue and the knowledge base; a reply naming
+unknown objects goes back to the model with the problems listed. A failure costs one agent-round,
+never the batch.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from anomalygen.brainstorm.idea import task_id
+from anomalygen.brainstorm.knowledge_engine import agent_roles, split_quota
+from anomalygen.brainstorm.validate import proposal_problems
+from anomalygen.knowledge import PLACEMENTS, ROOMS, KnowledgeBase, load_kb
+from anomalygen.rng import item_rng
+from anomalygen.schema import (
+    ArticulationUse,
+    AuxiliaryItem,
+    BrainstormMode,
+    Engine,
+    HazardCategory,
+    Provenance,
+    Scenario,
+    TaskProposal,
+    format_validation_error,
+)
+
+ROBOT_LIMITS = (
+    "The robot is a Franka Panda arm on a mobile base with a suction gripper. It can pick up and place "
+    "rigid objects, push and slide them, open and close doors, drawers, lids and windows, and turn knobs "
+    "and switches. It cannot assemble or take apart anything, and it cannot clean: no wiping, mopping, "
+    "sweeping or washing. Every task must be solvable with those skills."
+)
+
+
+class LLMProposal(BaseModel):
+    """What an agent writes for one idea: the task format plus grounding in catalogue names."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    name: str = Field(description="short task name")
+    explanation: str = Field(description="why this is a hazard, who is at risk")
+    description: str = Field(description="the situation in two to four sentences")
+    hazard_class: str = Field(description="a hazard class id from the list, or 'other'")
+    hazard_other: str | None = Field(None, description="the hazard in words when hazard_class is 'other'")
+    category: HazardCategory
+    target_asset: str = Field(description="one of the target categories")
+    hazard_object: str = Field(description="catalogue name of the object that is the hazard")
+    room: str
+    placement: str
+    person_at_risk: str = ""
+    container: str | None = Field(None, description="catalogue name where the robot puts the object, if it does")
+    co_objects: list[str] = Field(default_factory=list, description="other catalogue objects in the scene")
+    articulated_part: str | None = Field(None, description="joint label involved, e.g. door, drawer, lid, knob")
+    part_initial_state: Literal["open", "closed", "on", "off", "other"] | None = None
+    solution: str = ""
+    success_condition: str = ""
+    builds_on: list[str] = Field(default_factory=list, description="ids of other participants' proposals used")
+    borrowed: list[str] = Field(default_factory=list, description="what was borrowed: mechanism, location, co_objects, person_at_risk")
+
+
+class AgentReply(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+    proposals: list[LLMProposal] = Field(min_length=1)
+
+
+@dataclass
+class Shown:
+    """A proposal as the other agents see it in the next round."""
+
+    id: str
+    role: str | None
+    name: str
+    description: str
+
+
+@dataclass
+class LLMEngine:
+    client: object
+    kb: KnowledgeBase
+    seed: int = 0
+    mode: BrainstormMode = BrainstormMode.BRAINSTORM
+    agents: int = 10
+    rounds: int = 3
+    repair_retries: int = 2
+    errors: dict[str, str] = field(default_factory=dict)
+    accepted: list[TaskProposal] = field(default_factory=list)
+
+    @classmethod
+    def from_settings(cls, settings) -> LLMEngine:
+        from anomalygen.llm import get_client
+
+        cfg = settings.brainstorm
+        return cls(
+            client=get_client(settings.llm),
+            kb=load_kb(),
+            seed=settings.seed,
+            mode=cfg.mode,
+            agents=cfg.agents,
+            rounds=cfg.rounds,
+            repair_retries=settings.llm.repair_retries,
+        )
+
+    # ------------------------------------------------------------------ run
+    def run(self, n: int) -> list[TaskProposal]:
+        mode = BrainstormMode(self.mode)
+        n_agents = 1 if mode == BrainstormMode.PLAIN else self.agents
+        rounds = self.rounds if mode == BrainstormMode.BRAINSTORM else 1
+        roles: list[str | None] = [None] if mode == BrainstormMode.PLAIN else agent_roles(self.kb, n_agents)
+        previous: list[tuple[int, Shown]] = []
+        for r, quota in enumerate(split_quota(n, rounds), start=1):
+            shares = split_quota(quota, n_agents, offset=r - 1)
+            jobs = [(i, share) for i, share in enumerate(shares) if share > 0]
+            convs = [self.messages(r, i, roles[i], share, previous) for i, share in jobs]
+            replies = self.client.complete_many(convs, schema=AgentReply)
+            this_round: list[tuple[int, Shown]] = []
+            for (i, share), conv, reply in zip(jobs, convs, replies, strict=True):
+                item = f"r{r}-agent{i}"
+                if isinstance(reply, Exception):
+                    self.errors[item] = str(reply)
+                    continue
+                shown_ids = {s.id for a, s in previous if a != i}
+                for p in self._accept(reply, conv, r, i, roles[i], share, shown_ids, item):
+                    this_round.append((i, Shown(p.id, roles[i], p.name, p.description)))
+            previous = this_round
+        return list(self.accepted)
+
+    # ------------------------------------------------------------------ prompts
+    def system_prompt(self, role: str | None) -> str:
+        kb = self.kb
+        classes = "\n".join(f"- {hc.id} ({hc.category.value}): {hc.name}" for hc in kb.hazard_classes.values())
+        parts = []
+        if role is not None:
+            rp = kb.roles[role]
+            parts.append(
+                f"You are the {rp.name} of a household. {rp.description} You look at a home as someone who "
+                f"{rp.perspective}. You are one of several household experts in a collaborative brainstorming "
+                "session about hazards in the home that a robot could notice and fix on its own."
+            )
+        else:
+            parts.append("You write household hazard scenarios that a robot could notice and fix on its own.")
+        parts += [
+            ROBOT_LIMITS,
+            "Hazard classes (use the id, or 'other' with hazard_other):\n" + classes,
+            "Target categories: " + ", ".join(kb.targets),
+            "Other catalogue objects: " + ", ".join(kb.household),
+            "Rooms: " + ", ".join(ROOMS),
+            "Placements of the hazard object: " + ", ".join(PLACEMENTS) + ", inside:<catalogue name>, on:<catalogue name>",
+            "Use only catalogue names, exactly as written, for target_asset, hazard_object, container and co_objects.",
+        ]
+        return "\n\n".join(parts)
+
+    def messages(self, r: int, i: int, role: str | None, share: int, previous: list[tuple[int, Shown]]) -> list[dict]:
+        others = [s for a, s in previous if a != i]
+        if r == 1 or not others:
+            rng = item_rng(self.seed, "llm-brainstorm", r, i)
+            target = self.kb.targets[int(rng.integers(len(self.kb.targets)))]
+            ask = (
+                f"Round {r}. Your target object is {target}. Propose {share} distinct hazard scenario(s) in a "
+                f"home that involve the {target} (as the hazard, the place to store it, or the setting)."
+            )
+        else:
+            listing = "\n".join(f"- [{s.id}] ({s.role or 'participant'}) {s.name}: {s.description}" for s in others)
+            ask = (
+                f"Round {r} of the brainstorming session. These are the other participants' proposals from "
+                f"round {r - 1}:\n{listing}\n\nBuild on them: combine a hazard mechanism, a location, objects "
+                "or the person at risk from their ideas with your own perspective, and propose "
+                f"{share} new scenario(s) that are different from all of the above. Put the ids you build on "
+                "in builds_on and what you borrowed in borrowed."
+            )
+        return [{"role": "system", "content": self.system_prompt(role)}, {"role": "user", "content": ask}]
+
+    # ------------------------------------------------------------------ validation and repair
+    def _accept(self, reply: AgentReply, conv, r, i, role, share, shown_ids, item) -> list[TaskProposal]:
+        problems_by_idx: dict[int, list[str]] = {}
+        kept: list[TaskProposal] = []
+        for attempt in range(self.repair_retries + 1):
+            kept, problems_by_idx = [], {}
+            for k, raw in enumerate(reply.proposals[:share]):
+                proposal, problems = self._convert(raw, r, role, shown_ids)
+                if problems:
+                    problems_by_idx[k] = problems
+                else:
+                    kept.append(proposal)
+            if not problems_by_idx or attempt == self.repair_retries:
+                break
+            fixed = self._repair(conv, reply, problems_by_idx)
+            if fixed is None:
+                break
+            reply = fixed
+        for k, problems in problems_by_idx.items():
+            self.errors[f"{item}-p{k + 1}"] = "; ".join(problems)[:500]
+        out = []
+        names = {p.name.lower() for p in self.accepted}
+        for p in kept:
+            if p.name.lower() in names:
+                continue
+            names.add(p.name.lower())
+            index = len(self.accepted) + 1
+            p = p.model_copy(update={"id": task_id(index, p.name)})
+            self.accepted.append(p)
+            out.append(p)
+        return out
+
+    def _repair(self, conv, reply: AgentReply, problems_by_idx: dict[int, list[str]]) -> AgentReply | None:
+        listing = "\n".join(f"proposal {k + 1}: " + "; ".join(ps) for k, ps in problems_by_idx.items())
+        follow = conv + [
+            {"role": "assistant", "content": reply.model_dump_json()},
+            {
+                "role": "user",
+                "content": "Some proposals cannot be built:\n" + listing + "\nUse only the catalogue names, rooms, "
+                "placements and class ids listed above. Reply with the corrected proposals.",
+            },
+        ]
+        try:
+            out = self.client.complete(follow, schema=AgentReply)
+        except Exception as exc:  # noqa: BLE001 - a failed repair keeps the proposals that were valid
+            self.errors.setdefault("repair", str(exc)[:300])
+            return None
+        return out if isinstance(out, AgentReply) else None
+
+    def _convert(self, raw: LLMProposal, r: int, role: str | None, shown_ids: set[str]) -> tuple[TaskProposal | None, list[str]]:
+        kb = self.kb
+        hc = kb.hazard_classes.get(raw.hazard_class)
+        category = hc.category if hc is not None else raw.category
+        articulations = []
+        if raw.articulated_part:
+            obj = raw.hazard_object if raw.hazard_object in kb.objects else raw.target_asset
+            initial = raw.part_initial_state or (hc.articulation.initial_state if hc and hc.articulation else "open")
+            target_state = hc.articulation.target_state if hc and hc.articulation else "closed"
+            articulations.append(ArticulationUse(object=obj, part=raw.articulated_part, initial_state=initial, target_state=target_state))
+        aux = [
+            AuxiliaryItem(name=n, description=kb.objects[n].description if n in kb.objects else "", purpose=purpose)
+            for n, purpose in [(raw.hazard_object, "the hazard itself"), (raw.container, "where the robot puts it")]
+            + [(c, "part of the setting") for c in raw.co_objects]
+            if n and n != raw.target_asset
+        ]
+        try:
+            proposal = TaskProposal(
+                id="pending",
+                name=raw.name.strip() or "untitled",
+                explanation=raw.explanation,
+                description=raw.description,
+                category=category,
+                hazard_class=raw.hazard_class,
+                hazard_other=raw.hazard_other,
+                target_asset=raw.target_asset,
+                scenario=Scenario(
+                    hazard_object=raw.hazard_object,
+                    room=raw.room,
+                    placement=raw.placement,
+                    person_at_risk=raw.person_at_risk,
+                    container=raw.container,
+                    co_objects=list(raw.co_objects),
+                ),
+                auxiliary_items=aux,
+                articulations=articulations,
+                solution=raw.solution,
+                success_condition=raw.success_condition,
+                provenance=Provenance(
+                    engine=Engine.LLM,
+                    mode=BrainstormMode(self.mode),
+                    agent_role=role,
+                    round=r,
+                    builds_on=[b for b in raw.builds_on if b in shown_ids],
+                    borrowed=[b for b in raw.borrowed if b in ("mechanism", "location", "co_objects", "person_at_risk")],
+                    seed=self.seed,
+                    model=getattr(self.client, "model", None),
+                ),
+            )
+        except ValidationError as exc:
+            return None, [format_validation_error(exc)]
+        return proposal, proposal_problems(proposal, kb)
+
+
+def reply_json(proposals: list[dict]) -> str:
+    """Serialise scripted replies (tests, examples)."""
+    return json.dumps({"proposals": proposals})

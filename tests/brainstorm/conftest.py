@@ -1,0 +1,1 @@
+from support.fixtures import scripted_server  # noqa: F401
