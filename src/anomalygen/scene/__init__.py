@@ -1,1 +1,13 @@
-"""scene stage."""
+"""Scene stage: from a TaskProposal to a validated MuJoCo scene with robot, renders, scene graph and env.
+
+Modules: robot (Franka Panda + suction on a mobile base), select (asset choice), layout (placement
+solver), furniture (support surfaces), build (one scene), validate, graph (SceneGraph), render,
+sensors, env (Gymnasium), stage (``anomalygen build``).
+"""
+
+import os
+
+# Headless by default: MuJoCo picks its GL backend when it is first imported.
+if not os.environ.get("DISPLAY"):
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    os.environ.setdefault("PYOPENGL_PLATFORM", "egl")

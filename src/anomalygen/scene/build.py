@@ -42,6 +42,7 @@ from anomalygen.schema import (
 )
 from anomalygen.scene import furniture, layout, robot, select
 from anomalygen.scene.layout import Layout, Placed
+from anomalygen.scene.sensors import add_observation_sensors
 
 log = logging.getLogger(__name__)
 SURFACE_PLACEMENTS = {"table", "low_table", "table_edge", "counter", "counter_edge", "shelf"}
@@ -273,7 +274,7 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
     support: Placed | None = None
     if support_kind is not None:
         base_kind = support_kind.replace("_edge", "")
-        if target.catalogue == "Table" and base_kind in ("table", "low_table") and not hazard_is_target:
+        if target.catalogue == "Table" and base_kind == "table" and not hazard_is_target and _table_height_ok(target.asset):
             support = placed.setdefault(target.name, _placed(target))
         else:
             support = _support_placed(base_kind, _instance_name(furniture.CATEGORY[base_kind], used), rng)
@@ -364,6 +365,13 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
     return lay, bindings, placed
 
 
+def _table_height_ok(asset) -> bool:
+    """A catalogue Table may serve as the 'table' support only at a table's height (KB range)."""
+    lo, hi = furniture._heights().get("table", furniture.DEFAULT_HEIGHTS["table"])
+    tops = [s.center[2] for s in asset.surfaces] or [float(asset.aabb[1][2])]
+    return lo - 0.02 <= max(tops) <= hi + 0.02
+
+
 def _first_known(names: list[str]) -> str | None:
     for n in names:
         try:
@@ -381,7 +389,7 @@ def _check_articulations(task, hc, by_catalogue, target) -> None:
     if ch is None:
         return
     part = hc.articulation.part
-    if not select.joints_with_label(ch.asset, part) and not (part == "knob" and select.joints_with_label(ch.asset, "switch")):
+    if not select.joints_with_label(ch.asset, part):
         raise ItemFailed(f"{ch.catalogue} has no '{part}' joint for a {hc.id} scene")
 
 
@@ -452,6 +460,13 @@ def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
             loose.append(p.name)
         p.asset.attach(body, f"{p.name}/")
     robot.add_suction_welds(spec, loose)
+    task_objects = [p for p in placed.values() if p.role != ObjectRole.CLUTTER]
+    add_observation_sensors(
+        spec,
+        list(robot.ROBOT_JOINTS),
+        [p.name for p in task_objects],
+        [f"{p.name}/{j.name}" for p in task_objects if p.asset is not None for j in p.asset.joints],
+    )
     spec.add_key(name="init")
     return spec
 
@@ -533,7 +548,7 @@ def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, mo
             joints = [
                 JointState(
                     name=f"{p.name}/{j.name}",
-                    label=j.label,
+                    label=select.kb_label(j.label),
                     type=j.type,
                     value=float(data.joint(f"{p.name}/{j.name}").qpos[0]),
                     range=(float(j.range[0]), float(j.range[1])),

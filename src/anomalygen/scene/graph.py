@@ -10,6 +10,7 @@ rest is a few vectorised numpy passes.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -50,14 +51,16 @@ def _subtree_bodies(model, root: int) -> list[int]:
     return out
 
 
-_INDEX_CACHE: dict[tuple[int, str], _Index] = {}
+# Keyed weakly on the model object itself (an id() could be reused by a later model).
+_INDEX_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def _index(model, spec: SceneSpec) -> _Index:
     import mujoco
 
-    key = (id(model), spec.scene_id)
-    cached = _INDEX_CACHE.get(key)
+    key = (spec.scene_id, tuple(o.name for o in spec.objects))
+    per_model = _INDEX_CACHE.setdefault(model, {})
+    cached = per_model.get(key)
     if cached is not None:
         return cached
     owner = np.full(model.ngeom, -1, dtype=int)
@@ -77,9 +80,7 @@ def _index(model, spec: SceneSpec) -> _Index:
         joint_ids.append(tuple(jids))
     floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, FLOOR_GEOM)
     idx = _Index(tuple(o.name for o in spec.objects), owner, floor, tuple(joint_ids))
-    if len(_INDEX_CACHE) > 64:
-        _INDEX_CACHE.clear()
-    _INDEX_CACHE[key] = idx
+    per_model[key] = idx
     return idx
 
 

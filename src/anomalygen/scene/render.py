@@ -17,7 +17,7 @@ import numpy as np
 if TYPE_CHECKING:  # pragma: no cover
     import mujoco
 
-_LOCK = threading.Lock()
+_LOCK = threading.RLock()
 _GL: dict[str, object] = {}
 
 
@@ -42,21 +42,17 @@ class SceneRenderer:
         import mujoco
 
         self.model, self.width, self.height = model, width, height
-        _LOCK.acquire()
-        try:
+        self.con = None
+        with _LOCK:
             _gl_context(width, height)
             if model.vis.global_.offwidth < width or model.vis.global_.offheight < height:
                 model.vis.global_.offwidth = max(width, model.vis.global_.offwidth)
                 model.vis.global_.offheight = max(height, model.vis.global_.offheight)
             self.con = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_100)
-            mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self.con)
-            self.scene = mujoco.MjvScene(model, maxgeom=4000)
-            self.option = mujoco.MjvOption()
-            self.camera = mujoco.MjvCamera()
-            self.viewport = mujoco.MjrRect(0, 0, width, height)
-        except BaseException:
-            _LOCK.release()
-            raise
+        self.scene = mujoco.MjvScene(model, maxgeom=4000)
+        self.option = mujoco.MjvOption()
+        self.camera = mujoco.MjvCamera()
+        self.viewport = mujoco.MjrRect(0, 0, width, height)
 
     def render(self, data: mujoco.MjData, camera: str | int) -> np.ndarray:
         """RGB uint8 image (height, width, 3) from a named fixed camera."""
@@ -67,23 +63,33 @@ class SceneRenderer:
             raise KeyError(f"no camera {camera!r}")
         self.camera.type = mujoco.mjtCamera.mjCAMERA_FIXED
         self.camera.fixedcamid = cam_id
-        mujoco.mjv_updateScene(self.model, data, self.option, None, self.camera, mujoco.mjtCatBit.mjCAT_ALL, self.scene)
-        mujoco.mjr_render(self.viewport, self.scene, self.con)
         rgb = np.empty((self.height, self.width, 3), dtype=np.uint8)
-        mujoco.mjr_readPixels(rgb, None, self.viewport, self.con)
+        with _LOCK:  # one GL context per process: render calls of different models take turns
+            _gl_context(self.width, self.height)
+            mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self.con)
+            mujoco.mjv_updateScene(self.model, data, self.option, None, self.camera, mujoco.mjtCatBit.mjCAT_ALL, self.scene)
+            mujoco.mjr_render(self.viewport, self.scene, self.con)
+            mujoco.mjr_readPixels(rgb, None, self.viewport, self.con)
         return np.flipud(rgb).copy()
 
     def close(self) -> None:
-        if getattr(self, "con", None) is not None:
-            self.con.free()
+        if self.con is not None:
+            with _LOCK:
+                _gl_context(self.width, self.height)
+                self.con.free()
             self.con = None
-            _LOCK.release()
 
     def __enter__(self) -> SceneRenderer:
         return self
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+    def __del__(self):  # pragma: no cover - best effort
+        try:
+            self.close()
+        except Exception:  # noqa: BLE001
+            pass
 
 
 def png_bytes(rgb: np.ndarray) -> bytes:

@@ -20,7 +20,8 @@ Names other stages rely on (see docs/scene.md):
   by end-effector deltas);
 * welds ``suction__<object>`` from the cup to each free object, all inactive at build time; toggle
   them with :func:`suction_on` / :func:`suction_off`.
-* keyframe ``home``: base at the spec's base pose, arm at ``HOME_ARM`` (cup pointing down).
+* ``set_home``: base joints at the scene's base pose, arm at ``HOME_ARM`` (cup pointing down);
+  built scenes store their settled start state as keyframe ``init``.
 """
 
 from __future__ import annotations
@@ -109,9 +110,10 @@ def build_robot_spec(base_xyyaw=(0.0, 0.0, 0.0)) -> mujoco.MjSpec:
     spec = mujoco.MjSpec.from_string(_arm_xml())
     spec.compiler.degree = False
     spec.compiler.autolimits = True
+    # The base body sits at the world origin; its joints carry the world pose (base_x = world x,
+    # base_y = world y, base_yaw about z), so joint values read directly as the base pose.
+    # ``base_xyyaw`` is applied by ``set_home`` (scenes store it in their "init" keyframe).
     base = spec.body("base")
-    base.pos = [base_xyyaw[0], base_xyyaw[1], 0.0]
-    base.quat = [np.cos(base_xyyaw[2] / 2), 0.0, 0.0, np.sin(base_xyyaw[2] / 2)]
     base.gravcomp = 1.0
     base.add_joint(name="base_x", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0], damping=200.0, armature=1.0)
     base.add_joint(name="base_y", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 1, 0], damping=200.0, armature=1.0)
@@ -191,6 +193,32 @@ def set_home(model: mujoco.MjModel, data: mujoco.MjData, base_xyyaw=None) -> Non
             data.joint(name).qpos[0] = value
     for name in BASE_JOINTS:
         data.actuator(name).ctrl[0] = data.joint(name).qpos[0]
+
+
+def enable_ee_tracking(model: mujoco.MjModel, data: mujoco.MjData) -> int:
+    """Switch to end-effector control: the cup follows mocap body ``ee_target`` through the
+    ``ee_track`` weld; arm actuators go limp (zero gains) while the base actuators keep holding the
+    base where its ``ctrl`` says. The target starts at the cup's current pose. Returns the mocap id.
+    """
+    import mujoco
+
+    for name in ARM_JOINTS:
+        a = model.actuator(name).id
+        model.actuator_gainprm[a, :] = 0.0
+        model.actuator_biasprm[a, :] = 0.0
+    eq = model.equality("ee_track").id
+    model.eq_data[eq, :] = 0.0
+    model.eq_data[eq, 6] = 1.0
+    model.eq_data[eq, 10] = 1.0
+    mocap = int(model.body_mocapid[model.body("ee_target").id])
+    mujoco.mj_kinematics(model, data)
+    cup = model.body("suction").id
+    data.mocap_pos[mocap] = data.xpos[cup]
+    data.mocap_quat[mocap] = data.xquat[cup]
+    for name in BASE_JOINTS:
+        data.actuator(name).ctrl[0] = data.joint(name).qpos[0]
+    data.eq_active[eq] = 1
+    return mocap
 
 
 def robot_geom_ids(model: mujoco.MjModel) -> np.ndarray:

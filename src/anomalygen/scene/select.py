@@ -134,13 +134,22 @@ def plausibility_problem(asset, catalogue: str, kb, parts: list[ArticulationUse]
     return None
 
 
+# Asset joint labels -> the knowledge base's vocabulary (what predicates such as
+# ``joint_open(label="window")`` look for). A kettle's on-button is its switch; a window's sash is
+# the window; a dial is a knob.
+LABEL_ALIASES = {"sash": "window", "button": "switch", "dial": "knob"}
+
+
+def kb_label(label: str) -> str:
+    return LABEL_ALIASES.get(label, label)
+
+
 def joints_with_label(asset, label: str) -> list:
-    labels = {label}
-    if label in ("switch", "knob"):
-        labels |= {"switch", "knob", "button"}
-    if label in ("door", "window"):
-        labels |= {label, "sash"} if label == "window" else {label}
-    return [j for j in asset.joints if j.label in labels]
+    """Joints whose (KB-normalised) label is one of ``label``'s alternatives ('door|drawer')."""
+    wanted = {kb_label(x.strip()) for x in label.split("|") if x.strip()}
+    if "knob" in wanted or "switch" in wanted:
+        wanted |= {"knob", "switch"}
+    return [j for j in asset.joints if kb_label(j.label) in wanted]
 
 
 def pick_asset(
@@ -205,5 +214,10 @@ def set_articulations(chosen: Chosen, uses: list[tuple[str, str]], rng: np.rando
     for label, state in uses:
         if state == "other":
             continue
-        for joint in joints_with_label(chosen.asset, label):
+        joints = joints_with_label(chosen.asset, label)
+        if state in ("open", "on") and len(joints) > 1 and "|" in label:
+            # 'door|drawer': opening one kind is enough for the hazard; prefer the first alternative found
+            first = next(kb_label(x) for x in label.split("|") if any(kb_label(j.label) == kb_label(x) for j in joints))
+            joints = [j for j in joints if kb_label(j.label) == first]
+        for joint in joints:
             chosen.joint_values[joint.name] = open_value(joint, state, rng)

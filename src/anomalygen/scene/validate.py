@@ -13,8 +13,8 @@ import numpy as np
 from anomalygen.schema import SceneSpec, ValidationCheck, ValidationReport
 
 MAX_PENETRATION = 0.001  # m
-MAX_LIN_VEL = 0.02  # m/s
-MAX_ANG_VEL = 0.3  # rad/s
+MAX_LIN_VEL = 0.05  # m/s (a marble may still creep; the KB predicates are what matter)
+MAX_ANG_VEL = 0.5  # rad/s
 INITIAL_OVERLAP = 0.004  # m: deeper than this before settling means the layout overlaps
 
 

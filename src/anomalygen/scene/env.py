@@ -1,0 +1,282 @@
+"""A Gymnasium environment for a built scene: end-effector delta actions plus suction.
+
+Action (Box [-1, 1]^7), as in the paper: a delta translation (3) and a delta axis-angle rotation (3)
+of the end effector, scaled by ``max_delta_pos`` / ``max_delta_rot`` per step, plus suction (> 0 on,
+<= 0 off). The end effector follows a mocap target through the ``ee_track`` weld (MuJoCo solves it
+inside the physics step), so a step costs almost exactly ``frameskip`` raw ``mj_step`` calls: no
+Python IK loop. Arm actuators go limp in this mode (gravity compensation keeps the arm up); the base
+actuators hold the mobile base where the scene put it.
+
+Observation: a flat float64 vector of robot joint positions and velocities, end-effector position and
+quaternion, the suction state, and each task object's position and quaternion and articulated joint
+values (clutter left out). ``obs_layout`` names the slices.
+
+Suction grabs an object whose geoms touch the cup (a contact, checked with numpy on MuJoCo's contact
+list) and welds it at the current relative pose; turning suction off releases it.
+
+Hooks: ``reward_fn(env) -> float`` and ``success_fn(env) -> bool`` let the skills stage plug in
+RewardSpec/SuccessSpec evaluation; ``env.graph()`` gives the current SceneGraph.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from anomalygen.scene import robot
+
+ENV_ID = "anomalygen/Scene-v0"
+
+
+class SceneEnv(gym.Env):
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 25}
+
+    def __init__(
+        self,
+        scene_dir: str | Path,
+        frameskip: int = 2,
+        horizon: int = 100,
+        *,
+        render_mode: str | None = "rgb_array",
+        camera: str = "front",
+        width: int = 320,
+        height: int = 240,
+        max_delta_pos: float = 0.02,
+        max_delta_rot: float = 0.1,
+        init_noise: float = 0.0,
+        reward_fn: Callable[[SceneEnv], float] | None = None,
+        success_fn: Callable[[SceneEnv], bool] | None = None,
+    ):
+        import mujoco
+
+        from anomalygen.scene.graph import load_scene
+
+        self._mj = mujoco
+        self.scene_dir = Path(scene_dir)
+        self.model, self.data, self.spec = load_scene(self.scene_dir)
+        self.frameskip, self.horizon = int(frameskip), int(horizon)
+        self.render_mode, self.camera = render_mode, camera
+        self.width, self.height = width, height
+        self.max_delta_pos, self.max_delta_rot = float(max_delta_pos), float(max_delta_rot)
+        self.init_noise = float(init_noise)
+        self.reward_fn, self.success_fn = reward_fn, success_fn
+        self._renderer = None
+
+        m = self.model
+        name2id = mujoco.mj_name2id
+        self._track = name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, "ee_track")
+        self._mocap = int(m.body_mocapid[name2id(m, mujoco.mjtObj.mjOBJ_BODY, "ee_target")])
+        self._cup_body = name2id(m, mujoco.mjtObj.mjOBJ_BODY, "suction")
+        self._cup_geom = name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "suction_geom")
+        self._ee_site = name2id(m, mujoco.mjtObj.mjOBJ_SITE, "ee_site")
+        jids = [name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in robot.ROBOT_JOINTS]
+        self._robot_qpos = np.array([m.jnt_qposadr[j] for j in jids])
+        self._robot_qvel = np.array([m.jnt_dofadr[j] for j in jids])
+        task_objects = [o for o in self.spec.objects if o.role.value != "clutter"]
+        self.task_objects = [o.name for o in task_objects]
+        self._obj_bodies = np.array([name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in self.task_objects], dtype=int)
+        joint_names = [j.name for o in task_objects for j in o.joint_states]
+        self._obj_qpos = np.array([m.jnt_qposadr[name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j)] for j in joint_names], dtype=int)
+        # Suction: geom -> object body with a suction weld, and that weld's id.
+        self._geom_to_eq = np.full(m.ngeom, -1, dtype=int)
+        self._eq_rel = {}
+        for name in robot.suction_candidates(m):
+            eq = name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, robot.SUCTION_PREFIX + name)
+            body = name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
+            self._geom_to_eq[robot._subtree_geoms(m, body)] = eq
+            self._eq_rel[eq] = body
+        self._held_eq = -1
+
+        sizes = {
+            "robot_qpos": len(self._robot_qpos),
+            "robot_qvel": len(self._robot_qvel),
+            "ee_pos": 3,
+            "ee_quat": 4,
+            "suction": 1,
+            "object_pos": 3 * len(self._obj_bodies),
+            "object_quat": 4 * len(self._obj_bodies),
+            "object_joints": len(self._obj_qpos),
+        }
+        self.obs_layout: dict[str, slice] = {}
+        start = 0
+        for key, n in sizes.items():
+            self.obs_layout[key] = slice(start, start + n)
+            start += n
+        self._obs = np.zeros(start)
+        # Fast path: the scene compiled observation sensors (scene/sensors.py), read in one copy.
+        from anomalygen.scene.sensors import GROUPS, sensor_layout
+
+        layout = sensor_layout(m)
+        self._use_sensors = set(layout) == set(GROUPS) and all(layout[g].stop - layout[g].start == sizes[g] for g in GROUPS)
+        if self._use_sensors:
+            nsens = int(m.nsensordata)
+            self.obs_layout = {**layout, "suction": slice(nsens, nsens + 1)}
+            start = nsens + 1
+            self._obs = np.zeros(start)
+        self.observation_space = spaces.Box(-np.inf, np.inf, shape=(start,), dtype=np.float64)
+        self.action_space = spaces.Box(-1.0, 1.0, shape=(7,), dtype=np.float32)
+        self._cache_views()
+        self._dq = np.zeros(4)
+        self._qtmp = np.zeros(4)
+        self._axis = np.zeros(3)
+        self.t = 0
+
+    # ------------------------------------------------------------------ gym API
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        from anomalygen.scene.graph import reset_to_initial
+
+        super().reset(seed=seed)
+        mj, m, d = self._mj, self.model, self.data
+        reset_to_initial(m, d)
+        if self.init_noise > 0:
+            d.qpos[self._robot_qpos] += self.np_random.uniform(-self.init_noise, self.init_noise, size=len(self._robot_qpos))
+            mj.mj_forward(m, d)
+        # Start the mocap target at the cup's pose and switch on tracking (base held in place).
+        robot.enable_ee_tracking(m, d)
+        self._held_eq = -1
+        self.t = 0
+        return self._observe(), {}
+
+    def step(self, action):
+        # Scalar Python maths on 7 numbers beats a dozen tiny numpy calls: this is the hot path.
+        mj, d = self._mj, self.data
+        try:
+            a = action.tolist()
+        except AttributeError:
+            a = list(action)
+        dp, dr = self.max_delta_pos, self.max_delta_rot
+        mpos, cup = self._v_mpos, self._v_cup
+        for i in range(3):
+            # move the target, but keep it within 8 cm of the cup (no runaway target)
+            v = mpos[i] + (a[i] if -1.0 <= a[i] <= 1.0 else (1.0 if a[i] > 0 else -1.0)) * dp
+            c = cup[i]
+            mpos[i] = c - 0.08 if v < c - 0.08 else (c + 0.08 if v > c + 0.08 else v)
+        rx, ry, rz = (min(1.0, max(-1.0, a[3])) * dr, min(1.0, max(-1.0, a[4])) * dr, min(1.0, max(-1.0, a[5])) * dr)
+        angle = (rx * rx + ry * ry + rz * rz) ** 0.5
+        if angle > 1e-9:
+            axis = self._axis
+            axis[0], axis[1], axis[2] = rx / angle, ry / angle, rz / angle
+            mj.mju_axisAngle2Quat(self._dq, axis, angle)
+            mj.mju_mulQuat(self._qtmp, self._dq, self._v_mquat)
+            self._v_mquat[:] = self._qtmp
+        if a[6] > 0.0:
+            if self._held_eq < 0:
+                self._try_grab()
+        elif self._held_eq >= 0:
+            d.eq_active[self._held_eq] = 0
+            self._held_eq = -1
+        mj.mj_step(self.model, d, self.frameskip)
+        self.t += 1
+        if self._use_sensors:  # inlined _observe fast path
+            self._o_sens[:] = self._v_sens
+            self._obs[-1] = 1.0 if self._held_eq >= 0 else 0.0
+            obs = self._obs.copy()
+        else:
+            obs = self._observe()
+        reward = float(self.reward_fn(self)) if self.reward_fn is not None else 0.0
+        terminated = bool(self.success_fn(self)) if self.success_fn is not None else False
+        return obs, reward, terminated, self.t >= self.horizon, {}
+
+    def render(self):
+        if self.render_mode != "rgb_array":
+            return None
+        if self._renderer is None:
+            from anomalygen.scene.render import SceneRenderer
+
+            self._renderer = SceneRenderer(self.model, self.width, self.height)
+        return self._renderer.render(self.data, self.camera)
+
+    def close(self):
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    # ------------------------------------------------------------------ helpers
+    def _cache_views(self) -> None:
+        """Keep numpy views of MjData arrays: each attribute access costs a pybind call per step."""
+        d, L, o = self.data, self.obs_layout, self._obs
+        self._v_sens = d.sensordata
+        self._o_sens = o[:-1]
+        self._v_qpos, self._v_qvel, self._v_xpos, self._v_xquat = d.qpos, d.qvel, d.xpos, d.xquat
+        self._v_mpos = d.mocap_pos[self._mocap]
+        self._v_mquat = d.mocap_quat[self._mocap]
+        self._v_cup = d.xpos[self._cup_body]
+        self._v_site = d.site_xpos[self._ee_site]
+        self._o = {k: o[v] for k, v in L.items()}
+        self._o_obj_pos = self._o["object_pos"].reshape(-1, 3)
+        self._o_obj_quat = self._o["object_quat"].reshape(-1, 4)
+        self._lo = np.zeros(3)
+        self._hi = np.zeros(3)
+
+    def _observe(self) -> np.ndarray:
+        if self._use_sensors:
+            self._o_sens[:] = self._v_sens
+            self._obs[-1] = 1.0 if self._held_eq >= 0 else 0.0
+            return self._obs.copy()
+        o = self._o
+        np.take(self._v_qpos, self._robot_qpos, out=o["robot_qpos"])
+        np.take(self._v_qvel, self._robot_qvel, out=o["robot_qvel"])
+        o["ee_pos"][:] = self._v_site
+        o["ee_quat"][:] = self._v_xquat[self._cup_body]
+        o["suction"][0] = 1.0 if self._held_eq >= 0 else 0.0
+        np.take(self._v_xpos, self._obj_bodies, axis=0, out=self._o_obj_pos)
+        np.take(self._v_xquat, self._obj_bodies, axis=0, out=self._o_obj_quat)
+        np.take(self._v_qpos, self._obj_qpos, out=o["object_joints"])
+        return self._obs.copy()
+
+    def _try_grab(self) -> bool:
+        """Weld the object whose geom touches the cup (if any) at the current relative pose."""
+        d = self.data
+        n = d.ncon
+        if n == 0:
+            return False
+        g1 = d.contact.geom1[:n]
+        g2 = d.contact.geom2[:n]
+        hit = np.flatnonzero((g1 == self._cup_geom) | (g2 == self._cup_geom))
+        for k in hit:
+            other = int(g2[k] if g1[k] == self._cup_geom else g1[k])
+            eq = int(self._geom_to_eq[other])
+            if eq < 0 or d.contact.dist[k] > robot.SUCTION_RANGE:
+                continue
+            body = self._eq_rel[eq]
+            relpos, relquat = robot.relative_pose(d.xpos[self._cup_body], d.xquat[self._cup_body], d.xpos[body], d.xquat[body])
+            self.model.eq_data[eq, 0:3] = 0.0
+            self.model.eq_data[eq, 3:6] = relpos
+            self.model.eq_data[eq, 6:10] = relquat
+            self.model.eq_data[eq, 10] = 1.0
+            d.eq_active[eq] = 1
+            self._held_eq = eq
+            return True
+        return False
+
+    @property
+    def held(self) -> str | None:
+        """Name of the object held by suction, if any."""
+        if self._held_eq < 0:
+            return None
+        return self._mj.mj_id2name(self.model, self._mj.mjtObj.mjOBJ_BODY, self._eq_rel[self._held_eq])
+
+    def graph(self):
+        """The SceneGraph of the current state (for success predicates)."""
+        from anomalygen.scene.graph import scene_graph
+
+        self._mj.mj_forward(self.model, self.data)
+        return scene_graph(self.model, self.data, self.spec)
+
+
+def make_env(scene_dir, frameskip: int = 2, horizon: int = 100, **kwargs) -> SceneEnv:
+    """The env for a built scene folder, unwrapped (no checker wrappers: they would add step cost)."""
+    return SceneEnv(scene_dir, frameskip=frameskip, horizon=horizon, **kwargs)
+
+
+def register() -> None:
+    """Register ``anomalygen/Scene-v0`` with Gymnasium (idempotent): ``gym.make(ENV_ID, scene_dir=...)``."""
+    if ENV_ID not in gym.registry:
+        gym.register(id=ENV_ID, entry_point="anomalygen.scene.env:SceneEnv", kwargs={})
+
+
+register()

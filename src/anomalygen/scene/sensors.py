@@ -1,0 +1,51 @@
+"""Observation sensors compiled into every scene, so the env's observation costs one copy per step.
+
+MuJoCo evaluates sensors in C inside ``mj_step``; reading ``data.sensordata`` replaces a dozen numpy
+gathers per step in Python, which is what keeps the Gymnasium env's step overhead near raw physics.
+Sensor names are ``obs:<group>:<item>``; groups appear in ``GROUPS`` order, so the env can slice the
+vector by group. Sensors are computed at the start of the last physics substep, i.e. they lag the
+returned state by one timestep (2 ms).
+"""
+
+from __future__ import annotations
+
+GROUPS = ("robot_qpos", "robot_qvel", "ee_pos", "ee_quat", "object_pos", "object_quat", "object_joints")
+
+
+def add_observation_sensors(spec, robot_joints: list[str], objects: list[str], object_joints: list[str]) -> None:
+    import mujoco
+
+    S, O = mujoco.mjtSensor, mujoco.mjtObj
+
+    def add(group, item, stype, objtype, objname):
+        s = spec.add_sensor(name=f"obs:{group}:{item}", type=stype, objtype=objtype, objname=objname)
+        return s
+
+    for j in robot_joints:
+        add("robot_qpos", j, S.mjSENS_JOINTPOS, O.mjOBJ_JOINT, j)
+    for j in robot_joints:
+        add("robot_qvel", j, S.mjSENS_JOINTVEL, O.mjOBJ_JOINT, j)
+    add("ee_pos", "ee_site", S.mjSENS_FRAMEPOS, O.mjOBJ_SITE, "ee_site")
+    add("ee_quat", "ee_site", S.mjSENS_FRAMEQUAT, O.mjOBJ_XBODY, "suction")
+    for o in objects:
+        add("object_pos", o, S.mjSENS_FRAMEPOS, O.mjOBJ_XBODY, o)
+    for o in objects:
+        add("object_quat", o, S.mjSENS_FRAMEQUAT, O.mjOBJ_XBODY, o)
+    for j in object_joints:
+        add("object_joints", j, S.mjSENS_JOINTPOS, O.mjOBJ_JOINT, j)
+
+
+def sensor_layout(model) -> dict[str, slice]:
+    """Group -> slice of ``data.sensordata`` (empty dict when the scene has no observation sensors)."""
+    import mujoco
+
+    spans: dict[str, list[int]] = {}
+    for i in range(model.nsensor):
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SENSOR, i) or ""
+        if not name.startswith("obs:"):
+            continue
+        group = name.split(":")[1]
+        adr, dim = int(model.sensor_adr[i]), int(model.sensor_dim[i])
+        lo, hi = spans.get(group, [adr, adr])
+        spans[group] = [min(lo, adr), max(hi, adr + dim)]
+    return {g: slice(*spans[g]) for g in GROUPS if g in spans}

@@ -1,0 +1,86 @@
+"""``anomalygen build``: every task in the run becomes ``scenes/<task_id>/`` (resumable, parallel).
+
+A scene counts as done when its ``scene.json`` exists, validates as a SceneSpec and its validation
+report is ok (scene.json is written last, so a crash mid-scene leaves it undone). The item function
+is module-level so the process pool and Ray can pickle it. After the batch, a contact sheet of up to
+10 random front renders goes to ``scenes/contact_sheet.png`` for a quick visual check.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from anomalygen.runfolder import RunFolder, atomic_write_bytes, try_read_model
+from anomalygen.runner import StageContext, StageSummary, run_items
+from anomalygen.schema import SceneSpec, TaskProposal
+
+STAGE = "build"
+SHEET_N = 10
+
+
+def scene_ok(scene_dir: Path) -> bool:
+    spec = try_read_model(Path(scene_dir) / "scene.json", SceneSpec)
+    return spec is not None and spec.validation is not None and spec.validation.ok
+
+
+def build_item(item_id: str, payload: str, ctx: StageContext) -> str:
+    """Build one task's scene; returns the scene id (ItemFailed propagates as the item's reason)."""
+    from anomalygen.scene.build import build_scene
+
+    task = TaskProposal.model_validate_json(payload)
+    settings = ctx.settings
+    spec = build_scene(task, seed=settings.seed, settings=settings, out_dir=ctx.run.scene_dir(item_id))
+    return spec.scene_id
+
+
+def run_stage(run: RunFolder, settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
+    tasks = run.load_tasks()
+    if only:
+        wanted = set(only)
+        tasks = [t for t in tasks if t.id in wanted]
+    items = [(t.id, t.model_dump_json()) for t in tasks]
+    summary = run_items(
+        run,
+        STAGE,
+        items,
+        build_item,
+        settings=settings,
+        is_done=lambda task_id: scene_ok(run.scene_dir(task_id)),
+        force=force,
+        description="build scenes",
+    )
+    try:
+        write_contact_sheet(run, seed=settings.seed)
+    except Exception:  # noqa: BLE001 - a missing preview must not fail the stage
+        pass
+    return summary
+
+
+def write_contact_sheet(run: RunFolder, *, seed: int = 0, n: int = SHEET_N) -> Path | None:
+    """Tile up to ``n`` randomly chosen front renders (with their task ids) into one PNG."""
+    from PIL import Image, ImageDraw
+
+    from anomalygen.rng import item_rng
+
+    renders = sorted(p for p in run.scenes_dir.glob("*/render_front.png") if scene_ok(p.parent))
+    if not renders:
+        return None
+    rng = item_rng(seed, "contact_sheet")
+    pick = [renders[i] for i in sorted(rng.choice(len(renders), size=min(n, len(renders)), replace=False))]
+    images = [Image.open(p).convert("RGB") for p in pick]
+    w, h = images[0].size
+    cols = min(5, len(images))
+    rows = (len(images) + cols - 1) // cols
+    sheet = Image.new("RGB", (cols * w, rows * (h + 16)), "white")
+    draw = ImageDraw.Draw(sheet)
+    for i, (img, path) in enumerate(zip(images, pick, strict=True)):
+        x, y = (i % cols) * w, (i // cols) * (h + 16)
+        sheet.paste(img.resize((w, h)), (x, y + 16))
+        draw.text((x + 4, y + 2), path.parent.name, fill="black")
+    import io
+
+    buf = io.BytesIO()
+    sheet.save(buf, format="PNG")
+    out = run.scenes_dir / "contact_sheet.png"
+    atomic_write_bytes(out, buf.getvalue())
+    return out
