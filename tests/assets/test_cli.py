@@ -24,7 +24,9 @@ def test_list_and_show_json():
 
 def test_render_writes_a_png(tmp_path):
     out = tmp_path / "x.png"
-    res = runner.invoke(app, ["render", "Laptop", "--seed", "2", "--out", str(out), "--width", "120", "--height", "90"])
+    res = runner.invoke(
+        app, ["render", "Laptop", "--seed", "2", "--out", str(out), "--width", "120", "--height", "90"]
+    )
     assert res.exit_code == 0, res.output
     from PIL import Image
 
@@ -33,7 +35,9 @@ def test_render_writes_a_png(tmp_path):
 
 
 def test_validate_reports_categories_and_exit_code():
-    res = runner.invoke(app, ["validate", "-n", "1", "--name", "Toaster", "--name", "pill", "--no-render", "--json"])
+    res = runner.invoke(
+        app, ["validate", "-n", "1", "--name", "Toaster", "--name", "pill", "--no-render", "--json"]
+    )
     assert res.exit_code == 0, res.output
     summary = json.loads(res.stdout)
     assert summary["passed"] == 2 and summary["assets_ok"] == 2
@@ -41,7 +45,9 @@ def test_validate_reports_categories_and_exit_code():
 
 def test_search_json(tmp_path, monkeypatch):
     monkeypatch.setenv("ANOMALYGEN_CACHE_DIR", str(tmp_path))
-    res = runner.invoke(app, ["search", "cold food storage appliance", "-k", "3", "--variants", "1", "--json"])
+    res = runner.invoke(
+        app, ["search", "cold food storage appliance", "-k", "3", "--variants", "1", "--json"]
+    )
     assert res.exit_code == 0, res.output
     hits = json.loads(res.stdout)
     assert len(hits) == 3 and "Refrigerator" in [h["name"] for h in hits]

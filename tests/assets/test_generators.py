@@ -87,9 +87,16 @@ def test_size_is_clamped_to_the_plausible_range_and_scales_uniformly():
 
 
 def test_seeded_variants_are_deterministic_and_distinct():
-    a1, a2, b = generate("StorageFurniture", 5), generate("StorageFurniture", 5), generate("StorageFurniture", 6)
+    a1, a2, b = (
+        generate("StorageFurniture", 5),
+        generate("StorageFurniture", 5),
+        generate("StorageFurniture", 6),
+    )
     assert a1.spec.to_xml() == a2.spec.to_xml() and a1.description == a2.description
-    layouts = {(generate("StorageFurniture", s).params["cols"], generate("StorageFurniture", s).params["rows"]) for s in range(12)}
+    layouts = {
+        (generate("StorageFurniture", s).params["cols"], generate("StorageFurniture", s).params["rows"])
+        for s in range(12)
+    }
     assert len(layouts) >= 4
     assert a1.spec.to_xml() != b.spec.to_xml()
     counts = {len(generate("StorageFurniture", s).joints) for s in range(20)}
@@ -114,7 +121,9 @@ def test_refrigerator_has_freezer_and_a_fridge_cavity_closed_by_a_door():
         assert names["fridge"].joint in joints and names["freezer"].joint in joints
         lo, hi = a.aabb
         for c in a.cavities:
-            assert np.all(np.asarray(c.center) - c.half_extents >= lo - 1e-6) and np.all(np.asarray(c.center) + c.half_extents <= hi + 1e-6)
+            assert np.all(np.asarray(c.center) - c.half_extents >= lo - 1e-6) and np.all(
+                np.asarray(c.center) + c.half_extents <= hi + 1e-6
+            )
 
 
 def test_furniture_surfaces_and_cavities():
@@ -122,7 +131,9 @@ def test_furniture_surfaces_and_cavities():
     top = counter.surfaces[0]
     assert 0.8 < top.center[2] < 1.0 and top.center[2] == pytest.approx(counter.aabb[1][2], abs=0.01)
     shelf = generate("shelf", 2)
-    assert len(shelf.surfaces) >= 3 and sorted(s.center[2] for s in shelf.surfaces) == [s.center[2] for s in shelf.surfaces]
+    assert len(shelf.surfaces) >= 3 and sorted(s.center[2] for s in shelf.surfaces) == [
+        s.center[2] for s in shelf.surfaces
+    ]
     med = generate("medicine_cabinet", 0)
     assert med.cavities and all(c.joint == "door_hinge" and c.opening == "front" for c in med.cavities)
     assert generate("storage_box", 0).cavities[0].joint == "lid_hinge"

@@ -28,7 +28,9 @@ def test_partnet_folder_becomes_an_articulated_asset(tmp_path):
     folder = write_partnet_cabinet(tmp_path / "45135")
     assert read_semantics(folder / "semantics.txt")["link_1"] == ("hinge", "door")
     a = load_partnet(folder, size=0.9)
-    assert a.source == AssetSource.PARTNET and a.category == "StorageFurniture" and a.asset_id == "partnet:45135"
+    assert (
+        a.source == AssetSource.PARTNET and a.category == "StorageFurniture" and a.asset_id == "partnet:45135"
+    )
     labels = {j.name: j for j in a.joints}
     assert labels["joint_1"].label == "door" and labels["joint_1"].type == "hinge"
     assert labels["joint_1"].range == pytest.approx((0.0, 1.57))

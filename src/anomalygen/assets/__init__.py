@@ -41,6 +41,19 @@ def from_ref(ref):
 
 
 __all__ = [
-    "Asset", "AssetJoint", "CatalogueEntry", "Cavity", "Surface", "ValidationResult", "validate_asset", "available_names", "catalogue", "from_ref", "generate",
-    "household_names", "retrieve", "size_range", "target_names",
+    "Asset",
+    "AssetJoint",
+    "CatalogueEntry",
+    "Cavity",
+    "Surface",
+    "ValidationResult",
+    "validate_asset",
+    "available_names",
+    "catalogue",
+    "from_ref",
+    "generate",
+    "household_names",
+    "retrieve",
+    "size_range",
+    "target_names",
 ]

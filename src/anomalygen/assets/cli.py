@@ -34,12 +34,19 @@ def _check_name(name: str) -> str:
 
 
 @app.command("list")
-def list_cmd(json_out: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False) -> None:
+def list_cmd(
+    json_out: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+) -> None:
     """Every asset name with its kind and plausible size range."""
     from anomalygen.assets.core import group, household_names, size_range, target_names
 
-    rows = [{"name": n, "kind": "target", "group": group(n), "size_range": size_range(n)} for n in target_names()]
-    rows += [{"name": n, "kind": "household", "group": group(n), "size_range": size_range(n)} for n in household_names()]
+    rows = [
+        {"name": n, "kind": "target", "group": group(n), "size_range": size_range(n)} for n in target_names()
+    ]
+    rows += [
+        {"name": n, "kind": "household", "group": group(n), "size_range": size_range(n)}
+        for n in household_names()
+    ]
     if json_out:
         print(json.dumps(rows))
         return
@@ -68,9 +75,34 @@ def show(
         "size": round(a.size, 4),
         "aabb": [a.aabb[0].round(4).tolist(), a.aabb[1].round(4).tolist()],
         "mass": round(a.mass, 4),
-        "joints": [{"name": j.name, "type": j.type, "label": j.label, "range": [round(v, 4) for v in j.range], "closed": round(j.closed_value, 4)} for j in a.joints],
-        "surfaces": [{"name": s.name, "center": [round(v, 4) for v in s.center], "half_size": [round(v, 4) for v in s.half_size]} for s in a.surfaces],
-        "cavities": [{"name": c.name, "opening": c.opening, "joint": c.joint, "center": [round(v, 4) for v in c.center], "half_extents": [round(v, 4) for v in c.half_extents]} for c in a.cavities],
+        "joints": [
+            {
+                "name": j.name,
+                "type": j.type,
+                "label": j.label,
+                "range": [round(v, 4) for v in j.range],
+                "closed": round(j.closed_value, 4),
+            }
+            for j in a.joints
+        ],
+        "surfaces": [
+            {
+                "name": s.name,
+                "center": [round(v, 4) for v in s.center],
+                "half_size": [round(v, 4) for v in s.half_size],
+            }
+            for s in a.surfaces
+        ],
+        "cavities": [
+            {
+                "name": c.name,
+                "opening": c.opening,
+                "joint": c.joint,
+                "center": [round(v, 4) for v in c.center],
+                "half_extents": [round(v, 4) for v in c.half_extents],
+            }
+            for c in a.cavities
+        ],
         "description": a.description,
         "params": a.params,
     }
@@ -116,8 +148,13 @@ def _validate_one(args: tuple[str, int, bool]) -> dict:
 def validate(
     per_category: Annotated[int, typer.Option("--per-category", "-n", help="Seeds per name.")] = 10,
     names: Annotated[list[str] | None, typer.Option("--name", help="Only these names (repeatable).")] = None,
-    household: Annotated[bool, typer.Option("--household/--targets", help="Validate household objects instead of the 44 targets.")] = False,
-    do_render: Annotated[bool, typer.Option("--render/--no-render", help="Also render a thumbnail per asset.")] = True,
+    household: Annotated[
+        bool,
+        typer.Option("--household/--targets", help="Validate household objects instead of the 44 targets."),
+    ] = False,
+    do_render: Annotated[
+        bool, typer.Option("--render/--no-render", help="Also render a thumbnail per asset.")
+    ] = True,
     workers: Annotated[int, typer.Option("--workers", "-j", help="Parallel processes.")] = 1,
     json_out: Annotated[bool, typer.Option("--json")] = False,
 ) -> None:
@@ -125,7 +162,9 @@ def validate(
     os.environ.setdefault("MUJOCO_GL", "egl")
     from anomalygen.assets.core import household_names, target_names
 
-    todo_names = [_check_name(n) for n in names] if names else (household_names() if household else target_names())
+    todo_names = (
+        [_check_name(n) for n in names] if names else (household_names() if household else target_names())
+    )
     jobs = [(n, s, do_render) for n in todo_names for s in range(per_category)]
     t0 = time.perf_counter()
     if workers > 1:
@@ -143,13 +182,22 @@ def validate(
     per = {n: [r for r in results if r["name"] == n] for n in todo_names}
     passed = [n for n, rs in per.items() if all(r["ok"] for r in rs)]
     wall = time.perf_counter() - t0
-    summary = {"names": len(todo_names), "passed": len(passed), "assets": len(results), "assets_ok": sum(r["ok"] for r in results), "wall_s": round(wall, 1), "failures": [r for r in results if not r["ok"]]}
+    summary = {
+        "names": len(todo_names),
+        "passed": len(passed),
+        "assets": len(results),
+        "assets_ok": sum(r["ok"] for r in results),
+        "wall_s": round(wall, 1),
+        "failures": [r for r in results if not r["ok"]],
+    }
     if json_out:
         print(json.dumps(summary))
     else:
         for f in summary["failures"]:
             out.print(f"[red]FAIL[/red] {f['name']} seed {f['seed']}: {f['reason']}")
-        out.print(f"{len(passed)}/{len(todo_names)} categories pass ({summary['assets_ok']}/{len(results)} assets, {per_category} seeds each) in {wall:.0f} s")
+        out.print(
+            f"{len(passed)}/{len(todo_names)} categories pass ({summary['assets_ok']}/{len(results)} assets, {per_category} seeds each) in {wall:.0f} s"
+        )
     if len(passed) != len(todo_names):
         raise typer.Exit(1)
 
@@ -167,7 +215,20 @@ def search(
 
     hits = retrieve(query, k, category, variants_per_name=variants)
     if json_out:
-        print(json.dumps([{"asset_id": e.asset_id, "name": e.name, "score": round(s, 4), "size": e.size, "description": e.description} for e, s in hits]))
+        print(
+            json.dumps(
+                [
+                    {
+                        "asset_id": e.asset_id,
+                        "name": e.name,
+                        "score": round(s, 4),
+                        "size": e.size,
+                        "description": e.description,
+                    }
+                    for e, s in hits
+                ]
+            )
+        )
         return
     t = Table("score", "asset", "size (m)", "description")
     for e, s in hits:

@@ -12,9 +12,10 @@ from __future__ import annotations
 import functools
 import json
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from importlib import resources
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -89,7 +90,14 @@ class Asset:
 
     @property
     def ref(self) -> AssetRef:
-        return AssetRef(asset_id=self.asset_id, category=self.category, source=self.source, seed=self.seed, params=dict(self.params), path=self.path)
+        return AssetRef(
+            asset_id=self.asset_id,
+            category=self.category,
+            source=self.source,
+            seed=self.seed,
+            params=dict(self.params),
+            path=self.path,
+        )
 
     def root_body(self):
         return self.spec.worldbody.first_body()
@@ -117,7 +125,9 @@ class Asset:
 
 @functools.cache
 def object_table() -> dict[str, tuple[float, float, str, tuple[str, ...]]]:
-    raw = json.loads(resources.files("anomalygen.data").joinpath("assets/objects.json").read_text())["objects"]
+    raw = json.loads(resources.files("anomalygen.data").joinpath("assets/objects.json").read_text())[
+        "objects"
+    ]
     return {k: (float(v[0]), float(v[1]), v[2], tuple(v[3].split())) for k, v in raw.items()}
 
 
@@ -185,11 +195,17 @@ def _joint_gains(part: Part, scale: float) -> tuple[float, float]:
     return max(2.0 * eff, 1e-5), max(0.2 * eff, 1e-6)
 
 
-_GEOM_TYPES = {"box": "mjGEOM_BOX", "sphere": "mjGEOM_SPHERE", "cylinder": "mjGEOM_CYLINDER", "capsule": "mjGEOM_CAPSULE", "ellipsoid": "mjGEOM_ELLIPSOID"}
+_GEOM_TYPES = {
+    "box": "mjGEOM_BOX",
+    "sphere": "mjGEOM_SPHERE",
+    "cylinder": "mjGEOM_CYLINDER",
+    "capsule": "mjGEOM_CAPSULE",
+    "ellipsoid": "mjGEOM_ELLIPSOID",
+}
 
 
 def _emit(mujoco, part: Part, body, scale: float, offset: np.ndarray, joints: list[AssetJoint]) -> None:
-    for i, g in enumerate(part.geoms):
+    for g in part.geoms:
         size = [v * scale for v in g.size] + [0.0] * (3 - len(g.size))
         geom = body.add_geom(
             type=getattr(mujoco.mjtGeom, _GEOM_TYPES[g.kind]),
@@ -214,7 +230,15 @@ def _emit(mujoco, part: Part, body, scale: float, offset: np.ndarray, joints: li
         if j.spring or j.hold:
             # Worst-case gravity load on this joint: weight times lever arm (or weight for slides).
             m = part.mass() * scale**3
-            lever = 1.0 if j.type == "slide" else float(np.linalg.norm(np.cross(np.asarray(j.axis, float), (part.com() - np.asarray(j.pos)) * scale)))
+            lever = (
+                1.0
+                if j.type == "slide"
+                else float(
+                    np.linalg.norm(
+                        np.cross(np.asarray(j.axis, float), (part.com() - np.asarray(j.pos)) * scale)
+                    )
+                )
+            )
             load = m * 9.81 * lever + 1e-6
             if j.hold:
                 extra["frictionloss"] = 1.5 * load
@@ -237,9 +261,23 @@ def _emit(mujoco, part: Part, body, scale: float, offset: np.ndarray, joints: li
             joint.frictionloss = extra["frictionloss"]
         if "stiffness" in extra:
             cur = joint.stiffness
-            joint.stiffness = [extra["stiffness"]] + [0.0] * (len(cur) - 1) if hasattr(cur, "__len__") else extra["stiffness"]
+            joint.stiffness = (
+                [extra["stiffness"]] + [0.0] * (len(cur) - 1)
+                if hasattr(cur, "__len__")
+                else extra["stiffness"]
+            )
             joint.springref = extra["springref"]
-        joints.append(AssetJoint(j.name, j.type, (float(rng[0]), float(rng[1])), j.label, float(closed), tuple(float(a) for a in j.axis), part.name))
+        joints.append(
+            AssetJoint(
+                j.name,
+                j.type,
+                (float(rng[0]), float(rng[1])),
+                j.label,
+                float(closed),
+                tuple(float(a) for a in j.axis),
+                part.name,
+            )
+        )
     for c in part.children:
         cb = body.add_body(name=c.name, pos=list(np.asarray(c.pos) * scale + offset), quat=list(c.quat))
         _emit(mujoco, c, cb, scale, np.zeros(3), joints)
@@ -266,7 +304,15 @@ def new_spec():
     return spec
 
 
-def finalize(draft: Draft, *, name: str, seed: int | None, size: float | None, rng: np.random.Generator, source=AssetSource.PROCEDURAL) -> Asset:
+def finalize(
+    draft: Draft,
+    *,
+    name: str,
+    seed: int | None,
+    size: float | None,
+    rng: np.random.Generator,
+    source=AssetSource.PROCEDURAL,
+) -> Asset:
     """Scale the draft to the requested (clamped) largest dimension, centre it, emit the MjSpec."""
     import mujoco
 
@@ -290,8 +336,14 @@ def finalize(draft: Draft, *, name: str, seed: int | None, size: float | None, r
     def tf(p):
         return tuple(float(v) for v in np.asarray(p) * scale + offset)
 
-    surfaces = [Surface(s.name, tf(s.center), (s.half_size[0] * scale, s.half_size[1] * scale)) for s in draft.surfaces]
-    cavities = [Cavity(c.name, tf(c.center), tuple(h * scale for h in c.half_extents), c.opening, c.joint) for c in draft.cavities]
+    surfaces = [
+        Surface(s.name, tf(s.center), (s.half_size[0] * scale, s.half_size[1] * scale))
+        for s in draft.surfaces
+    ]
+    cavities = [
+        Cavity(c.name, tf(c.center), tuple(h * scale for h in c.half_extents), c.opening, c.joint)
+        for c in draft.cavities
+    ]
     ext = (hi - lo) * scale
     aabb = (np.array([-ext[0] / 2, -ext[1] / 2, 0.0]), np.array([ext[0] / 2, ext[1] / 2, ext[2]]))
     params = {"size": round(target, 5), **draft.params}

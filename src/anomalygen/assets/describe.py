@@ -53,18 +53,50 @@ _TAG_TEXT = {
 
 
 TARGET_BLURBS = {
-    "Bottle": "bottle with a cap", "Box": "storage box", "Bucket": "open bucket with a handle",
-    "Camera": "photo camera", "Cart": "wheeled trolley cart with shelves", "Chair": "chair",
-    "Clock": "desk clock", "CoffeeMachine": "coffee machine", "Dishwasher": "kitchen dishwasher",
-    "Dispenser": "soap or lotion pump dispenser", "Display": "computer monitor screen", "Door": "room door",
-    "Eyeglasses": "pair of glasses", "Fan": "electric fan", "FoldingChair": "folding chair", "Globe": "desk globe",
-    "Kettle": "electric kettle", "Keyboard": "computer keyboard", "KitchenPot": "cooking pot with a lid",
-    "Knife": "folding pocket knife", "Lamp": "desk lamp", "Laptop": "laptop computer", "Microwave": "microwave oven",
-    "Mouse": "computer mouse", "Oven": "kitchen oven and stove", "Pen": "pen", "Phone": "mobile phone",
-    "Pliers": "pliers", "Printer": "printer", "Refrigerator": "fridge / refrigerator", "Remote": "TV remote control",
-    "Safe": "safe", "Scissors": "scissors", "Stapler": "stapler", "StorageFurniture": "cabinet / storage furniture",
-    "Suitcase": "suitcase", "Table": "table", "Toaster": "toaster", "Toilet": "toilet", "TrashCan": "trash can / rubbish bin",
-    "USB": "USB stick", "WashingMachine": "washing machine", "Window": "window", "Lighter": "cigarette lighter",
+    "Bottle": "bottle with a cap",
+    "Box": "storage box",
+    "Bucket": "open bucket with a handle",
+    "Camera": "photo camera",
+    "Cart": "wheeled trolley cart with shelves",
+    "Chair": "chair",
+    "Clock": "desk clock",
+    "CoffeeMachine": "coffee machine",
+    "Dishwasher": "kitchen dishwasher",
+    "Dispenser": "soap or lotion pump dispenser",
+    "Display": "computer monitor screen",
+    "Door": "room door",
+    "Eyeglasses": "pair of glasses",
+    "Fan": "electric fan",
+    "FoldingChair": "folding chair",
+    "Globe": "desk globe",
+    "Kettle": "electric kettle",
+    "Keyboard": "computer keyboard",
+    "KitchenPot": "cooking pot with a lid",
+    "Knife": "folding pocket knife",
+    "Lamp": "desk lamp",
+    "Laptop": "laptop computer",
+    "Microwave": "microwave oven",
+    "Mouse": "computer mouse",
+    "Oven": "kitchen oven and stove",
+    "Pen": "pen",
+    "Phone": "mobile phone",
+    "Pliers": "pliers",
+    "Printer": "printer",
+    "Refrigerator": "fridge / refrigerator",
+    "Remote": "TV remote control",
+    "Safe": "safe",
+    "Scissors": "scissors",
+    "Stapler": "stapler",
+    "StorageFurniture": "cabinet / storage furniture",
+    "Suitcase": "suitcase",
+    "Table": "table",
+    "Toaster": "toaster",
+    "Toilet": "toilet",
+    "TrashCan": "trash can / rubbish bin",
+    "USB": "USB stick",
+    "WashingMachine": "washing machine",
+    "Window": "window",
+    "Lighter": "cigarette lighter",
 }
 
 
@@ -89,7 +121,9 @@ def describe(name: str, asset: Asset, features: list[str]) -> str:
     parts = [f"{size_words(size)} {name.replace('_', ' ')}: {blurb}"]
     d = ".1f" if size < 0.1 else ".0f"
     mass = f"{asset.mass * 1000:.0f} g" if asset.mass < 0.5 else f"{asset.mass:.1f} kg"
-    parts.append(f"about {size * 100:{d}} cm across ({dims[0] * 100:{d}} x {dims[1] * 100:{d}} x {dims[2] * 100:{d}} cm), {mass}")
+    parts.append(
+        f"about {size * 100:{d}} cm across ({dims[0] * 100:{d}} x {dims[1] * 100:{d}} x {dims[2] * 100:{d}} cm), {mass}"
+    )
     if features:
         parts.append(", ".join(features))
     labels = sorted({j.label for j in asset.joints})

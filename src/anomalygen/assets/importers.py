@@ -71,7 +71,15 @@ def _attach_unprefixed(spec, frame, child) -> None:
     """Attach ``child``'s first body keeping the original names (MuJoCo warns on an empty prefix,
     so attach with a temporary prefix and strip it)."""
     frame.attach_body(child.worldbody.first_body(), _TMP_PREFIX, "")
-    for group in (spec.bodies, spec.joints, spec.geoms, spec.meshes, spec.sites, spec.materials, spec.textures):
+    for group in (
+        spec.bodies,
+        spec.joints,
+        spec.geoms,
+        spec.meshes,
+        spec.sites,
+        spec.materials,
+        spec.textures,
+    ):
         for el in group:
             if el.name.startswith(_TMP_PREFIX):
                 el.name = el.name[len(_TMP_PREFIX) :]
@@ -143,7 +151,15 @@ def prepare_urdf(urdf_text: str, mesh_dir: Path) -> str:
     for old in root.findall("mujoco"):
         root.remove(old)
     mj = ET.SubElement(root, "mujoco")
-    ET.SubElement(mj, "compiler", meshdir=str(mesh_dir), strippath="true", discardvisual="false", fusestatic="false", balanceinertia="true")
+    ET.SubElement(
+        mj,
+        "compiler",
+        meshdir=str(mesh_dir),
+        strippath="true",
+        discardvisual="false",
+        fusestatic="false",
+        balanceinertia="true",
+    )
     return ET.tostring(root, encoding="unicode")
 
 
@@ -177,9 +193,14 @@ def load_partnet(path: str | Path, *, size: float | None = None, up_axis: str = 
     up = _Y_UP_TO_Z_UP if up_axis == "y" else (1.0, 0.0, 0.0, 0.0)
     lo_hi = size_range(category) if _known(category) else (0.05, 3.0)
     default = float(np.mean(lo_hi))
-    spec, aabb, mass, s = _wrap(inner, up_quat=up, size=None if size is None else float(size), default_size=default)
+    spec, aabb, mass, s = _wrap(
+        inner, up_quat=up, size=None if size is None else float(size), default_size=default
+    )
     joints = []
-    child_of = {j.get("name"): (j.find("child").get("link") if j.find("child") is not None else "") for j in urdf_root.iter("joint")}
+    child_of = {
+        j.get("name"): (j.find("child").get("link") if j.find("child") is not None else "")
+        for j in urdf_root.iter("joint")
+    }
     model = spec.compile()
     for j in spec.joints:
         if j.type not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
@@ -189,7 +210,17 @@ def load_partnet(path: str | Path, *, size: float | None = None, up_axis: str = 
         jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j.name)
         rng = tuple(float(v) for v in model.jnt_range[jid]) if model.jnt_limited[jid] else (-math.pi, math.pi)
         closed = 0.0 if rng[0] <= 0.0 <= rng[1] else rng[0]
-        joints.append(AssetJoint(j.name, "hinge" if j.type == mujoco.mjtJoint.mjJNT_HINGE else "slide", rng, label, closed, tuple(float(a) for a in j.axis), link))
+        joints.append(
+            AssetJoint(
+                j.name,
+                "hinge" if j.type == mujoco.mjtJoint.mjJNT_HINGE else "slide",
+                rng,
+                label,
+                closed,
+                tuple(float(a) for a in j.axis),
+                link,
+            )
+        )
     labels = sorted({j.label for j in joints})
     desc = f"{category} imported from PartNet-Mobility model {meta.get('anno_id', folder.name)}; about {float(np.max(aabb[1] - aabb[0])) * 100:.0f} cm; movable parts: {', '.join(labels) or 'none'}"
     return Asset(
@@ -205,7 +236,12 @@ def load_partnet(path: str | Path, *, size: float | None = None, up_axis: str = 
         surfaces=[],
         cavities=[],
         description=desc,
-        params={"size": round(float(np.max(aabb[1] - aabb[0])), 5), "scale": s, "up_axis": up_axis, "semantics": {k: list(v) for k, v in semantics.items()}},
+        params={
+            "size": round(float(np.max(aabb[1] - aabb[0])), 5),
+            "scale": s,
+            "up_axis": up_axis,
+            "semantics": {k: list(v) for k, v in semantics.items()},
+        },
         path=str(folder),
     )
 
@@ -233,7 +269,15 @@ def _names(items) -> list[str]:
     return [i.get("name", "") if isinstance(i, dict) else str(i) for i in (items or [])]
 
 
-def load_objaverse(path: str | Path, *, annotations: str | Path | dict | None = None, size: float | None = None, name: str | None = None, up_axis: str = "y", density: float = 500.0) -> Asset:
+def load_objaverse(
+    path: str | Path,
+    *,
+    annotations: str | Path | dict | None = None,
+    size: float | None = None,
+    name: str | None = None,
+    up_axis: str = "y",
+    density: float = 500.0,
+) -> Asset:
     """Import one Objaverse-style mesh (OBJ) as a rigid Asset; ``annotations`` gives its text."""
     import mujoco
 
@@ -244,7 +288,9 @@ def load_objaverse(path: str | Path, *, annotations: str | Path | dict | None = 
         try:
             import trimesh  # noqa: F401  (optional; converts GLB to OBJ if the user has it)
         except ImportError:
-            raise UserError(f"{mesh_path.name}: GLB import needs the optional 'trimesh' package; install it or convert the file to OBJ") from None
+            raise UserError(
+                f"{mesh_path.name}: GLB import needs the optional 'trimesh' package; install it or convert the file to OBJ"
+            ) from None
         mesh_path = _glb_to_obj(mesh_path)
     if mesh_path.suffix.lower() != ".obj":
         raise UserError(f"{mesh_path.name}: only OBJ (or GLB with trimesh) is supported")
@@ -254,9 +300,13 @@ def load_objaverse(path: str | Path, *, annotations: str | Path | dict | None = 
     ann = read_annotation(annotations, uid)
     label = name or ann.get("name") or uid
     inner = new_spec()
-    inner.add_mesh(name="mesh", file=str(mesh_path.resolve()), inertia=mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX)
+    inner.add_mesh(
+        name="mesh", file=str(mesh_path.resolve()), inertia=mujoco.mjtMeshInertia.mjMESH_INERTIA_CONVEX
+    )
     body = inner.worldbody.add_body(name="mesh_body")
-    body.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname="mesh", density=density, rgba=[0.75, 0.72, 0.68, 1])
+    body.add_geom(
+        type=mujoco.mjtGeom.mjGEOM_MESH, meshname="mesh", density=density, rgba=[0.75, 0.72, 0.68, 1]
+    )
     up = _Y_UP_TO_Z_UP if up_axis == "y" else (1.0, 0.0, 0.0, 0.0)
     key = label.lower().replace(" ", "_")
     default = float(np.mean(size_range(key))) if _known(key) else 0.3
@@ -264,7 +314,17 @@ def load_objaverse(path: str | Path, *, annotations: str | Path | dict | None = 
     tags = _names(ann.get("tags"))
     cats = _names(ann.get("categories"))
     extent = float(np.max(aabb[1] - aabb[0]))
-    desc = "; ".join(x for x in [f"{label} (Objaverse {uid})", f"about {extent * 100:.0f} cm", ann.get("description", ""), ", ".join(tags[:10]), ", ".join(cats)] if x)
+    desc = "; ".join(
+        x
+        for x in [
+            f"{label} (Objaverse {uid})",
+            f"about {extent * 100:.0f} cm",
+            ann.get("description", ""),
+            ", ".join(tags[:10]),
+            ", ".join(cats),
+        ]
+        if x
+    )
     return Asset(
         asset_id=f"objaverse:{uid}",
         name=label,

@@ -117,23 +117,76 @@ class Part:
 
     # ------------------------------------------------------------------ geometry helpers
     def _add(self, kind, size, pos, quat, rgba, density, collide, name) -> Geom:
-        g = Geom(kind, tuple(float(v) for v in size), tuple(float(v) for v in pos), tuple(quat), tuple(rgba), float(density), collide, name)
+        g = Geom(
+            kind,
+            tuple(float(v) for v in size),
+            tuple(float(v) for v in pos),
+            tuple(quat),
+            tuple(rgba),
+            float(density),
+            collide,
+            name,
+        )
         self.geoms.append(g)
         return g
 
-    def box(self, half, pos=(0, 0, 0), rgba=(0.7, 0.7, 0.7, 1), density=700.0, *, quat=(1, 0, 0, 0), collide=True, name=None):
+    def box(
+        self,
+        half,
+        pos=(0, 0, 0),
+        rgba=(0.7, 0.7, 0.7, 1),
+        density=700.0,
+        *,
+        quat=(1, 0, 0, 0),
+        collide=True,
+        name=None,
+    ):
         return self._add("box", half, pos, quat, rgba, density, collide, name)
 
-    def cyl(self, r, hh, pos=(0, 0, 0), rgba=(0.7, 0.7, 0.7, 1), density=700.0, *, axis="z", quat=None, collide=True, name=None):
+    def cyl(
+        self,
+        r,
+        hh,
+        pos=(0, 0, 0),
+        rgba=(0.7, 0.7, 0.7, 1),
+        density=700.0,
+        *,
+        axis="z",
+        quat=None,
+        collide=True,
+        name=None,
+    ):
         return self._add("cylinder", (r, hh), pos, quat or _AXIS_QUAT[axis], rgba, density, collide, name)
 
-    def capsule(self, r, hh, pos=(0, 0, 0), rgba=(0.7, 0.7, 0.7, 1), density=700.0, *, axis="z", quat=None, collide=True, name=None):
+    def capsule(
+        self,
+        r,
+        hh,
+        pos=(0, 0, 0),
+        rgba=(0.7, 0.7, 0.7, 1),
+        density=700.0,
+        *,
+        axis="z",
+        quat=None,
+        collide=True,
+        name=None,
+    ):
         return self._add("capsule", (r, hh), pos, quat or _AXIS_QUAT[axis], rgba, density, collide, name)
 
     def sphere(self, r, pos=(0, 0, 0), rgba=(0.7, 0.7, 0.7, 1), density=700.0, *, collide=True, name=None):
         return self._add("sphere", (r,), pos, (1, 0, 0, 0), rgba, density, collide, name)
 
-    def ellipsoid(self, half, pos=(0, 0, 0), rgba=(0.7, 0.7, 0.7, 1), density=700.0, *, quat=(1, 0, 0, 0), collide=True, name=None):
+    def ellipsoid(
+        self,
+        half,
+        pos=(0, 0, 0),
+        rgba=(0.7, 0.7, 0.7, 1),
+        density=700.0,
+        *,
+        quat=(1, 0, 0, 0),
+        collide=True,
+        name=None,
+    ):
         return self._add("ellipsoid", half, pos, quat, rgba, density, collide, name)
 
     def segment(self, a, b, r, rgba=(0.7, 0.7, 0.7, 1), density=700.0, *, kind="capsule", collide=True):
@@ -149,7 +202,9 @@ class Part:
             quat = axis_angle(axis, math.acos(max(-1.0, min(1.0, d[2] / length))))
         return self._add(kind, (r, length / 2), (a + b) / 2, quat, rgba, density, collide, None)
 
-    def ring(self, r, z0, z1, thick, n=12, rgba=(0.7, 0.7, 0.7, 1), density=700.0, center=(0.0, 0.0), ry=None):
+    def ring(
+        self, r, z0, z1, thick, n=12, rgba=(0.7, 0.7, 0.7, 1), density=700.0, center=(0.0, 0.0), ry=None
+    ):
         """A thin cylindrical (or elliptical) wall of n boxes: hollow containers that can hold things."""
         ry = ry or r
         hz = (z1 - z0) / 2
@@ -164,13 +219,37 @@ class Part:
         self.children.append(p)
         return p
 
-    def hinge(self, name, axis, range, label, closed=None, pos=(0, 0, 0), *, spring=False, hold=False) -> JointDef:
-        self.joint = JointDef(name, "hinge", tuple(axis), (float(range[0]), float(range[1])), label, float(range[0] if closed is None else closed), tuple(pos), spring, hold)
+    def hinge(
+        self, name, axis, range, label, closed=None, pos=(0, 0, 0), *, spring=False, hold=False
+    ) -> JointDef:
+        self.joint = JointDef(
+            name,
+            "hinge",
+            tuple(axis),
+            (float(range[0]), float(range[1])),
+            label,
+            float(range[0] if closed is None else closed),
+            tuple(pos),
+            spring,
+            hold,
+        )
         self.label = self.label or label
         return self.joint
 
-    def slide(self, name, axis, range, label, closed=None, pos=(0, 0, 0), *, spring=False, hold=False) -> JointDef:
-        self.joint = JointDef(name, "slide", tuple(axis), (float(range[0]), float(range[1])), label, float(range[0] if closed is None else closed), tuple(pos), spring, hold)
+    def slide(
+        self, name, axis, range, label, closed=None, pos=(0, 0, 0), *, spring=False, hold=False
+    ) -> JointDef:
+        self.joint = JointDef(
+            name,
+            "slide",
+            tuple(axis),
+            (float(range[0]), float(range[1])),
+            label,
+            float(range[0] if closed is None else closed),
+            tuple(pos),
+            spring,
+            hold,
+        )
         self.label = self.label or label
         return self.joint
 

@@ -40,7 +40,18 @@ def _entries(variants_per_name: int) -> tuple[CatalogueEntry, ...]:
     for name in target_names() + household_names():
         for seed in range(variants_per_name):
             a = generate(name, seed)
-            out.append(CatalogueEntry(a.asset_id, name, a.category, a.description, seed, "target" if name in targets else "household", round(a.size, 4), tuple(properties(name, a.size))))
+            out.append(
+                CatalogueEntry(
+                    a.asset_id,
+                    name,
+                    a.category,
+                    a.description,
+                    seed,
+                    "target" if name in targets else "household",
+                    round(a.size, 4),
+                    tuple(properties(name, a.size)),
+                )
+            )
     return tuple(out)
 
 
@@ -98,7 +109,9 @@ def embeddings(entries: list[CatalogueEntry]) -> np.ndarray:
         return vecs
 
 
-def search(query: str, entries: list[CatalogueEntry], k: int = 5, category: str | None = None) -> list[tuple[CatalogueEntry, float]]:
+def search(
+    query: str, entries: list[CatalogueEntry], k: int = 5, category: str | None = None
+) -> list[tuple[CatalogueEntry, float]]:
     """Top-k entries by cosine similarity; optional filter by category (or group name)."""
     from anomalygen.embedding import embed
 
@@ -110,14 +123,24 @@ def search(query: str, entries: list[CatalogueEntry], k: int = 5, category: str 
     idx = np.arange(len(entries))
     if category is not None:
         want = category.lower()
-        idx = np.array([i for i, e in enumerate(entries) if e.category.lower() == want or e.name.lower() == want], dtype=int)
+        idx = np.array(
+            [i for i, e in enumerate(entries) if e.category.lower() == want or e.name.lower() == want],
+            dtype=int,
+        )
         if len(idx) == 0:
             return []
     order = idx[np.argsort(-sims[idx], kind="stable")][:k]
     return [(entries[i], float(sims[i])) for i in order]
 
 
-def retrieve(query: str, k: int = 5, category: str | None = None, *, variants_per_name: int = 3, distinct_names: bool = True) -> list[tuple[CatalogueEntry, float]]:
+def retrieve(
+    query: str,
+    k: int = 5,
+    category: str | None = None,
+    *,
+    variants_per_name: int = 3,
+    distinct_names: bool = True,
+) -> list[tuple[CatalogueEntry, float]]:
     """Top-k catalogue assets for a text query. With ``distinct_names`` each name appears once (its
     best variant), so "something a toddler could choke on" returns five kinds of thing, not five
     marbles."""

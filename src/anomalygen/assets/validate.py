@@ -55,7 +55,13 @@ def check_rest(asset: Asset) -> ValidationCheck:
     dq = abs(float(np.dot(data.xquat[bid], q0)))
     tilt = 2 * math.acos(min(1.0, dq))
     ok = drift <= MAX_DRIFT and tilt <= MAX_TILT
-    return ValidationCheck(name="rest", passed=ok, value=round(drift, 5), limit=MAX_DRIFT, detail=f"drift {drift * 1000:.1f} mm, tilt {tilt:.3f} rad after {REST_SECONDS:.0f} s")
+    return ValidationCheck(
+        name="rest",
+        passed=ok,
+        value=round(drift, 5),
+        limit=MAX_DRIFT,
+        detail=f"drift {drift * 1000:.1f} mm, tilt {tilt:.3f} rad after {REST_SECONDS:.0f} s",
+    )
 
 
 def _gravity_load(model, data, jid: int) -> float:
@@ -86,6 +92,7 @@ def check_joints(asset: Asset, *, ramp_s: float = 0.5, hold_s: float = 0.25) -> 
     model0 = spec.compile()
     data0 = mujoco.MjData(model0)
     mujoco.mj_forward(model0, data0)
+
     def inertia_of(dof: int) -> float:
         e, out = np.zeros(model0.nv), np.zeros(model0.nv)
         e[dof] = 1.0
@@ -93,7 +100,7 @@ def check_joints(asset: Asset, *, ramp_s: float = 0.5, hold_s: float = 0.25) -> 
         return float(out[dof])
 
     names = ["a_" + j.name for j in asset.joints]
-    for j, name in zip(asset.joints, names):
+    for j, name in zip(asset.joints, names, strict=True):
         jid = mujoco.mj_name2id(model0, mujoco.mjtObj.mjOBJ_JOINT, name)
         dof = model0.jnt_dofadr[jid]
         span = abs(j.range[1] - j.range[0])
@@ -108,12 +115,14 @@ def check_joints(asset: Asset, *, ramp_s: float = 0.5, hold_s: float = 0.25) -> 
     model = spec.compile()
     data = mujoco.MjData(model)
     qadr = [model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n)] for n in names]
-    dadr = [model.jnt_dofadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n)] for n in names]
     for k, j in enumerate(asset.joints):
         data.qpos[qadr[k]] = j.closed_value
         data.ctrl[k] = j.closed_value
     mujoco.mj_forward(model, data)
-    far = [j.range[1] if abs(j.range[1] - j.closed_value) >= abs(j.range[0] - j.closed_value) else j.range[0] for j in asset.joints]
+    far = [
+        j.range[1] if abs(j.range[1] - j.closed_value) >= abs(j.range[0] - j.closed_value) else j.range[0]
+        for j in asset.joints
+    ]
     reached = [[False, False] for _ in asset.joints]
     final = [[None, None] for _ in asset.joints]
     worst_speed = 0.0
@@ -146,9 +155,28 @@ def check_joints(asset: Asset, *, ramp_s: float = 0.5, hold_s: float = 0.25) -> 
     checks = []
     for k, j in enumerate(asset.joints):
         ok = not exploded and all(reached[k])
-        detail = "exploded (NaN)" if exploded == j.name else ("" if ok else f"did not reach {'far end' if not reached[k][0] else 'closed'} ({final[k]})")
-        checks.append(ValidationCheck(name=f"joint:{j.name}", passed=ok, value=round(abs(far[k] - j.closed_value), 4), detail=detail or f"{j.label} {j.type} through {j.range[0]:.3f}..{j.range[1]:.3f}"))
-    checks.append(ValidationCheck(name="joint_speed", passed=exploded is None and worst_speed < 200.0, value=round(worst_speed, 3), limit=200.0, detail="largest joint speed at rest after a move"))
+        detail = (
+            "exploded (NaN)"
+            if exploded == j.name
+            else ("" if ok else f"did not reach {'far end' if not reached[k][0] else 'closed'} ({final[k]})")
+        )
+        checks.append(
+            ValidationCheck(
+                name=f"joint:{j.name}",
+                passed=ok,
+                value=round(abs(far[k] - j.closed_value), 4),
+                detail=detail or f"{j.label} {j.type} through {j.range[0]:.3f}..{j.range[1]:.3f}",
+            )
+        )
+    checks.append(
+        ValidationCheck(
+            name="joint_speed",
+            passed=exploded is None and worst_speed < 200.0,
+            value=round(worst_speed, 3),
+            limit=200.0,
+            detail="largest joint speed at rest after a move",
+        )
+    )
     return checks
 
 
@@ -157,7 +185,12 @@ def check_render(asset: Asset) -> ValidationCheck:
 
     rgb = render_asset(asset, width=96, height=72)
     spread = float(rgb.astype(np.float32).std())
-    return ValidationCheck(name="render", passed=rgb.shape == (72, 96, 3) and spread > 2.0, value=round(spread, 2), detail="thumbnail pixel spread")
+    return ValidationCheck(
+        name="render",
+        passed=rgb.shape == (72, 96, 3) and spread > 2.0,
+        value=round(spread, 2),
+        detail="thumbnail pixel spread",
+    )
 
 
 def validate_asset(asset: Asset, *, render: bool = True) -> ValidationResult:
@@ -165,16 +198,37 @@ def validate_asset(asset: Asset, *, render: bool = True) -> ValidationResult:
     checks: list[ValidationCheck] = []
     try:
         model = asset.spec.copy().compile()
-        checks.append(ValidationCheck(name="compile", passed=True, value=float(model.nbody), detail=f"{model.nbody} bodies, {model.njnt} joints, {model.ngeom} geoms"))
+        checks.append(
+            ValidationCheck(
+                name="compile",
+                passed=True,
+                value=float(model.nbody),
+                detail=f"{model.nbody} bodies, {model.njnt} joints, {model.ngeom} geoms",
+            )
+        )
     except Exception as exc:  # a broken asset is a result, not a crash
         checks.append(ValidationCheck(name="compile", passed=False, detail=str(exc)[:200]))
-        return ValidationResult(ok=False, checks=checks, reason=f"compile: {exc}"[:200], asset_id=asset.asset_id, category=asset.category)
+        return ValidationResult(
+            ok=False,
+            checks=checks,
+            reason=f"compile: {exc}"[:200],
+            asset_id=asset.asset_id,
+            category=asset.category,
+        )
     for fn in (check_rest, check_joints) + ((check_render,) if render else ()):
         try:
             out = fn(asset)
             checks.extend(out if isinstance(out, list) else [out])
         except Exception as exc:
-            checks.append(ValidationCheck(name=fn.__name__.removeprefix("check_"), passed=False, detail=f"{type(exc).__name__}: {exc}"[:200]))
+            checks.append(
+                ValidationCheck(
+                    name=fn.__name__.removeprefix("check_"),
+                    passed=False,
+                    detail=f"{type(exc).__name__}: {exc}"[:200],
+                )
+            )
     failed = [c for c in checks if not c.passed]
     reason = "; ".join(f"{c.name}: {c.detail}" for c in failed)[:300]
-    return ValidationResult(ok=not failed, checks=checks, reason=reason, asset_id=asset.asset_id, category=asset.category)
+    return ValidationResult(
+        ok=not failed, checks=checks, reason=reason, asset_id=asset.asset_id, category=asset.category
+    )

@@ -6,10 +6,25 @@ import math
 
 from anomalygen.assets.core import Cavity, Draft, Surface, register
 from anomalygen.assets.generators.common import (
-    APPLIANCE, BLACK_GLASS, CERAMIC, D_HOLLOW, D_METAL, D_PLASTIC, DARK, FABRIC, GLASS, METAL, PLASTIC, WHITE, WOOD,
-    colour, colour_name, open_box, pick, u,
+    APPLIANCE,
+    BLACK_GLASS,
+    D_HOLLOW,
+    D_METAL,
+    D_PLASTIC,
+    DARK,
+    FABRIC,
+    GLASS,
+    METAL,
+    PLASTIC,
+    WHITE,
+    WOOD,
+    colour,
+    colour_name,
+    open_box,
+    pick,
+    u,
 )
-from anomalygen.assets.generators.parts_lib import drawer, knob, side_door, top_lid
+from anomalygen.assets.generators.parts_lib import knob, side_door, top_lid
 from anomalygen.assets.parts import Part, axis_angle
 
 
@@ -27,7 +42,9 @@ def coffee_machine(rng):
     hx, hy, h = u(rng, 0.1, 0.15), u(rng, 0.14, 0.2), u(rng, 0.3, 0.4)
     c = colour(rng, APPLIANCE + [(0.6, 0.1, 0.1, 1)])
     r.box((hx, hy, 0.02), (0, 0, 0.02), c, D_HOLLOW)  # base
-    r.box((hx, hy * 0.45, h / 2 - 0.02), (0, hy * 0.55, h / 2 + 0.02 - 0.02), c, D_HOLLOW)  # tower at the back
+    r.box(
+        (hx, hy * 0.45, h / 2 - 0.02), (0, hy * 0.55, h / 2 + 0.02 - 0.02), c, D_HOLLOW
+    )  # tower at the back
     r.box((hx, hy * 0.5, 0.04), (0, -hy * 0.2, h - 0.04), c, D_HOLLOW)  # head
     r.cyl(0.012, 0.02, (0, -hy * 0.4, h - 0.1), METAL[1], D_METAL)  # spout
     tray = r.child("drip_tray", (0, -hy + 0.005, 0.045))
@@ -35,8 +52,16 @@ def coffee_machine(rng):
     tray.box((hx * 0.8, hy * 0.4, 0.006), (0, hy * 0.4, 0.006), METAL[0], D_METAL)
     lid = top_lid(r, "lid", hx * 0.8, hy * 0.3, h, DARK, 900)
     lid.pos = (0, hy * 0.95, h)
-    button(r, "power_button", (hx * 0.5, -hy * 0.7 + 0.02, h + 0.004), (0.012, 0.012, 0.004), (0.2, 0.8, 0.3, 1))
-    return Draft(r, {}, [Surface("cup_tray", (0, -hy * 0.4, 0.052), (hx * 0.6, hy * 0.25))], [], [colour_name(c), "hinged water tank lid", "pull-out drip tray", "hot water and steam"])
+    button(
+        r, "power_button", (hx * 0.5, -hy * 0.7 + 0.02, h + 0.004), (0.012, 0.012, 0.004), (0.2, 0.8, 0.3, 1)
+    )
+    return Draft(
+        r,
+        {},
+        [Surface("cup_tray", (0, -hy * 0.4, 0.052), (hx * 0.6, hy * 0.25))],
+        [],
+        [colour_name(c), "hinged water tank lid", "pull-out drip tray", "hot water and steam"],
+    )
 
 
 @register("Dispenser")
@@ -64,7 +89,9 @@ def display(rng):
     scr.hinge("screen_tilt", (1, 0, 0), (-0.35, 0.25), "hinge", 0.0, hold=True)
     scr.box((w, 0.015, hgt), (0, -0.01, hgt * 0.6), c, 600)
     scr.box((w * 0.95, 0.001, hgt * 0.92), (0, -0.026, hgt * 0.6), BLACK_GLASS, 100, collide=False)
-    return Draft(r, {}, [], [], [colour_name(c), "computer monitor", "tilting screen", "top-heavy, can tip over"])
+    return Draft(
+        r, {}, [], [], [colour_name(c), "computer monitor", "tilting screen", "top-heavy, can tip over"]
+    )
 
 
 @register("Printer")
@@ -73,12 +100,18 @@ def printer(rng):
     hx, hy, hz = u(rng, 0.18, 0.24), u(rng, 0.15, 0.2), u(rng, 0.08, 0.14)
     c = colour(rng, APPLIANCE)
     r.box((hx, hy, hz), (0, 0, hz), c, D_HOLLOW)
-    lid = top_lid(r, "scanner_lid", hx, hy, 2 * hz, c, D_HOLLOW, thick=0.015, open_angle=1.3)
+    top_lid(r, "scanner_lid", hx, hy, 2 * hz, c, D_HOLLOW, thick=0.015, open_angle=1.3)
     tray = r.child("output_tray", (0, -hy - 0.002, hz * 0.5))
     tray.hinge("output_tray_hinge", (1, 0, 0), (0, 1.5), "tray", 0.0, spring=True)
     tray.box((hx * 0.7, 0.004, hz * 0.4), (0, -0.004, hz * 0.4), c, D_PLASTIC)
     button(r, "power_button", (hx * 0.7, -hy * 0.8, 2 * hz + 0.02), (0.008, 0.008, 0.003), (0.3, 0.7, 0.3, 1))
-    return Draft(r, {}, [Surface("lid_top", (0, 0, 2 * hz + 0.015), (hx - 0.01, hy - 0.01))], [], [colour_name(c), "scanner lid", "fold-down paper tray"])
+    return Draft(
+        r,
+        {},
+        [Surface("lid_top", (0, 0, 2 * hz + 0.015), (hx - 0.01, hy - 0.01))],
+        [],
+        [colour_name(c), "scanner lid", "fold-down paper tray"],
+    )
 
 
 @register("Toaster")
@@ -95,7 +128,13 @@ def toaster(rng):
     lever.slide("lever_press", (0, 0, -1), (0, hz * 1.0), "lever", 0.0, spring=True)
     lever.box((0.015, 0.012, 0.008), (0.015, 0, 0), DARK, 900)
     knob(r, "knob_0", (hx + 0.002, 0, hz * 0.6), 0.012, DARK, axis=(1, 0, 0))
-    return Draft(r, {"slots": slots}, [], [Cavity("slot", (0, 0, hz * 1.5), (hx * 0.7, 0.01, hz * 0.45), "top")], [colour_name(c), f"{slots * 2} bread slots", "push-down lever", "hot when on"])
+    return Draft(
+        r,
+        {"slots": slots},
+        [],
+        [Cavity("slot", (0, 0, hz * 1.5), (hx * 0.7, 0.01, hz * 0.45), "top")],
+        [colour_name(c), f"{slots * 2} bread slots", "push-down lever", "hot when on"],
+    )
 
 
 @register("Kettle")
@@ -116,7 +155,9 @@ def kettle(rng):
     lid.box((0.012, 0.008, 0.01), (rad * 1.3, 0, 0.018), DARK, 1100)
     button(r, "switch", (-rad - 0.05, 0, h * 0.3 - 0.02), (0.008, 0.006, 0.004), (0.9, 0.4, 0.1, 1))
     cav = [Cavity("inside", (0, 0, h / 2 + 0.02), (rad * 0.65, rad * 0.65, h / 2 - 0.03), "top", "lid_hinge")]
-    return Draft(r, {}, [], cav, [colour_name(c), "hinged lid", "spout and handle", "boiling water, burn risk"])
+    return Draft(
+        r, {}, [], cav, [colour_name(c), "hinged lid", "spout and handle", "boiling water, burn risk"]
+    )
 
 
 @register("KitchenPot")
@@ -137,7 +178,13 @@ def kitchen_pot(rng):
     lid.cyl(rad + 0.004, 0.003, (0, 0, 0.003), GLASS if rng.random() < 0.5 else c, 2500)
     lid.cyl(0.015, 0.01, (0, 0, 0.016), DARK, 1100)
     cav = [Cavity("inside", (0, 0, h / 2 + 0.004), (rad * 0.7, rad * 0.7, h / 2 - 0.01), "top", "lid_lift")]
-    return Draft(r, {"two_handles": two}, [], cav, [colour_name(c), "lid", "two side handles" if two else "long handle", "hot when cooking"])
+    return Draft(
+        r,
+        {"two_handles": two},
+        [],
+        cav,
+        [colour_name(c), "lid", "two side handles" if two else "long handle", "hot when cooking"],
+    )
 
 
 @register("Fan")
@@ -161,11 +208,30 @@ def fan(rng):
     for k in range(n):
         a = 2 * math.pi * k / n
         q = axis_angle((0, 1, 0), a)
-        rot.box((rad * 0.42, 0.004, 0.035), (rad * 0.5 * math.cos(a), -0.01, -rad * 0.5 * math.sin(a)), bc, 900, quat=q)
+        rot.box(
+            (rad * 0.42, 0.004, 0.035),
+            (rad * 0.5 * math.cos(a), -0.01, -rad * 0.5 * math.sin(a)),
+            bc,
+            900,
+            quat=q,
+        )
     for k in range(12):
         a = 2 * math.pi * k / 12
-        head.box((0.003, 0.003, math.pi * (rad + 0.01) / 12), ((rad + 0.01) * math.cos(a), -0.07, 0.05 + (rad + 0.01) * math.sin(a)), (0.85, 0.85, 0.85, 1), 500, quat=axis_angle((0, 1, 0), -a), collide=False)
-    return Draft(r, {"standing": stand, "blades": n}, [], [], [colour_name(c), f"{n} spinning blades", "tilting head", "standing fan" if stand else "desk fan"])
+        head.box(
+            (0.003, 0.003, math.pi * (rad + 0.01) / 12),
+            ((rad + 0.01) * math.cos(a), -0.07, 0.05 + (rad + 0.01) * math.sin(a)),
+            (0.85, 0.85, 0.85, 1),
+            500,
+            quat=axis_angle((0, 1, 0), -a),
+            collide=False,
+        )
+    return Draft(
+        r,
+        {"standing": stand, "blades": n},
+        [],
+        [],
+        [colour_name(c), f"{n} spinning blades", "tilting head", "standing fan" if stand else "desk fan"],
+    )
 
 
 @register("Lamp")
@@ -180,7 +246,14 @@ def lamp(rng):
     a1.capsule(0.009, l1 / 2, (0, 0, l1 / 2), c, 2000)
     a2 = a1.child("upper_arm", (0, 0, l1))
     a2.hinge("upper_arm_joint", (1, 0, 0), (-1.2, 0.6), "arm", 0.0, hold=True)
-    a2.capsule(0.008, l2 / 2, (0, -l2 / 2 * math.sin(1.2), l2 / 2 * math.cos(1.2)), c, 2000, quat=axis_angle((1, 0, 0), 1.2))
+    a2.capsule(
+        0.008,
+        l2 / 2,
+        (0, -l2 / 2 * math.sin(1.2), l2 / 2 * math.cos(1.2)),
+        c,
+        2000,
+        quat=axis_angle((1, 0, 0), 1.2),
+    )
     sh = a2.child("shade", (0, -l2 * math.sin(1.2), l2 * math.cos(1.2)))
     sh.hinge("shade_joint", (1, 0, 0), (-0.8, 0.8), "arm", 0.0, hold=True)
     sh.cyl(0.055, 0.05, (0, 0, -0.04), c, 300)
@@ -200,19 +273,33 @@ def globe(rng):
     r.cyl(0.012, stem / 2, (0, 0, 0.024 + stem / 2), c, 2000)
     cz = 0.024 + stem + rad + 0.01
     ax = (math.sin(tilt), 0, math.cos(tilt))
-    n = 10  # meridian arc, tilted with the axis
-    for k in range(n + 1):
-        a = -math.pi / 2 + math.pi * k / n - 0.6
-        p = (math.sin(tilt + a + 0.6) * (rad + 0.015), 0.0, cz + math.cos(tilt + a + 0.6) * (rad + 0.015))
-        r.box((0.004, 0.006, math.pi * rad / n * 0.6), p, METAL[1], D_METAL, quat=axis_angle((0, 1, 0), tilt + a + 0.6))
+    R = (
+        rad + 0.012
+    )  # meridian half-ring from the north to the south pole on the +x side, tilted with the axis
+    n = 10
+    pts = [
+        (R * math.sin(tilt + math.pi * k / n), 0.0, cz + R * math.cos(tilt + math.pi * k / n))
+        for k in range(n + 1)
+    ]
+    for p0, p1 in zip(pts, pts[1:], strict=False):
+        r.segment(p0, p1, 0.004, METAL[1], D_METAL)
+    r.segment((0, 0, 0.024 + stem), pts[-1], 0.006, METAL[1], D_METAL)
     g = r.child("sphere", (0, 0, cz))
     g.hinge("spin", ax, (0, 2 * math.pi), "spin", 0.0)
     g.sphere(rad, (0, 0, 0), (0.25, 0.5, 0.85, 1), 200)
     for k in range(4):  # continents
         d = (math.cos(k * 1.7), math.sin(k * 1.7), 0.3 * (k - 1.5))
         nrm = math.sqrt(sum(v * v for v in d))
-        g.ellipsoid((rad * 0.35, rad * 0.25, rad * 0.1), tuple(rad * 0.93 * v / nrm for v in d), (0.3, 0.65, 0.3, 1), 100, collide=False,
-                    quat=axis_angle((-d[1], d[0], 0), math.acos(max(-1, min(1, d[2] / nrm))) + 1e-6) if abs(d[0]) + abs(d[1]) > 1e-6 else (1, 0, 0, 0))
+        g.ellipsoid(
+            (rad * 0.35, rad * 0.25, rad * 0.1),
+            tuple(rad * 0.93 * v / nrm for v in d),
+            (0.3, 0.65, 0.3, 1),
+            100,
+            collide=False,
+            quat=axis_angle((-d[1], d[0], 0), math.acos(max(-1, min(1, d[2] / nrm))) + 1e-6)
+            if abs(d[0]) + abs(d[1]) > 1e-6
+            else (1, 0, 0, 0),
+        )
     return Draft(r, {}, [], [], [colour_name(c), "spinning world map sphere on a stand"])
 
 
@@ -227,7 +314,14 @@ def clock(rng):
     r.cyl(rad * 0.9, 0.001, (0, -depth / 2 - 0.001, cz), WHITE, 100, axis="y", collide=False)
     for k in range(12):
         a = 2 * math.pi * k / 12
-        r.box((0.003, 0.001, 0.01), (rad * 0.8 * math.sin(a), -depth / 2 - 0.002, cz + rad * 0.8 * math.cos(a)), DARK, 100, quat=axis_angle((0, 1, 0), a), collide=False)
+        r.box(
+            (0.003, 0.001, 0.01),
+            (rad * 0.8 * math.sin(a), -depth / 2 - 0.002, cz + rad * 0.8 * math.cos(a)),
+            DARK,
+            100,
+            quat=axis_angle((0, 1, 0), a),
+            collide=False,
+        )
     for name, length, wid in (("hour_hand", 0.5, 0.006), ("minute_hand", 0.8, 0.004)):
         hnd = r.child(name, (0, -depth / 2 - 0.004 - (0.002 if name == "minute_hand" else 0), cz))
         hnd.hinge(f"{name}_joint", (0, -1, 0), (0, 2 * math.pi), "hand", 0.0)
@@ -245,11 +339,15 @@ def bucket(rng):
     hd = r.child("handle", (0, 0, h * 0.92))
     hd.hinge("handle_hinge", (1, 0, 0), (0, 1.55), "handle", 0.0)
     n = 8
-    pts = [(rad * math.cos(math.pi * k / n), rad * 0.9 * math.sin(math.pi * k / n), 0.02) for k in range(n + 1)]
-    for a, b in zip(pts, pts[1:]):
+    pts = [
+        (rad * math.cos(math.pi * k / n), rad * 0.9 * math.sin(math.pi * k / n), 0.02) for k in range(n + 1)
+    ]
+    for a, b in zip(pts, pts[1:], strict=False):
         hd.segment(a, b, 0.004, METAL[1], D_METAL)
     cav = [Cavity("inside", (0, 0, h / 2), (rad * 0.65, rad * 0.65, h / 2 - 0.01), "top")]
-    return Draft(r, {}, [], cav, [colour_name(c), "swing handle", "open top, holds water: a toddler can drown in it"])
+    return Draft(
+        r, {}, [], cav, [colour_name(c), "swing handle", "open top, holds water: a toddler can drown in it"]
+    )
 
 
 @register("Box")
@@ -271,7 +369,13 @@ def box(rng):
         joint = "lid_hinge"
         feats = [colour_name(c), "hinged lid"]
     cav = [Cavity("inside", (0, 0, hz + t / 2), (hx - 1.5 * t, hy - 1.5 * t, hz - t), "top", joint)]
-    return Draft(r, {"cardboard": cardboard}, [Surface("top", (0, 0, 2 * hz + t), (hx - 0.01, hy - 0.01))], cav, feats + ["storage box, can be closed"])
+    return Draft(
+        r,
+        {"cardboard": cardboard},
+        [Surface("top", (0, 0, 2 * hz + t), (hx - 0.01, hy - 0.01))],
+        cav,
+        feats + ["storage box, can be closed"],
+    )
 
 
 @register("Suitcase")
@@ -291,14 +395,18 @@ def suitcase(rng):
     for s in (-1, 1):
         r.cyl(0.02, 0.01, (s * (hx - 0.03), hy - 0.03, 0.02), DARK, 1200, axis="x")
     cav = [Cavity("inside", (0, 0.02, hz), (hx - 1.5 * t, hy - 0.03 - t, hz - 1.5 * t), "front", "lid_hinge")]
-    return Draft(r, {}, [], cav, [colour_name(c), "zip-around lid", "telescoping handle", "trip hazard in a hallway"])
+    return Draft(
+        r, {}, [], cav, [colour_name(c), "zip-around lid", "telescoping handle", "trip hazard in a hallway"]
+    )
 
 
 @register("Bottle")
 def bottle(rng):
     r = Part("root")
     rad, h = u(rng, 0.03, 0.045), u(rng, 0.18, 0.28)
-    c = colour(rng, [GLASS, (0.2, 0.5, 0.25, 0.7), (0.45, 0.25, 0.1, 0.75), (0.6, 0.8, 0.95, 0.6)] + PLASTIC[:2])
+    c = colour(
+        rng, [GLASS, (0.2, 0.5, 0.25, 0.7), (0.45, 0.25, 0.1, 0.75), (0.6, 0.8, 0.95, 0.6)] + PLASTIC[:2]
+    )
     r.cyl(rad, h * 0.35, (0, 0, h * 0.35), c, 800)
     r.cyl(rad * 0.7, h * 0.06, (0, 0, h * 0.76), c, 800)
     r.cyl(rad * 0.38, h * 0.1, (0, 0, h * 0.9), c, 800)

@@ -10,8 +10,23 @@ import math
 
 from anomalygen.assets.core import Cavity, Draft, Surface, register
 from anomalygen.assets.generators.common import (
-    APPLIANCE, BLACK_GLASS, D_HOLLOW, D_METAL, D_PLASTIC, D_WOOD, DARK, FABRIC, GLASS, METAL, PLASTIC, WHITE, WOOD,
-    colour, colour_name, open_box, pick, u,
+    APPLIANCE,
+    BLACK_GLASS,
+    D_HOLLOW,
+    D_METAL,
+    D_WOOD,
+    DARK,
+    FABRIC,
+    GLASS,
+    METAL,
+    PLASTIC,
+    WHITE,
+    WOOD,
+    colour,
+    colour_name,
+    open_box,
+    pick,
+    u,
 )
 from anomalygen.assets.generators.parts_lib import drawer, drop_door, knob, side_door, top_lid
 from anomalygen.assets.parts import Part
@@ -33,13 +48,32 @@ def _cells(r: Part, hx, hy, z0, z1, cols: int, rows: int, t: float, rgba, densit
             xa, xb = -hx + 2 * hx * j / cols, -hx + 2 * hx * (j + 1) / cols
             name = f"{prefix}{kind}_{i}_{j}"
             if kind == "drawer":
-                _, cav = drawer(r, name, xa + 0.003, xb - 0.003, za + 0.003, zb - 0.003, -hy, 2 * hy - 2 * t, rgba, density)
+                _, cav = drawer(
+                    r,
+                    name,
+                    xa + 0.003,
+                    xb - 0.003,
+                    za + 0.003,
+                    zb - 0.003,
+                    -hy,
+                    2 * hy - 2 * t,
+                    rgba,
+                    density,
+                )
                 cavities.append(cav)
                 n_drawers += 1
             else:
                 left = (j % 2 == 0) if cols > 1 else bool(rng.random() < 0.5)
                 side_door(r, name, xa + 0.003, xb - 0.003, za + 0.003, zb - 0.003, -hy, left, rgba, density)
-                cavities.append(Cavity(f"{name}_space", ((xa + xb) / 2, 0, (za + zb) / 2 + t / 2), ((xb - xa) / 2 - t, hy - 1.5 * t, row_h / 2 - t), "front", f"{name}_hinge"))
+                cavities.append(
+                    Cavity(
+                        f"{name}_space",
+                        ((xa + xb) / 2, 0, (za + zb) / 2 + t / 2),
+                        ((xb - xa) / 2 - t, hy - 1.5 * t, row_h / 2 - t),
+                        "front",
+                        f"{name}_hinge",
+                    )
+                )
                 n_doors += 1
     feats = []
     if n_doors:
@@ -61,9 +95,17 @@ def storage_furniture(rng):
     h = u(rng, 0.3, 0.45) * rows + 0.08
     c = colour(rng, WOOD + [WHITE, (0.35, 0.4, 0.5, 1)])
     open_box(r, hx, hy, h / 2, t, c, D_WOOD, top=True, front=False)
-    r.box((hx - 0.01, hy - 0.01, 0.04), (0, 0.005, 0.04), (c[0] * 0.7, c[1] * 0.7, c[2] * 0.7, 1), D_WOOD)  # plinth
+    r.box(
+        (hx - 0.01, hy - 0.01, 0.04), (0, 0.005, 0.04), (c[0] * 0.7, c[1] * 0.7, c[2] * 0.7, 1), D_WOOD
+    )  # plinth
     cavities, feats = _cells(r, hx - t, hy, 0.08 + 0.004, h - t, cols, rows, t, c, D_WOOD, rng)
-    return Draft(r, {"cols": cols, "rows": rows}, [Surface("top", (0, 0, h), (hx - 0.01, hy - 0.01))], cavities, feats + [colour_name(c), "cabinet"])
+    return Draft(
+        r,
+        {"cols": cols, "rows": rows},
+        [Surface("top", (0, 0, h), (hx - 0.01, hy - 0.01))],
+        cavities,
+        feats + [colour_name(c), "cabinet"],
+    )
 
 
 @register("Refrigerator")
@@ -78,13 +120,35 @@ def refrigerator(rng):
     surfaces, cavities = [], []
     if layout == "bottom_drawer":
         r.box((hx - t, hy - t, t / 2), (0, 0, freezer_h), c, D_HOLLOW)
-        _, cav = drawer(r, "freezer", -hx + 0.004, hx - 0.004, 0.004, freezer_h - 0.004, -hy, 2 * hy - 2 * t, c, D_HOLLOW)
+        _, cav = drawer(
+            r, "freezer", -hx + 0.004, hx - 0.004, 0.004, freezer_h - 0.004, -hy, 2 * hy - 2 * t, c, D_HOLLOW
+        )
         cavities.append(Cavity("freezer", cav.center, cav.half_extents, "top", cav.joint))
         z_main0, z_main1 = freezer_h, h
     else:
         r.box((hx - t, hy - t, t / 2), (0, 0, h - freezer_h), c, D_HOLLOW)
-        side_door(r, "freezer_door", -hx + 0.004, hx - 0.004, h - freezer_h + 0.004, h - 0.004, -hy, False, c, D_HOLLOW, thick=0.05)
-        cavities.append(Cavity("freezer", (0, 0, h - freezer_h / 2), (hx - 1.5 * t, hy - 1.5 * t, freezer_h / 2 - t), "front", "freezer_door_hinge"))
+        side_door(
+            r,
+            "freezer_door",
+            -hx + 0.004,
+            hx - 0.004,
+            h - freezer_h + 0.004,
+            h - 0.004,
+            -hy,
+            False,
+            c,
+            D_HOLLOW,
+            thick=0.05,
+        )
+        cavities.append(
+            Cavity(
+                "freezer",
+                (0, 0, h - freezer_h / 2),
+                (hx - 1.5 * t, hy - 1.5 * t, freezer_h / 2 - t),
+                "front",
+                "freezer_door_hinge",
+            )
+        )
         z_main0, z_main1 = 0.0, h - freezer_h
     n_shelves = int(rng.integers(2, 4))
     for k in range(n_shelves):
@@ -93,14 +157,64 @@ def refrigerator(rng):
         surfaces.append(Surface(f"shelf_{k}", (0, 0.01, z + 0.005), (hx - t - 0.01, hy - t - 0.02)))
     main_joint = "door_hinge"
     if two:
-        side_door(r, "door_left", -hx + 0.004, -0.003, z_main0 + 0.004, z_main1 - 0.004, -hy, True, c, D_HOLLOW, thick=0.05)
-        side_door(r, "door_right", 0.003, hx - 0.004, z_main0 + 0.004, z_main1 - 0.004, -hy, False, c, D_HOLLOW, thick=0.05)
+        side_door(
+            r,
+            "door_left",
+            -hx + 0.004,
+            -0.003,
+            z_main0 + 0.004,
+            z_main1 - 0.004,
+            -hy,
+            True,
+            c,
+            D_HOLLOW,
+            thick=0.05,
+        )
+        side_door(
+            r,
+            "door_right",
+            0.003,
+            hx - 0.004,
+            z_main0 + 0.004,
+            z_main1 - 0.004,
+            -hy,
+            False,
+            c,
+            D_HOLLOW,
+            thick=0.05,
+        )
         main_joint = "door_left_hinge"
     else:
-        side_door(r, "door", -hx + 0.004, hx - 0.004, z_main0 + 0.004, z_main1 - 0.004, -hy, bool(rng.random() < 0.5), c, D_HOLLOW, thick=0.05)
-    cavities.insert(0, Cavity("fridge", (0, 0, (z_main0 + z_main1) / 2), (hx - 1.5 * t, hy - 1.5 * t, (z_main1 - z_main0) / 2 - t), "front", main_joint))
+        side_door(
+            r,
+            "door",
+            -hx + 0.004,
+            hx - 0.004,
+            z_main0 + 0.004,
+            z_main1 - 0.004,
+            -hy,
+            bool(rng.random() < 0.5),
+            c,
+            D_HOLLOW,
+            thick=0.05,
+        )
+    cavities.insert(
+        0,
+        Cavity(
+            "fridge",
+            (0, 0, (z_main0 + z_main1) / 2),
+            (hx - 1.5 * t, hy - 1.5 * t, (z_main1 - z_main0) / 2 - t),
+            "front",
+            main_joint,
+        ),
+    )
     surfaces.append(Surface("top", (0, 0, h), (hx - 0.01, hy - 0.01)))
-    feats = [colour_name(c), "two doors" if two else "one door", f"freezer {'drawer at the bottom' if layout == 'bottom_drawer' else 'door on top'}", "keeps food cold"]
+    feats = [
+        colour_name(c),
+        "two doors" if two else "one door",
+        f"freezer {'drawer at the bottom' if layout == 'bottom_drawer' else 'door on top'}",
+        "keeps food cold",
+    ]
     return Draft(r, {"layout": layout, "two_doors": two}, surfaces, cavities, feats)
 
 
@@ -117,16 +231,42 @@ def oven(rng):
     panel = 0.1
     r.box((hx, 0.02, panel / 2), (0, -hy - 0.02, h - panel / 2), c, D_HOLLOW)  # control panel
     r.box((hx - t, hy - t, 0.005), (0, 0, h * 0.35), METAL[1], D_METAL)  # rack
-    drop_door(r, "door", -hx + 0.004, hx - 0.004, 0.06, h - panel - 0.004, -hy, c, D_HOLLOW, window=BLACK_GLASS)
+    drop_door(
+        r, "door", -hx + 0.004, hx - 0.004, 0.06, h - panel - 0.004, -hy, c, D_HOLLOW, window=BLACK_GLASS
+    )
     n = int(rng.integers(2, 6))
     for k in range(n):
         x = -hx * 0.8 + 1.6 * hx * (k + 0.5) / n
         knob(r, f"knob_{k}", (x, -hy - 0.04, h - panel / 2), 0.018, DARK)
-    surfaces = [Surface("cooktop", (0, 0, h), (hx - 0.01, hy - 0.01)), Surface("rack", (0, 0, h * 0.35 + 0.005), (hx - t - 0.01, hy - t - 0.01))]
-    cav = [Cavity("oven", (0, 0, (0.06 + h - panel) / 2), (hx - 1.5 * t, hy - 1.5 * t, (h - panel - 0.06) / 2 - t), "front", "door_hinge")]
+    surfaces = [
+        Surface("cooktop", (0, 0, h), (hx - 0.01, hy - 0.01)),
+        Surface("rack", (0, 0, h * 0.35 + 0.005), (hx - t - 0.01, hy - t - 0.01)),
+    ]
+    cav = [
+        Cavity(
+            "oven",
+            (0, 0, (0.06 + h - panel) / 2),
+            (hx - 1.5 * t, hy - 1.5 * t, (h - panel - 0.06) / 2 - t),
+            "front",
+            "door_hinge",
+        )
+    ]
     for k in range(4):  # burners on the cooktop
-        r.cyl(0.06, 0.003, ((-1) ** k * hx * 0.45, (-1) ** (k // 2) * hy * 0.45, h + 0.003), DARK, D_METAL, collide=False)
-    return Draft(r, {"knobs": n}, surfaces, cav, [colour_name(c), "drop-down door with a window", f"{n} control knobs", "hot inside when on"])
+        r.cyl(
+            0.06,
+            0.003,
+            ((-1) ** k * hx * 0.45, (-1) ** (k // 2) * hy * 0.45, h + 0.003),
+            DARK,
+            D_METAL,
+            collide=False,
+        )
+    return Draft(
+        r,
+        {"knobs": n},
+        surfaces,
+        cav,
+        [colour_name(c), "drop-down door with a window", f"{n} control knobs", "hot inside when on"],
+    )
 
 
 @register("Dishwasher")
@@ -135,7 +275,9 @@ def dishwasher(rng):
     hx, hy, h, t = u(rng, 0.29, 0.31), u(rng, 0.28, 0.31), u(rng, 0.8, 0.86), 0.03
     c = colour(rng, APPLIANCE)
     _appliance_shell(r, hx, hy, h, t, c)
-    drop_door(r, "door", -hx + 0.004, hx - 0.004, 0.08, h - 0.004, -hy, c, D_HOLLOW, handle=rng.random() < 0.7)
+    drop_door(
+        r, "door", -hx + 0.004, hx - 0.004, 0.08, h - 0.004, -hy, c, D_HOLLOW, handle=rng.random() < 0.7
+    )
     rack = r.child("rack", (0, 0, h * 0.25))
     depth = 2 * hy - 2 * t - 0.04
     rack.slide("rack_slide", (0, -1, 0), (0, depth * 0.8), "rack", 0.0)
@@ -145,9 +287,19 @@ def dishwasher(rng):
         rack.box((rw, 0.004, 0.05), (0, s * depth / 2, 0.05), METAL[0], D_METAL)
     for k in range(5):
         rack.box((rw, 0.003, 0.003), (0, -depth / 2 + depth * (k + 0.5) / 5, 0.003), METAL[0], D_METAL)
-    cav = [Cavity("tub", (0, 0, h / 2 + 0.04), (hx - 1.5 * t, hy - 1.5 * t, h / 2 - 0.04 - t), "front", "door_hinge"),
-           Cavity("rack", (0, 0, h * 0.25 + 0.06), (rw - 0.01, depth / 2 - 0.01, 0.05), "top", "rack_slide")]
-    return Draft(r, {}, [Surface("top", (0, 0, h), (hx - 0.01, hy - 0.01))], cav, [colour_name(c), "drop-down door", "pull-out dish rack"])
+    cav = [
+        Cavity(
+            "tub", (0, 0, h / 2 + 0.04), (hx - 1.5 * t, hy - 1.5 * t, h / 2 - 0.04 - t), "front", "door_hinge"
+        ),
+        Cavity("rack", (0, 0, h * 0.25 + 0.06), (rw - 0.01, depth / 2 - 0.01, 0.05), "top", "rack_slide"),
+    ]
+    return Draft(
+        r,
+        {},
+        [Surface("top", (0, 0, h), (hx - 0.01, hy - 0.01))],
+        cav,
+        [colour_name(c), "drop-down door", "pull-out dish rack"],
+    )
 
 
 @register("Microwave")
@@ -158,13 +310,46 @@ def microwave(rng):
     _appliance_shell(r, hx, hy, hz, t, c)
     pw = hx * 0.5
     r.box((pw / 2, 0.01, hz - 0.004), (hx - pw / 2, -hy - 0.01, hz), c, D_HOLLOW)  # control panel
-    side_door(r, "door", -hx + 0.004, hx - pw - 0.004, 0.004, 2 * hz - 0.004, -hy, True, c, D_HOLLOW, thick=0.025, handle=False)
-    r.children[-1].box(((hx * 2 - pw) / 2 * 0.7, 0.001, hz * 0.6), ((2 * hx - pw) / 2, -0.026, 0), BLACK_GLASS, 100, collide=False)
+    side_door(
+        r,
+        "door",
+        -hx + 0.004,
+        hx - pw - 0.004,
+        0.004,
+        2 * hz - 0.004,
+        -hy,
+        True,
+        c,
+        D_HOLLOW,
+        thick=0.025,
+        handle=False,
+    )
+    r.children[-1].box(
+        ((hx * 2 - pw) / 2 * 0.7, 0.001, hz * 0.6),
+        ((2 * hx - pw) / 2, -0.026, 0),
+        BLACK_GLASS,
+        100,
+        collide=False,
+    )
     r.children[-1].box((0.01, 0.01, hz * 0.5), (2 * hx - pw - 0.03, -0.035, 0), DARK, 900)
     knob(r, "knob_0", (hx - pw / 2, -hy - 0.02, hz * 1.3), 0.015, DARK)
     r.cyl(hx * 0.4, 0.004, (-pw / 2, 0, t + 0.005), GLASS, 2500)
-    cav = [Cavity("inside", (-pw / 2, 0, hz), (hx - pw / 2 - 1.5 * t, hy - 1.5 * t, hz - 1.5 * t), "front", "door_hinge")]
-    return Draft(r, {}, [Surface("top", (0, 0, 2 * hz), (hx - 0.01, hy - 0.01))], cav, [colour_name(c), "side-hinged door", "turntable"])
+    cav = [
+        Cavity(
+            "inside",
+            (-pw / 2, 0, hz),
+            (hx - pw / 2 - 1.5 * t, hy - 1.5 * t, hz - 1.5 * t),
+            "front",
+            "door_hinge",
+        )
+    ]
+    return Draft(
+        r,
+        {},
+        [Surface("top", (0, 0, 2 * hz), (hx - 0.01, hy - 0.01))],
+        cav,
+        [colour_name(c), "side-hinged door", "turntable"],
+    )
 
 
 @register("WashingMachine")
@@ -181,13 +366,32 @@ def washing_machine(rng):
         feats = ["top-loading lid"]
     else:
         _appliance_shell(r, hx, hy, h, t, c)
-        d = side_door(r, "door", -hx * 0.6, hx * 0.6, h * 0.2, h * 0.75, -hy, True, c, D_HOLLOW, thick=0.03, handle=False)
+        d = side_door(
+            r,
+            "door",
+            -hx * 0.6,
+            hx * 0.6,
+            h * 0.2,
+            h * 0.75,
+            -hy,
+            True,
+            c,
+            D_HOLLOW,
+            thick=0.03,
+            handle=False,
+        )
         d.cyl(hx * 0.45, 0.005, (hx * 0.6, -0.035, 0), GLASS, 2500, axis="y", collide=False)
         d.cyl(hx * 0.55, 0.012, (hx * 0.6, -0.02, 0), WHITE, D_HOLLOW, axis="y")
         cav.append(Cavity("drum", (0, 0, h * 0.48), (hx * 0.6, hy * 0.7, h * 0.25), "front", "door_hinge"))
         feats = ["round front door"]
     knob(r, "knob_0", (hx * 0.6, -hy - 0.005, h * 0.9), 0.03, DARK)
-    return Draft(r, {"top_loader": top_loader}, [Surface("top", (0, 0, h), (hx - 0.01, hy - 0.01))] if not top_loader else [], cav, [colour_name(c)] + feats)
+    return Draft(
+        r,
+        {"top_loader": top_loader},
+        [Surface("top", (0, 0, h), (hx - 0.01, hy - 0.01))] if not top_loader else [],
+        cav,
+        [colour_name(c)] + feats,
+    )
 
 
 @register("Safe")
@@ -199,7 +403,13 @@ def safe(rng):
     d = side_door(r, "door", -hx + 0.004, hx - 0.004, 0.004, 2 * hz - 0.004, -hy, True, c, 2000, thick=0.04)
     knob(d, "dial", (hx, -0.04, hz * 0.3), min(hx, hz) * 0.2, METAL[0], label="dial")
     cav = [Cavity("inside", (0, 0, hz), (hx - 1.5 * t, hy - 1.5 * t, hz - 1.5 * t), "front", "door_hinge")]
-    return Draft(r, {}, [Surface("top", (0, 0, 2 * hz), (hx - 0.01, hy - 0.01))], cav, [colour_name(c), "heavy steel door", "combination dial", "locks away valuables and medicine"])
+    return Draft(
+        r,
+        {},
+        [Surface("top", (0, 0, 2 * hz), (hx - 0.01, hy - 0.01))],
+        cav,
+        [colour_name(c), "heavy steel door", "combination dial", "locks away valuables and medicine"],
+    )
 
 
 @register("Door")
@@ -214,7 +424,21 @@ def door(rng):
         r.box((fw / 2, 0.06, h / 2), (s * (w / 2 + fw / 2), 0, h / 2 + 0.01), fc, D_WOOD)
     r.box((w / 2 + fw, 0.06, fw / 2), (0, 0, h + 0.01 + fw / 2), fc, D_WOOD)
     left = bool(rng.random() < 0.5)
-    d = side_door(r, "door", -w / 2 + 0.004, w / 2 - 0.004, 0.02, h, t / 2 + 0.002, left, c, D_WOOD, thick=t, handle=False, open_angle=1.75)
+    d = side_door(
+        r,
+        "door",
+        -w / 2 + 0.004,
+        w / 2 - 0.004,
+        0.02,
+        h,
+        t / 2 + 0.002,
+        left,
+        c,
+        D_WOOD,
+        thick=t,
+        handle=False,
+        open_angle=1.75,
+    )
     sx = 1 if left else -1
     d.segment((sx * (w - 0.08), -t - 0.04, 0), (sx * (w - 0.2), -t - 0.04, 0), 0.01, METAL[0], D_METAL)
     d.segment((sx * (w - 0.08), -t, 0), (sx * (w - 0.08), -t - 0.04, 0), 0.008, METAL[0], D_METAL)
@@ -252,7 +476,13 @@ def window(rng):
             s.box((w / 2 - 0.004, 0.016, 0.02), (w / 2, 0, sz * (h / 2 - 0.02)), fc, D_WOOD)
         s.box((0.01, 0.02, 0.05), (w - 0.04, -0.03, 0), METAL[0], D_METAL)
         feats = ["hinged casement sash"]
-    return Draft(r, {"sliding": sliding}, [Surface("sill", (0, -0.1, 0.04), (w / 2, 0.08))], [], feats + ["glass panes", "open window lets air in, fall risk"])
+    return Draft(
+        r,
+        {"sliding": sliding},
+        [Surface("sill", (0, -0.1, 0.04), (w / 2, 0.08))],
+        [],
+        feats + ["glass panes", "open window lets air in, fall risk"],
+    )
 
 
 @register("Table")
@@ -273,7 +503,9 @@ def table(rng):
     r.box((hx - 0.07, 0.01, 0.04), (0, -hy + 0.05, h - t - 0.04), c, D_WOOD)
     cav, feats = [], [colour_name(c), f"{leg} legs"]
     if rng.random() < 0.4:
-        _, cv = drawer(r, "drawer", -0.2, 0.2, h - t - 0.1, h - t - 0.005, -hy + 0.04, 2 * hy - 0.2, c, D_WOOD)
+        _, cv = drawer(
+            r, "drawer", -0.2, 0.2, h - t - 0.1, h - t - 0.005, -hy + 0.04, 2 * hy - 0.2, c, D_WOOD
+        )
         cav.append(cv)
         feats.append("drawer under the top")
     return Draft(r, {"legs": leg}, [Surface("top", (0, 0, h), (hx - 0.02, hy - 0.02))], cav, feats)
@@ -300,8 +532,20 @@ def chair(rng):
     back = r.child("backrest", (0, hd - 0.02, seat_h))
     back.hinge("backrest_hinge", (1, 0, 0), (0, 1.3), "backrest", 0.0)
     tilt = 0.12
-    back.box((hw - 0.01, 0.015, back_h / 2), (0, 0.015 + back_h / 2 * math.sin(tilt), back_h / 2 + 0.01), c, D_WOOD, quat=(math.cos(tilt / 2), math.sin(tilt / 2), 0, 0))
-    return Draft(r, {"back_height": back_h}, [Surface("seat", (0, -0.02, seat_h), (hw - 0.02, hd - 0.04))], [], [colour_name(c), "folding backrest", "children climb on it to reach high places"])
+    back.box(
+        (hw - 0.01, 0.015, back_h / 2),
+        (0, 0.015 + back_h / 2 * math.sin(tilt), back_h / 2 + 0.01),
+        c,
+        D_WOOD,
+        quat=(math.cos(tilt / 2), math.sin(tilt / 2), 0, 0),
+    )
+    return Draft(
+        r,
+        {"back_height": back_h},
+        [Surface("seat", (0, -0.02, seat_h), (hw - 0.02, hd - 0.04))],
+        [],
+        [colour_name(c), "folding backrest", "children climb on it to reach high places"],
+    )
 
 
 @register("FoldingChair")
@@ -318,7 +562,13 @@ def folding_chair(rng):
     seat = r.child("seat", (0, hd - 0.01, seat_h - 0.015))
     seat.hinge("seat_hinge", (1, 0, 0), (-1.5, 0), "seat", 0.0)
     seat.box((hw - 0.02, hd - 0.01, 0.012), (0, -hd + 0.01, 0.012), c, 700)
-    return Draft(r, {}, [Surface("seat", (0, 0, seat_h + 0.01), (hw - 0.03, hd - 0.03))], [], [colour_name(c), "folding seat", "scissor metal frame", "can pinch fingers when folded"])
+    return Draft(
+        r,
+        {},
+        [Surface("seat", (0, 0, seat_h + 0.01), (hw - 0.03, hd - 0.03))],
+        [],
+        [colour_name(c), "folding seat", "scissor metal frame", "can pinch fingers when folded"],
+    )
 
 
 @register("Toilet")
@@ -337,12 +587,24 @@ def toilet(rng):
     lid.ellipsoid((bw * 0.95, bd * 0.92, 0.01), (0, -bd * 0.92, 0), c, 900)
     seat = r.child("seat", (0, bd - 0.05, bh + 0.008))
     seat.hinge("seat_hinge", (1, 0, 0), (-1.65, 0), "seat", 0.0)
-    n = 12
+    n = 16
     for i in range(n):
         a = 2 * math.pi * i / n
-        seat.box((0.018, 0.035, 0.007), (bw * 0.8 * math.cos(a), -bd * 0.92 + bd * 0.8 * math.sin(a), 0), c, 900, quat=(math.cos(a / 2), 0, 0, math.sin(a / 2)))
+        seat.box(
+            (0.02, 0.032, 0.007),
+            (bw * 0.8 * math.cos(a), -bd * 0.92 + bd * 0.8 * math.sin(a), 0),
+            c,
+            900,
+            quat=(math.cos(a / 2), 0, 0, math.sin(a / 2)),
+        )
     cav = [Cavity("bowl", (0, -0.02, bh - 0.08), (bw * 0.5, bd * 0.5, 0.07), "top", "lid_hinge")]
-    return Draft(r, {}, [Surface("tank_top", (0, bd + 0.05, bh + 0.342), (tank_w - 0.01, 0.08))], cav, ["white porcelain", "hinged lid and seat", "bowl of water, drowning risk for toddlers"])
+    return Draft(
+        r,
+        {},
+        [Surface("tank_top", (0, bd + 0.05, bh + 0.342), (tank_w - 0.01, 0.08))],
+        cav,
+        ["white porcelain", "hinged lid and seat", "bowl of water, drowning risk for toddlers"],
+    )
 
 
 @register("TrashCan")
@@ -362,7 +624,9 @@ def trash_can(rng):
         p.hinge("pedal_hinge", (1, 0, 0), (0, 0.35), "pedal", 0.0, spring=True)
         p.box((rad * 0.35, 0.04, 0.006), (0, -0.04, 0), DARK, 1500)
         feats.append("foot pedal")
-    cav = [Cavity("inside", (0, 0, h / 2 + 0.006), (rad * 0.68, rad * 0.68, h / 2 - 0.02), "top", "lid_hinge")]
+    cav = [
+        Cavity("inside", (0, 0, h / 2 + 0.006), (rad * 0.68, rad * 0.68, h / 2 - 0.02), "top", "lid_hinge")
+    ]
     return Draft(r, {"pedal": pedal}, [], cav, feats + ["for rubbish and spoiled food"])
 
 
@@ -381,7 +645,13 @@ def cart(rng):
         surfaces.append(Surface(f"shelf_{k}", (0, 0, z + 0.01), (hx - 0.02, hy - 0.02)))
     for sx in (-1, 1):
         for sy in (-1, 1):
-            r.cyl(0.012, (h - base) / 2, (sx * (hx - 0.015), sy * (hy - 0.015), base + (h - base) / 2), METAL[1], D_METAL)
+            r.cyl(
+                0.012,
+                (h - base) / 2,
+                (sx * (hx - 0.015), sy * (hy - 0.015), base + (h - base) / 2),
+                METAL[1],
+                D_METAL,
+            )
             r.box((0.012, 0.012, 0.012), (sx * (hx - 0.05), sy * (hy - 0.05), base - 0.02), METAL[1], D_METAL)
     r.segment((hx, -hy * 0.8, h + 0.02), (hx, hy * 0.8, h + 0.02), 0.012, DARK, 1000)
     for s in (-1, 1):
@@ -393,6 +663,18 @@ def cart(rng):
             w.hinge(f"wheel_{k}_joint", (0, 1, 0), (-math.pi, math.pi), "wheel", 0.0)
             w.cyl(wr, 0.012, (0, 0, 0), DARK, 1200, axis="y")
             w.box((0.01, 0.005, 0.01), (0, 0, wr * 0.6), METAL[0], D_METAL, collide=False)
-            r.box((0.006, 0.016, (base - 0.02 - wr) / 2 + 0.01), (sx * (hx - 0.05), sy * (hy - 0.05) + 0.02 * sy, wr + (base - 0.02 - wr) / 2), METAL[1], D_METAL, collide=False)
+            r.box(
+                (0.006, 0.016, (base - 0.02 - wr) / 2 + 0.01),
+                (sx * (hx - 0.05), sy * (hy - 0.05) + 0.02 * sy, wr + (base - 0.02 - wr) / 2),
+                METAL[1],
+                D_METAL,
+                collide=False,
+            )
             k += 1
-    return Draft(r, {"shelves": n_shelves}, surfaces, [], [colour_name(c), f"{n_shelves} shelves", "four wheels", "push handle"])
+    return Draft(
+        r,
+        {"shelves": n_shelves},
+        surfaces,
+        [],
+        [colour_name(c), f"{n_shelves} shelves", "four wheels", "push handle"],
+    )

@@ -12,8 +12,25 @@ import numpy as np
 
 from anomalygen.assets.core import Cavity, Draft, Surface, register
 from anomalygen.assets.generators.common import (
-    CERAMIC, D_CERAMIC, D_FABRIC, D_FOOD, D_GLASS, D_HOLLOW, D_METAL, D_PLASTIC, D_WOOD, DARK, FABRIC, GLASS,
-    METAL, PLASTIC, WHITE, WOOD, cable_path, colour, colour_name, open_box, pick, u,
+    CERAMIC,
+    D_CERAMIC,
+    D_FOOD,
+    D_GLASS,
+    D_METAL,
+    D_WOOD,
+    DARK,
+    FABRIC,
+    GLASS,
+    METAL,
+    PLASTIC,
+    WHITE,
+    WOOD,
+    cable_path,
+    colour,
+    colour_name,
+    open_box,
+    pick,
+    u,
 )
 from anomalygen.assets.parts import Part, axis_angle
 
@@ -94,7 +111,9 @@ def detergent_pod(rng):
     a, b, c = u(rng, 0.017, 0.021), u(rng, 0.015, 0.018), u(rng, 0.008, 0.011)
     col = colour(rng, [(0.2, 0.45, 0.95, 1), (0.95, 0.45, 0.1, 1), (0.4, 0.85, 0.4, 1)])
     r.ellipsoid((a, b, c), (0, 0, c), col, 1050)
-    r.ellipsoid((a * 0.6, b * 0.5, c * 0.5), (a * 0.2, 0, c * 1.6), (0.95, 0.95, 0.95, 0.9), 1050, collide=False)
+    r.ellipsoid(
+        (a * 0.6, b * 0.5, c * 0.5), (a * 0.2, 0, c * 1.6), (0.95, 0.95, 0.95, 0.9), 1050, collide=False
+    )
     return _d(r, ["bright colourful capsule that looks like candy"], size=a)
 
 
@@ -113,7 +132,13 @@ def cup(rng):
     rad, h = u(rng, 0.035, 0.045), u(rng, 0.08, 0.11)
     c = colour(rng, PLASTIC + CERAMIC)
     _vessel(r, rad, h, 0.004, c, 1000)
-    return Draft(r, {"radius": rad}, [], [Cavity("inside", (0, 0, h / 2), (rad * 0.7, rad * 0.7, h / 2 - 0.005), "top")], [colour_name(c)])
+    return Draft(
+        r,
+        {"radius": rad},
+        [],
+        [Cavity("inside", (0, 0, h / 2), (rad * 0.7, rad * 0.7, h / 2 - 0.005), "top")],
+        [colour_name(c)],
+    )
 
 
 def _mug(rng, hot: bool):
@@ -129,7 +154,13 @@ def _mug(rng, hot: bool):
     if hot:
         r.cyl(rad - 0.006, 0.002, (0, 0, h * 0.8), (0.3, 0.17, 0.08, 1), 1000, collide=False)
         feats += ["full of steaming hot coffee or tea"]
-    return Draft(r, {"radius": rad}, [], [Cavity("inside", (0, 0, h / 2), (rad * 0.7, rad * 0.7, h / 2 - 0.006), "top")], feats)
+    return Draft(
+        r,
+        {"radius": rad},
+        [],
+        [Cavity("inside", (0, 0, h / 2), (rad * 0.7, rad * 0.7, h / 2 - 0.006), "top")],
+        feats,
+    )
 
 
 register("mug")(lambda rng: _mug(rng, False))
@@ -143,8 +174,17 @@ def plate(rng):
     c = colour(rng, CERAMIC)
     r.cyl(rad * 0.6, 0.003, (0, 0, 0.003), c, 1500)
     r.cyl(rad, 0.003, (0, 0, 0.009), c, 1500)
-    r.cyl(rad * 0.65, 0.0035, (0, 0, 0.0095), (c[0] * 0.95, c[1] * 0.95, c[2] * 0.95, 1), D_CERAMIC, collide=False)
-    return Draft(r, {"radius": rad}, [Surface("top", (0, 0, 0.012), (rad * 0.5, rad * 0.5))], [], [colour_name(c)])
+    r.cyl(
+        rad * 0.65,
+        0.0035,
+        (0, 0, 0.0095),
+        (c[0] * 0.95, c[1] * 0.95, c[2] * 0.95, 1),
+        D_CERAMIC,
+        collide=False,
+    )
+    return Draft(
+        r, {"radius": rad}, [Surface("top", (0, 0, 0.012), (rad * 0.5, rad * 0.5))], [], [colour_name(c)]
+    )
 
 
 @register("bowl")
@@ -161,8 +201,20 @@ def bowl(rng):
         from anomalygen.assets.parts import quat_mul
 
         q = quat_mul(q, axis_angle((0, 0, 1), a))
-        r.box((0.0025, math.pi * rad / n * 1.1, h / 2), (rr * math.cos(a), rr * math.sin(a), h / 2 + 0.002), c, D_CERAMIC, quat=q)
-    return Draft(r, {"radius": rad}, [], [Cavity("inside", (0, 0, h / 2), (rad * 0.5, rad * 0.5, h / 2 - 0.004), "top")], [colour_name(c)])
+        r.box(
+            (0.0025, math.pi * rad / n * 1.1, h / 2),
+            (rr * math.cos(a), rr * math.sin(a), h / 2 + 0.002),
+            c,
+            D_CERAMIC,
+            quat=q,
+        )
+    return Draft(
+        r,
+        {"radius": rad},
+        [],
+        [Cavity("inside", (0, 0, h / 2), (rad * 0.5, rad * 0.5, h / 2 - 0.004), "top")],
+        [colour_name(c)],
+    )
 
 
 @register("glass")
@@ -170,7 +222,13 @@ def glass(rng):
     r = Part("root")
     rad, h = u(rng, 0.03, 0.04), u(rng, 0.09, 0.14)
     _vessel(r, rad, h, 0.003, GLASS, D_GLASS, bottom=0.01)
-    return Draft(r, {"radius": rad}, [], [Cavity("inside", (0, 0, h / 2 + 0.005), (rad * 0.7, rad * 0.7, h / 2 - 0.01), "top")], ["transparent glass"])
+    return Draft(
+        r,
+        {"radius": rad},
+        [],
+        [Cavity("inside", (0, 0, h / 2 + 0.005), (rad * 0.7, rad * 0.7, h / 2 - 0.01), "top")],
+        ["transparent glass"],
+    )
 
 
 @register("wine_glass")
@@ -215,8 +273,20 @@ def kitchen_knife(rng):
     blade, handle, width = u(rng, 0.12, 0.2), u(rng, 0.09, 0.12), u(rng, 0.018, 0.04)
     hc = colour(rng, [DARK, WOOD[0], WOOD[2]])
     r.box((handle / 2, 0.011, 0.009), (-handle / 2, 0, 0.009), hc, D_WOOD)
-    r.box((blade / 2, width / 2, 0.0012), (blade / 2, -width / 2 + 0.011, 0.0092), METAL[0], D_METAL, name="blade")
-    r.box((blade * 0.12, width * 0.3, 0.0012), (blade * 1.06, -width * 0.7 + 0.011, 0.0092), METAL[0], D_METAL, quat=axis_angle((0, 0, 1), -0.5))
+    r.box(
+        (blade / 2, width / 2, 0.0012),
+        (blade / 2, -width / 2 + 0.011, 0.0092),
+        METAL[0],
+        D_METAL,
+        name="blade",
+    )
+    r.box(
+        (blade * 0.12, width * 0.3, 0.0012),
+        (blade * 1.06, -width * 0.7 + 0.011, 0.0092),
+        METAL[0],
+        D_METAL,
+        quat=axis_angle((0, 0, 1), -0.5),
+    )
     return _d(r, ["long sharp steel blade", "pointed tip", f"{colour_name(hc)} handle"], blade=blade)
 
 
@@ -237,7 +307,13 @@ def frying_pan(rng):
     r.cyl(rad, 0.003, (0, 0, 0.003), c, D_METAL)
     r.ring(rad, 0.006, 0.045, 0.003, 14, c, D_METAL)
     r.box((hl / 2, 0.012, 0.008), (rad + hl / 2, 0, 0.03), DARK, 1100)
-    return Draft(r, {"radius": rad}, [], [Cavity("inside", (0, 0, 0.025), (rad * 0.7, rad * 0.7, 0.018), "top")], ["long handle", "heavy metal"])
+    return Draft(
+        r,
+        {"radius": rad},
+        [],
+        [Cavity("inside", (0, 0, 0.025), (rad * 0.7, rad * 0.7, 0.018), "top")],
+        ["long handle", "heavy metal"],
+    )
 
 
 # ----------------------------------------------------------------------------- food
@@ -246,14 +322,24 @@ def frying_pan(rng):
 def _apple(rng, rotten: bool):
     r = Part("root")
     rad = u(rng, 0.036, 0.044)
-    c = (0.45, 0.3, 0.12, 1) if rotten else colour(rng, [(0.8, 0.1, 0.1, 1), (0.5, 0.8, 0.2, 1), (0.9, 0.75, 0.2, 1)])
+    c = (
+        (0.45, 0.3, 0.12, 1)
+        if rotten
+        else colour(rng, [(0.8, 0.1, 0.1, 1), (0.5, 0.8, 0.2, 1), (0.9, 0.75, 0.2, 1)])
+    )
     r.ellipsoid((rad, rad, rad * 0.9), (0, 0, rad * 0.9), c, 800)
     r.cyl(0.002, 0.008, (0, 0, rad * 1.8 + 0.006), (0.35, 0.22, 0.1, 1), 800)
     feats = [colour_name(c)]
     if rotten:
         for _ in range(4):
             a = u(rng, 0, 2 * math.pi)
-            r.sphere(rad * 0.3, (rad * 0.8 * math.cos(a), rad * 0.8 * math.sin(a), rad * u(rng, 0.6, 1.2)), (0.2, 0.15, 0.05, 1), 800, collide=False)
+            r.sphere(
+                rad * 0.3,
+                (rad * 0.8 * math.cos(a), rad * 0.8 * math.sin(a), rad * u(rng, 0.6, 1.2)),
+                (0.2, 0.15, 0.05, 1),
+                800,
+                collide=False,
+            )
         feats += ["brown soft rotten spots"]
     return _d(r, feats, radius=rad)
 
@@ -267,8 +353,11 @@ def banana(rng):
     r = Part("root")
     rad, bend, n = u(rng, 0.016, 0.02), u(rng, 0.5, 0.9), 5
     c = colour(rng, [(0.95, 0.85, 0.2, 1), (0.75, 0.8, 0.2, 1)])
-    pts = [(0.09 * math.sin(bend * (i / n - 0.5)) / bend * 1.9, 0.05 * (1 - math.cos(bend * (i / n - 0.5))), rad) for i in range(n + 1)]
-    for a, b in zip(pts, pts[1:]):
+    pts = [
+        (0.09 * math.sin(bend * (i / n - 0.5)) / bend * 1.9, 0.05 * (1 - math.cos(bend * (i / n - 0.5))), rad)
+        for i in range(n + 1)
+    ]
+    for a, b in zip(pts, pts[1:], strict=False):
         r.segment(a, b, rad * 0.95, c, D_FOOD)
     return _d(r, ["yellow peel"], bend=bend)
 
@@ -282,7 +371,13 @@ def _bread(rng, moldy: bool):
     feats = ["baked loaf"]
     if moldy:
         for _ in range(6):
-            r.sphere(hy * u(rng, 0.2, 0.35), (u(rng, -hx, hx) * 0.8, u(rng, -hy, hy) * 0.6, 2 * hz + hz * 0.4), (0.35, 0.55, 0.35, 1), 250, collide=False)
+            r.sphere(
+                hy * u(rng, 0.2, 0.35),
+                (u(rng, -hx, hx) * 0.8, u(rng, -hy, hy) * 0.6, 2 * hz + hz * 0.4),
+                (0.35, 0.55, 0.35, 1),
+                250,
+                collide=False,
+            )
         feats += ["green fuzzy mould spots", "spoiled"]
     return _d(r, feats, length=hx * 2)
 
@@ -296,8 +391,20 @@ def spoiled_milk_carton(rng):
     r = Part("root")
     w, h = u(rng, 0.035, 0.05), u(rng, 0.15, 0.2)
     r.box((w, w, h / 2), (0, 0, h / 2), WHITE, 300)
-    r.box((w, w * 0.72, 0.004), (0, -w * 0.5, h + w * 0.45), (0.2, 0.45, 0.85, 1), 300, quat=axis_angle((1, 0, 0), -0.78))
-    r.box((w, w * 0.72, 0.004), (0, w * 0.5, h + w * 0.45), (0.2, 0.45, 0.85, 1), 300, quat=axis_angle((1, 0, 0), 0.78))
+    r.box(
+        (w, w * 0.72, 0.004),
+        (0, -w * 0.5, h + w * 0.45),
+        (0.2, 0.45, 0.85, 1),
+        300,
+        quat=axis_angle((1, 0, 0), -0.78),
+    )
+    r.box(
+        (w, w * 0.72, 0.004),
+        (0, w * 0.5, h + w * 0.45),
+        (0.2, 0.45, 0.85, 1),
+        300,
+        quat=axis_angle((1, 0, 0), 0.78),
+    )
     r.box((w * 0.8, w * 0.4, h * 0.15), (0, -w - 0.0005, h * 0.55), (0.2, 0.45, 0.85, 1), 300, collide=False)
     return _d(r, ["gable-top carton", "milk past its date, sour"], height=h)
 
@@ -433,7 +540,7 @@ def _cable(rng, end: str):
     n = int(rng.integers(8, 14))
     c = colour(rng, [DARK, WHITE, (0.2, 0.2, 0.25, 1), (0.9, 0.5, 0.1, 1)])
     pts = cable_path(rng, 1.0, n, rad)
-    for a, b in zip(pts, pts[1:]):
+    for a, b in zip(pts, pts[1:], strict=False):
         r.segment(a, b, rad, c, 1300)
     p0, p1 = pts[0], pts[-1]
     r.box((0.015, 0.012, 0.009), (p0[0] - 0.012, p0[1], 0.009), c, 1300)  # plug
@@ -466,7 +573,9 @@ def book(rng):
     c = colour(rng, FABRIC + PLASTIC[:3])
     r.box((hx, hy, hz), (0, 0, hz), c, 700)
     r.box((hx * 0.98, hy * 0.96, hz * 0.85), (0.003, 0, hz), (0.95, 0.93, 0.86, 1), 700, collide=False)
-    return Draft(r, {}, [Surface("cover", (0, 0, 2 * hz), (hx * 0.9, hy * 0.9))], [], [colour_name(c), "hard cover"])
+    return Draft(
+        r, {}, [Surface("cover", (0, 0, 2 * hz), (hx * 0.9, hy * 0.9))], [], [colour_name(c), "hard cover"]
+    )
 
 
 @register("magazine")
@@ -511,7 +620,9 @@ def rug(rng):
     c = colour(rng, FABRIC)
     r.box((hx, hy, 0.004), (0, 0, 0.004), c, 300)
     r.box((hx * 0.8, hy * 0.7, 0.0045), (0, 0, 0.004), colour(rng, FABRIC), 300, collide=False)
-    r.box((hx * 0.08, hy * 0.6, 0.004), (hx * 0.7, 0, 0.011), c, 300, quat=axis_angle((0, 1, 0), -0.2))  # curled corner
+    r.box(
+        (hx * 0.08, hy * 0.6, 0.004), (hx * 0.7, 0, 0.011), c, 300, quat=axis_angle((0, 1, 0), -0.2)
+    )  # curled corner
     return _d(r, [colour_name(c), "curled edge", "loose on the floor"], length=2 * hx)
 
 
@@ -583,9 +694,15 @@ def matches(rng):
 def plastic_bag(rng):
     r = Part("root")
     c = colour(rng, [WHITE, (0.9, 0.9, 0.8, 0.9), (0.3, 0.5, 0.8, 0.9)])
-    for k in range(4):  # flat overlapping folds: a crumpled bag lying flat, stable on the floor
+    for _ in range(4):  # flat overlapping folds: a crumpled bag lying flat, stable on the floor
         hz = u(rng, 0.003, 0.008)
-        r.box((u(rng, 0.06, 0.12), u(rng, 0.05, 0.09), hz), (u(rng, -0.05, 0.05), u(rng, -0.04, 0.04), hz), c, 20, quat=axis_angle((0, 0, 1), u(rng, 0, math.pi)))
+        r.box(
+            (u(rng, 0.06, 0.12), u(rng, 0.05, 0.09), hz),
+            (u(rng, -0.05, 0.05), u(rng, -0.04, 0.04), hz),
+            c,
+            20,
+            quat=axis_angle((0, 0, 1), u(rng, 0, math.pi)),
+        )
     return _d(r, ["thin crumpled plastic"], pieces=4)
 
 
@@ -634,7 +751,13 @@ def garden_shears(rng):
     for s in (-1, 1):
         q = axis_angle((0, 0, 1), s * a)
         ca, sa = math.cos(s * a), math.sin(s * a)
-        r.box((bl / 2, 0.012, 0.003), (ca * bl / 2, sa * bl / 2, 0.003 + (s + 1) * 0.003), METAL[0], D_METAL, quat=q)
+        r.box(
+            (bl / 2, 0.012, 0.003),
+            (ca * bl / 2, sa * bl / 2, 0.003 + (s + 1) * 0.003),
+            METAL[0],
+            D_METAL,
+            quat=q,
+        )
         r.box((hl / 2, 0.011, 0.009), (-ca * hl / 2, -sa * hl / 2, 0.009), hc, D_WOOD, quat=q)
     return _d(r, ["two sharp blades", "long handles"], opening=a)
 
@@ -740,8 +863,13 @@ def storage_box(rng):
     lid = r.child("lid", (0, hy, 2 * hz + 0.002))
     lid.hinge("lid_hinge", (1, 0, 0), (-1.9, 0), "lid", 0.0)
     lid.box((hx + 0.004, hy + 0.002, 0.006), (0, -hy, 0.006), c, 900)
-    return Draft(r, {"size_x": hx}, [Surface("lid_top", (0, 0, 2 * hz + 0.014), (hx * 0.9, hy * 0.9))],
-                 [Cavity("inside", (0, 0, hz + t / 2), (hx - t * 1.5, hy - t * 1.5, hz - t), "top", "lid_hinge")], [colour_name(c), "hinged lid"])
+    return Draft(
+        r,
+        {"size_x": hx},
+        [Surface("lid_top", (0, 0, 2 * hz + 0.014), (hx * 0.9, hy * 0.9))],
+        [Cavity("inside", (0, 0, hz + t / 2), (hx - t * 1.5, hy - t * 1.5, hz - t), "top", "lid_hinge")],
+        [colour_name(c), "hinged lid"],
+    )
 
 
 @register("basket")
@@ -751,7 +879,13 @@ def basket(rng):
     c = colour(rng, WOOD)
     r.cyl(rad, 0.004, (0, 0, 0.004), c, D_WOOD)
     r.ring(rad, 0.008, h, 0.006, 14, c, D_WOOD, ry=rad * 0.75)
-    return Draft(r, {"radius": rad}, [], [Cavity("inside", (0, 0, h / 2), (rad * 0.7, rad * 0.5, h / 2 - 0.01), "top")], ["woven", "open top"])
+    return Draft(
+        r,
+        {"radius": rad},
+        [],
+        [Cavity("inside", (0, 0, h / 2), (rad * 0.7, rad * 0.5, h / 2 - 0.01), "top")],
+        ["woven", "open top"],
+    )
 
 
 @register("shelf")
@@ -783,9 +917,21 @@ def counter(rng):
     n = max(1, int(hx / 0.3))
     for i in range(n):  # front panels and handles (decoration)
         x = -hx + hx / n * (2 * i + 1)
-        r.box((hx / n - 0.006, 0.003, h / 2 - 0.08), (x, -hy + 0.018, h / 2 - 0.02), (body[0] * 0.9, body[1] * 0.9, body[2] * 0.9, 1), 300, collide=False)
+        r.box(
+            (hx / n - 0.006, 0.003, h / 2 - 0.08),
+            (x, -hy + 0.018, h / 2 - 0.02),
+            (body[0] * 0.9, body[1] * 0.9, body[2] * 0.9, 1),
+            300,
+            collide=False,
+        )
         r.box((0.04, 0.006, 0.006), (x, -hy + 0.01, h - 0.12), METAL[0], D_METAL, collide=False)
-    return Draft(r, {"length": 2 * hx}, [Surface("top", (0, 0, h), (hx - 0.02, hy - 0.02))], [], ["worktop", colour_name(top)])
+    return Draft(
+        r,
+        {"length": 2 * hx},
+        [Surface("top", (0, 0, h), (hx - 0.02, hy - 0.02))],
+        [],
+        ["worktop", colour_name(top)],
+    )
 
 
 @register("medicine_cabinet")
@@ -800,7 +946,14 @@ def medicine_cabinet(rng):
     door.box((hx - 0.002, 0.006, hz - 0.002), (hx, -0.003, 0), c, D_WOOD)
     door.box((hx * 0.8, 0.001, hz * 0.8), (hx, -0.0095, 0), (0.8, 0.88, 0.92, 1), D_GLASS, collide=False)
     door.box((0.006, 0.01, 0.03), (2 * hx - 0.03, -0.018, 0), METAL[0], D_METAL)
-    cav = [Cavity("lower", (0, 0, hz / 2 + t / 2), (hx - t * 1.5, hy - t * 1.5, hz / 2 - t), "front", "door_hinge"),
-           Cavity("upper", (0, 0, hz * 1.5), (hx - t * 1.5, hy - t * 1.5, hz / 2 - t), "front", "door_hinge")]
-    surfs = [Surface("top", (0, 0, 2 * hz), (hx - 0.01, hy - 0.01)), Surface("shelf", (0, 0, hz + t / 2), (hx - t * 1.5, hy - t * 1.5))]
+    cav = [
+        Cavity(
+            "lower", (0, 0, hz / 2 + t / 2), (hx - t * 1.5, hy - t * 1.5, hz / 2 - t), "front", "door_hinge"
+        ),
+        Cavity("upper", (0, 0, hz * 1.5), (hx - t * 1.5, hy - t * 1.5, hz / 2 - t), "front", "door_hinge"),
+    ]
+    surfs = [
+        Surface("top", (0, 0, 2 * hz), (hx - 0.01, hy - 0.01)),
+        Surface("shelf", (0, 0, hz + t / 2), (hx - t * 1.5, hy - t * 1.5)),
+    ]
     return Draft(r, {}, surfs, cav, ["mirrored door", "shelf inside"])

@@ -14,7 +14,21 @@ from anomalygen.assets.generators.common import D_METAL, METAL, open_box
 from anomalygen.assets.parts import Part
 
 
-def side_door(parent: Part, name: str, x0, x1, z0, z1, y, hinge_left: bool, rgba, density, thick=0.018, handle=True, open_angle=1.9):
+def side_door(
+    parent: Part,
+    name: str,
+    x0,
+    x1,
+    z0,
+    z1,
+    y,
+    hinge_left: bool,
+    rgba,
+    density,
+    thick=0.018,
+    handle=True,
+    open_angle=1.9,
+):
     """A door on a vertical hinge covering x0..x1, z0..z1, its back face at y (the cabinet front)."""
     w, hz, zc = x1 - x0, (z1 - z0) / 2, (z0 + z1) / 2
     if hinge_left:
@@ -32,7 +46,9 @@ def side_door(parent: Part, name: str, x0, x1, z0, z1, y, hinge_left: bool, rgba
     return d
 
 
-def drop_door(parent: Part, name: str, x0, x1, z0, z1, y, rgba, density, thick=0.03, handle=True, window=None):
+def drop_door(
+    parent: Part, name: str, x0, x1, z0, z1, y, rgba, density, thick=0.03, handle=True, window=None
+):
     """A door hinged along its bottom edge that falls open forward (oven, dishwasher)."""
     w, h = x1 - x0, z1 - z0
     d = parent.child(name, ((x0 + x1) / 2, y - 0.002, z0))
@@ -41,9 +57,21 @@ def drop_door(parent: Part, name: str, x0, x1, z0, z1, y, rgba, density, thick=0
     if window is not None:
         d.box((w * 0.35, 0.001, h * 0.25), (0, -thick - 0.001, h * 0.5), window, 100, collide=False)
     if handle:
-        d.segment((-w * 0.35, -thick - 0.025, h * 0.88), (w * 0.35, -thick - 0.025, h * 0.88), 0.008, METAL[0], D_METAL)
+        d.segment(
+            (-w * 0.35, -thick - 0.025, h * 0.88),
+            (w * 0.35, -thick - 0.025, h * 0.88),
+            0.008,
+            METAL[0],
+            D_METAL,
+        )
         for sx in (-1, 1):
-            d.segment((sx * w * 0.33, -thick, h * 0.88), (sx * w * 0.33, -thick - 0.025, h * 0.88), 0.006, METAL[0], D_METAL)
+            d.segment(
+                (sx * w * 0.33, -thick, h * 0.88),
+                (sx * w * 0.33, -thick - 0.025, h * 0.88),
+                0.006,
+                METAL[0],
+                D_METAL,
+            )
     return d
 
 
@@ -56,10 +84,24 @@ def drawer(parent: Part, name: str, x0, x1, z0, z1, y, depth, rgba, density, t=0
     dr.box((w / 2 - 0.002, 0.009, h / 2 - 0.002), (0, -0.009, h / 2), rgba, density)
     dr.box((min(0.06, w * 0.25), 0.01, 0.008), (0, -0.03, h * 0.6), METAL[0], D_METAL)
     bh = h / 2 * 0.75
-    open_box(dr, w / 2 - 0.02, depth / 2 - 0.01, bh, t, rgba, density, z0=0.012, center=(0, depth / 2 + 0.005))
-    cav = Cavity(f"{name}_bin", (0, 0, 0), (w / 2 - 0.02 - t * 1.5, depth / 2 - 0.01 - t * 1.5, bh - t), "top", f"{name}_slide")
+    open_box(
+        dr, w / 2 - 0.02, depth / 2 - 0.01, bh, t, rgba, density, z0=0.012, center=(0, depth / 2 + 0.005)
+    )
+    cav = Cavity(
+        f"{name}_bin",
+        (0, 0, 0),
+        (w / 2 - 0.02 - t * 1.5, depth / 2 - 0.01 - t * 1.5, bh - t),
+        "top",
+        f"{name}_slide",
+    )
     # cavity centre in the parent frame (closed state)
-    cav = Cavity(cav.name, ((x0 + x1) / 2, y - 0.002 + depth / 2 + 0.005, z0 + 0.012 + bh + t / 2), cav.half_extents, "top", cav.joint)
+    cav = Cavity(
+        cav.name,
+        ((x0 + x1) / 2, y - 0.002 + depth / 2 + 0.005, z0 + 0.012 + bh + t / 2),
+        cav.half_extents,
+        "top",
+        cav.joint,
+    )
     return dr, cav
 
 
@@ -71,7 +113,13 @@ def knob(parent: Part, name: str, pos, r, rgba, axis=(0, -1, 0), label="knob", r
     off = [0.0, 0.0, 0.0]
     off["xyz".index(ax)] = r * 0.6 * (1 if sum(axis) > 0 else -1)
     k.cyl(r, r * 0.6, off, rgba, 900, axis=ax)
-    k.box((r * 0.15, r * 0.3, r * 0.8) if ax == "y" else (r * 0.8, r * 0.15, r * 0.3), [2 * o for o in off], (0.9, 0.9, 0.9, 1), 900, collide=False)
+    k.box(
+        (r * 0.15, r * 0.3, r * 0.8) if ax == "y" else (r * 0.8, r * 0.15, r * 0.3),
+        [2 * o for o in off],
+        (0.9, 0.9, 0.9, 1),
+        900,
+        collide=False,
+    )
     return k
 
 

@@ -11,7 +11,18 @@ import math
 from anomalygen.assets.core import Draft, Surface, register
 from anomalygen.assets.generators.appliances import button
 from anomalygen.assets.generators.common import (
-    BLACK_GLASS, D_METAL, D_PLASTIC, D_WOOD, DARK, GLASS, METAL, PLASTIC, WHITE, WOOD, colour, colour_name, pick, u,
+    BLACK_GLASS,
+    D_METAL,
+    D_PLASTIC,
+    DARK,
+    METAL,
+    PLASTIC,
+    WHITE,
+    WOOD,
+    colour,
+    colour_name,
+    pick,
+    u,
 )
 from anomalygen.assets.parts import Part, axis_angle
 
@@ -46,7 +57,9 @@ def eyeglasses(rng):
     r.box((bridge / 2 + 0.002, 0.003, 0.002), (0, 0, z + lr * 0.5), c, 1200)
     for s, name in ((-1, "left_temple"), (1, "right_temple")):
         t = r.child(name, (s * w, 0.002, z + lr * 0.5))
-        t.hinge(f"{name}_hinge", (0, 0, 1), (-1.5, 0) if s < 0 else (0, 1.5), "temple", -1.5 if s < 0 else 1.5)
+        t.hinge(
+            f"{name}_hinge", (0, 0, 1), (-1.5, 0) if s < 0 else (0, 1.5), "temple", -1.5 if s < 0 else 1.5
+        )
         t.box((0.0015, tl / 2, 0.002), (0, tl / 2, 0), c, 1200)
         drop = (z + lr * 0.5) - (z - lr - 0.002)  # ear piece reaches down to the rims' bottom level
         t.box((0.0015, 0.004, drop / 2), (0, tl, -drop / 2), c, 1200)
@@ -58,14 +71,20 @@ def keyboard(rng):
     r = Part("root")
     hx, hy = u(rng, 0.15, 0.22), u(rng, 0.05, 0.08)
     c = colour(rng, [DARK, WHITE, METAL[1]])
-    kc = colour(rng, [DARK, WHITE, (0.3, 0.3, 0.32, 1)])
+    kc = (0.12, 0.12, 0.13, 1) if sum(c[:3]) > 1.5 else (0.85, 0.85, 0.86, 1)  # keys contrast with the body
     r.box((hx, hy, 0.008), (0, 0, 0.008), c, 1000)
-    rows, cols = 4, int(hx / 0.019)
+    rows, cols = 4, int((2 * hx - 0.012) / 0.019)
     for i in range(rows):
         for j in range(cols):
             if i == 0 and cols // 2 - 3 <= j <= cols // 2 + 3:
                 continue
-            r.box((0.0075, 0.0075, 0.003), (-hx + 0.012 + j * 0.019, -hy + 0.015 + i * 0.019, 0.019), kc, 900, collide=False)
+            r.box(
+                (0.0075, 0.0075, 0.003),
+                (-hx + 0.012 + j * 0.019, -hy + 0.015 + i * 0.019, 0.019),
+                kc,
+                900,
+                collide=False,
+            )
     sp = r.child("space_bar", (0, -hy + 0.015, 0.019))
     sp.slide("space_bar_press", (0, 0, -1), (0, 0.003), "key", 0.0, spring=True)
     sp.box((0.065, 0.0075, 0.003), (0, 0, 0), kc, 900)
@@ -82,8 +101,16 @@ def folding_knife(rng):
     bl_.hinge("blade_hinge", (0, 0, 1), (0, math.pi), "blade", 0.0)
     # folded (0): the blade lies back along the handle; open (pi): it sticks out beyond the end
     bl_.box((bl / 2, hw * 0.8, 0.0012), (-bl / 2, 0.001, 0.0), METAL[0], D_METAL, name="blade")
-    bl_.box((bl * 0.1, hw * 0.5, 0.0012), (-bl * 1.02, -hw * 0.25, 0.0), METAL[0], D_METAL, quat=axis_angle((0, 0, 1), 0.5))
-    return Draft(r, {"blade": bl}, [], [], [colour_name(c), "folding pocket knife", "sharp blade that swings out"])
+    bl_.box(
+        (bl * 0.1, hw * 0.5, 0.0012),
+        (-bl * 1.02, -hw * 0.25, 0.0),
+        METAL[0],
+        D_METAL,
+        quat=axis_angle((0, 0, 1), 0.5),
+    )
+    return Draft(
+        r, {"blade": bl}, [], [], [colour_name(c), "folding pocket knife", "sharp blade that swings out"]
+    )
 
 
 @register("Laptop")
@@ -93,12 +120,24 @@ def laptop(rng):
     c = colour(rng, [METAL[0], METAL[2], DARK, WHITE])
     r.box((hx, hy, 0.008), (0, 0, 0.008), c, 1600)
     r.box((hx * 0.85, hy * 0.45, 0.001), (0, hy * 0.3, 0.0165), DARK, 100, collide=False)  # keyboard area
-    r.box((hx * 0.25, hy * 0.2, 0.0005), (0, -hy * 0.6, 0.016), (c[0] * 0.9, c[1] * 0.9, c[2] * 0.9, 1), 100, collide=False)
+    r.box(
+        (hx * 0.25, hy * 0.2, 0.0005),
+        (0, -hy * 0.6, 0.016),
+        (c[0] * 0.9, c[1] * 0.9, c[2] * 0.9, 1),
+        100,
+        collide=False,
+    )
     lid = r.child("screen", (0, hy, 0.017))
     lid.hinge("screen_hinge", (1, 0, 0), (-2.0, 0), "hinge", 0.0)
     lid.box((hx, hy, 0.004), (0, -hy, 0.004), c, 1400)
     lid.box((hx * 0.92, hy * 0.88, 0.0005), (0, -hy, -0.0005), BLACK_GLASS, 100, collide=False)
-    return Draft(r, {}, [Surface("lid_top", (0, 0, 0.025), (hx - 0.01, hy - 0.01))], [], [colour_name(c), "hinged screen lid", "fragile electronics"])
+    return Draft(
+        r,
+        {},
+        [Surface("lid_top", (0, 0, 0.025), (hx - 0.01, hy - 0.01))],
+        [],
+        [colour_name(c), "hinged screen lid", "fragile electronics"],
+    )
 
 
 @register("Mouse")
@@ -134,7 +173,13 @@ def pen(rng):
         b = r.child("click", (-L / 2, 0, rad))
         b.slide("click_press", (1, 0, 0), (0, 0.004), "button", 0.0, spring=True)
         b.cyl(rad * 0.6, 0.006, (-0.006, 0, 0), METAL[0], D_METAL, axis="x")
-    return Draft(r, {"kind": cap_kind}, [], [], [colour_name(c), "pen with a cap" if cap_kind == "cap" else "click pen", "pointed tip"])
+    return Draft(
+        r,
+        {"kind": cap_kind},
+        [],
+        [],
+        [colour_name(c), "pen with a cap" if cap_kind == "cap" else "click pen", "pointed tip"],
+    )
 
 
 @register("Phone")
@@ -151,25 +196,53 @@ def phone(rng):
 
 
 def _hinged_pair(rng, kind: str):
+    """Two crossing halves on a pivot at the origin: blade/jaw ahead (+x), handle behind (-x)."""
     r = Part("root")
-    if kind == "Scissors":
-        bl, hl = u(rng, 0.06, 0.1), u(rng, 0.06, 0.08)
-    else:
-        bl, hl = u(rng, 0.04, 0.06), u(rng, 0.1, 0.14)
+    scissors = kind == "Scissors"
+    bl, hl = (u(rng, 0.06, 0.1), u(rng, 0.06, 0.08)) if scissors else (u(rng, 0.035, 0.05), u(rng, 0.1, 0.14))
     hc = colour(rng, PLASTIC[:4] + [DARK])
-    a = 0.08
-    thick = 0.003
-    # lower half: the root. Each half is a blade/jaw on one side of the pivot and a handle on the other.
-    r.box((bl / 2, 0.006, thick), (bl / 2 * math.cos(a), bl / 2 * math.sin(a), thick), METAL[0], D_METAL, quat=axis_angle((0, 0, 1), a), name="blade")
-    r.box((hl / 2, 0.008, 0.004), (-hl / 2 * math.cos(a), -hl / 2 * math.sin(a), 0.004), hc, D_PLASTIC if kind == "Scissors" else D_METAL, quat=axis_angle((0, 0, 1), a))
-    if kind == "Scissors":
-        r.ring(0.012, 0.0, 0.008, 0.004, 8, hc, D_PLASTIC, center=(-hl * math.cos(a) - 0.008, -hl * math.sin(a) - 0.006))
-    up = r.child("upper_half", (0, 0, 2 * thick + 0.001))
-    up.hinge("pivot", (0, 0, 1), (0, 0.7), "blade" if kind == "Scissors" else "handle", 0.0)
-    up.box((bl / 2, 0.006, thick), (bl / 2 * math.cos(-a), bl / 2 * math.sin(-a), thick), METAL[0], D_METAL, quat=axis_angle((0, 0, 1), -a))
-    up.box((hl / 2, 0.008, 0.004), (-hl / 2 * math.cos(-a), -hl / 2 * math.sin(-a), 0.001), hc, D_PLASTIC if kind == "Scissors" else D_METAL, quat=axis_angle((0, 0, 1), -a))
+    a = 0.12  # each half's blade leans this far off the axis; the handles splay the other way
+    thick = 0.004  # blade and handle share one thickness so the lower half lies flat
+    dens = D_PLASTIC if scissors else D_METAL
+
+    def half(part: Part, side: int, z: float, blade_name=None):
+        q = axis_angle((0, 0, 1), side * a)
+        c, s_ = math.cos(side * a), math.sin(side * a)
+        bw = 0.006 if scissors else 0.009
+        part.box(
+            (bl / 2, bw, thick), (bl / 2 * c, bl / 2 * s_, z), METAL[0], D_METAL, quat=q, name=blade_name
+        )
+        qh = axis_angle((0, 0, 1), -side * 2.5 * a)
+        ch, sh = math.cos(-side * 2.5 * a), math.sin(-side * 2.5 * a)
+        part.box((hl / 2, 0.006, 0.004), (-hl / 2 * ch, -hl / 2 * sh, z), hc, dens, quat=qh)
+        end = (-hl * ch, -hl * sh)
+        if scissors:  # finger loop
+            part.ring(
+                0.013,
+                z - 0.004,
+                z + 0.004,
+                0.004,
+                8,
+                hc,
+                dens,
+                center=(end[0] - 0.011 * ch, end[1] - 0.011 * sh),
+            )
+        else:  # rubber grip
+            part.box((hl * 0.3, 0.009, 0.004), (end[0] * 0.7, end[1] * 0.7, z), hc, 1100, quat=qh)
+
+    half(r, 1, thick, "blade")
+    up = r.child("upper_half", (0, 0, 0))
+    up.hinge("pivot", (0, 0, 1), (0, 0.6), "blade" if scissors else "handle", 0.0)
+    half(
+        up, -1, thick + 0.0005
+    )  # same level as the lower half (own-part contacts are excluded): both lie flat
+    r.cyl(0.005, 0.004, (0, 0, 2 * thick + 0.001), METAL[2], D_METAL)
     feats = [colour_name(hc), "two hinged halves"]
-    feats += ["sharp pointed blades"] if kind == "Scissors" else ["metal gripping jaws", "can pinch"]
+    feats += (
+        ["sharp pointed blades", "finger loops"]
+        if scissors
+        else ["metal gripping jaws", "rubber grips", "can pinch"]
+    )
     return Draft(r, {"blade": bl}, [], [], feats)
 
 
@@ -185,10 +258,23 @@ def remote(rng):
     r.box((hx, hy, 0.01), (0, 0, 0.01), c, 1000)
     n = int(rng.integers(2, 5))
     for k in range(n):
-        button(r, f"button_{k}", (0, hy * 0.6 - k * 0.02, 0.0215), (hx * 0.5, 0.006, 0.0015), pick(rng, [(0.8, 0.2, 0.2, 1), (0.6, 0.6, 0.6, 1), (0.2, 0.6, 0.3, 1)]), travel=0.0015)
+        button(
+            r,
+            f"button_{k}",
+            (0, hy * 0.6 - k * 0.02, 0.0215),
+            (hx * 0.5, 0.006, 0.0015),
+            pick(rng, [(0.8, 0.2, 0.2, 1), (0.6, 0.6, 0.6, 1), (0.2, 0.6, 0.3, 1)]),
+            travel=0.0015,
+        )
     for i in range(3):
         for j in range(3):
-            r.box((0.004, 0.004, 0.001), (-0.01 + 0.01 * i, -hy * 0.5 + 0.01 * j, 0.0205), (0.7, 0.7, 0.7, 1), 100, collide=False)
+            r.box(
+                (0.004, 0.004, 0.001),
+                (-0.01 + 0.01 * i, -hy * 0.5 + 0.01 * j, 0.0205),
+                (0.7, 0.7, 0.7, 1),
+                100,
+                collide=False,
+            )
     return Draft(r, {"buttons": n}, [], [], [colour_name(c), f"{n} push buttons", "contains batteries"])
 
 
