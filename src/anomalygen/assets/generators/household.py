@@ -197,7 +197,7 @@ def bowl(rng):
     for i in range(n):  # flared wall: tilted boxes
         a = 2 * math.pi * i / n
         rr = (rad * 0.55 + rad) / 2
-        q = axis_angle((math.cos(a + math.pi / 2), math.sin(a + math.pi / 2), 0), -0.45)
+        q = axis_angle((math.cos(a + math.pi / 2), math.sin(a + math.pi / 2), 0), 0.45)
         from anomalygen.assets.parts import quat_mul
 
         q = quat_mul(q, axis_angle((0, 0, 1), a))
