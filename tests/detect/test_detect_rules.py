@@ -67,7 +67,8 @@ def test_deterministic_and_deduplicated(kb):
 
 def test_ranking_prefers_severity_then_covers_other_objects():
     def cand(obj, cls, score):
-        return Candidate(cls, obj, "x", score, score, "p", "s", "e", ())
+        return Candidate(hazard_class=cls, object=obj, category="x", severity=score, score=score, typical=True,
+                         specificity=2, problem="p", solution="s", explanation="e", bindings=())
 
     a1, a2, b1 = cand("a", "c1", 0.9), cand("a", "c2", 0.85), cand("b", "c3", 0.8)
     assert [c.hazard_class for c in rank([b1, a2, a1], 3)] == ["c1", "c3", "c2"]
@@ -75,6 +76,18 @@ def test_ranking_prefers_severity_then_covers_other_objects():
     b_low = cand("b", "c3", 0.85 - REPEAT_PENALTY - 0.05)
     assert [c.hazard_class for c in rank([a1, a2, b_low], 3)] == ["c1", "c2", "c3"]
     assert rank([a1, a2, b1], 1) == [a1]
+
+
+def test_typical_hazard_objects_break_ties(kb):
+    """Two objects in the walkway: the shoe (a typical trip hazard) ranks before the cup."""
+    assert "shoe" in kb.hazard_classes["reduce_tripping_hazards"].hazard_objects
+    assert "cup" not in kb.hazard_classes["reduce_tripping_hazards"].hazard_objects
+    floor = [g.obj("cup_0", "cup", pos=(0.9, -0.9, 0.05), size=(0.08, 0.08, 0.1)),
+             g.obj("shoe_0", "shoe", pos=(1.4, -0.6, 0.08), size=(0.3, 0.12, 0.16))]
+    hyps = RuleDetector(kb).detect(g.scene("s", "bedroom", g.kitchen_furniture() + floor), 2)
+    assert [(h.target_object, h.hazard_class) for h in hyps] == [
+        ("shoe_0", "reduce_tripping_hazards"), ("cup_0", "reduce_tripping_hazards")]
+    assert hyps[0].score == kb.hazard_classes["reduce_tripping_hazards"].severity
 
 
 def test_candidates_cover_every_kb_class_that_fires(kb):

@@ -5,11 +5,14 @@ explanations that made it fire, so a miss can be traced to a knowledge-base rule
 model's mood. They read only the scene graph (through the same predicates planning and evaluation
 use), never the task.
 
-Ranking. Each (object, class) pair is one candidate, scored by the class's severity, plus a small
-bonus for specificity (a class with more preconditions that all hold is a sharper explanation of the
-same object than a generic one). When several objects are hazardous, the top of the list should
-cover them all rather than repeat one object under three classes, so each further hypothesis about
-an object already listed pays a diversity penalty.
+Ranking. Each (object, class) pair is one candidate, scored by the class's severity: the knowledge
+base uses severity to settle overlaps between classes, so nothing is added to it. Equal scores are
+broken, in order, by typicality (the object is on the class's curated list of typical hazard objects:
+a shoe in the walkway before a cup that happens to stand there), by specificity (a class with more
+preconditions that all hold explains the object more sharply), then by names, so the order is
+deterministic. When several objects are hazardous, the top of the list should cover them all rather
+than repeat one object under three classes, so each further hypothesis about an object already
+listed pays a diversity penalty.
 """
 
 from __future__ import annotations
@@ -18,8 +21,6 @@ from dataclasses import dataclass
 
 from anomalygen.schema import Hypothesis, SceneGraph
 
-#: Score bonus per precondition beyond the first (specificity), kept below the gaps between severities.
-SPECIFICITY_BONUS = 0.01
 #: Penalty for each hypothesis already listed about the same object (coverage of several hazards).
 REPEAT_PENALTY = 0.12
 
@@ -33,6 +34,8 @@ class Candidate:
     category: str
     severity: float
     score: float
+    typical: bool  # on the class's curated hazard-object list
+    specificity: int  # number of preconditions that hold
     problem: str
     solution: str
     explanation: str
@@ -76,13 +79,16 @@ def candidates(graph: SceneGraph, kb=None) -> list[Candidate]:
             slots["container"] = m.bindings.get("$container") or (hc.default_containers[0].replace("_", " ") if hc.default_containers else "a safe place")
             slots["support"] = m.bindings.get("$support") or (hc.default_supports[0].replace("_", " ") if hc.default_supports else "a safe surface")
             solution = _fill(hc.solution, slots) if hc.solution else "; ".join(_fill(str(s), {}) for s in hc.recipe)
-            score = hc.severity + SPECIFICITY_BONUS * max(0, len(hc.preconditions) - 1) + 0.001 * m.score
+            score = hc.severity
+            typical = category in getattr(hc, "hazard_objects", [])
             cand = Candidate(
                 hazard_class=hc.id,
                 object=obj,
                 category=category,
                 severity=hc.severity,
                 score=round(score, 6),
+                typical=typical,
+                specificity=len(hc.preconditions),
                 problem=f"{hc.name}: {obj} ({category.replace('_', ' ')}) — {hc.why}",
                 solution=solution,
                 explanation=f"{hc.id} holds because {_because(hc, graph, m.bindings, evaluate)}",
@@ -110,7 +116,7 @@ def _because(hc, graph: SceneGraph, bindings: dict[str, str], evaluate) -> str:
 
 def rank(cands: list[Candidate], k: int) -> list[Candidate]:
     """Greedy ranking by score with a penalty for objects already listed; deterministic ties."""
-    pool = sorted(cands, key=lambda c: (-c.score, c.object, c.hazard_class))
+    pool = sorted(cands, key=lambda c: (-c.score, not c.typical, -c.specificity, c.object, c.hazard_class))
     chosen: list[Candidate] = []
     seen: dict[str, int] = {}
     while pool and len(chosen) < k:
