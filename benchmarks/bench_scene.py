@@ -57,6 +57,9 @@ def bench_build(n: int) -> dict:
     from anomalygen.errors import ItemFailed
     from anomalygen.scene.build import build_scene
 
+    import torch
+
+    torch.set_num_threads(1)  # as the build stage's workers do (scene/stage.py)
     settings = Settings()
     out = Path(tempfile.mkdtemp(prefix="bench-scene-"))
     build_scene(_task(0), seed=99, settings=settings, out_dir=out / "warmup")  # SBERT + meshes + GL

@@ -34,7 +34,7 @@ def test_outputs_written_and_valid(built_scenes):
         assert spec.validation.ok, (key, spec.validation.reason)
         for name in ("scene.xml", "scene_graph.json", "render_front.png", "render_top.png", "render_wrist.png"):
             assert (folder / name).stat().st_size > 100, name
-        assert (folder / "assets" / "franka" / "visual" / "link0.stl").is_file()
+        assert (folder / "assets" / "franka" / "collision" / "link0.stl").is_file()
         pen = next(c for c in spec.validation.checks if c.name == "max_penetration")
         assert pen.value <= 0.001
 

@@ -417,7 +417,7 @@ def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.visual.global_.offwidth = max(640, settings.build.render_width)
     spec.visual.global_.offheight = max(480, settings.build.render_height)
-    spec.visual.quality.shadowsize = 1024
+    spec.visual.quality.shadowsize = 512
     tex = spec.add_texture(name="floor_tex", type=mujoco.mjtTexture.mjTEXTURE_2D, builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
                            rgb1=[0.62, 0.58, 0.52], rgb2=[0.55, 0.5, 0.45], width=256, height=256)
     mat = spec.add_material(name="floor_mat", texrepeat=[6, 6], reflectance=0.05)

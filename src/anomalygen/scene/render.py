@@ -29,10 +29,25 @@ def _gl_context(width: int, height: int):
     if ctx is None or _GL["size"][0] < width or _GL["size"][1] < height:
         if ctx is not None:
             ctx.free()
-        ctx = mujoco.GLContext(max(width, 640), max(height, 480))
+        ctx = _context_class()(max(width, 640), max(height, 480))
         _GL["ctx"], _GL["size"] = ctx, (max(width, 640), max(height, 480))
     ctx.make_current()
     return ctx
+
+
+def _context_class():
+    """EGL when headless, even if mujoco was imported before MUJOCO_GL was set (it then picks GLFW)."""
+    import mujoco
+
+    if not os.environ.get("DISPLAY"):
+        os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+        try:
+            from mujoco.egl import GLContext
+
+            return GLContext
+        except Exception:  # noqa: BLE001 - fall back to whatever mujoco chose
+            pass
+    return mujoco.GLContext
 
 
 class SceneRenderer:

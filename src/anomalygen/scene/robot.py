@@ -82,7 +82,12 @@ def _arm_xml() -> str:
     assets = re.sub(r"<compiler[^>]*/>", "", assets)
     assets = re.sub(r"<option[^>]*/>", "", assets)
     assets = re.sub(r"<size[^>]*/>", "", assets)
+    # Render with the collision meshes (120 KB) instead of the 6.5 MB visual ones: software EGL
+    # rendering and mesh upload were 3-5x slower with them, and the scene builder renders 3 views
+    # of every scene within its per-scene budget. The arm still reads clearly as a Panda.
+    assets = re.sub(r'<mesh name="\w+_viz"[^>]*/>', "", assets)
     chain = _strip_include((root / "chain.xml").read_text())
+    chain = re.sub(r'mesh="(\w+)_viz"', r'mesh="\1_col"', chain)
     chain = chain.replace("robot:panda0_joint", "panda_joint").replace('name="panda0_link', 'name="panda_link')
     chain = re.sub(r"<body name=\"panda0_(left|right)finger\".*?</body>", "", chain, flags=re.S)
     chain = re.sub(r"<site name='end_effector'[^>]*/>", "", chain)
@@ -96,7 +101,8 @@ def _arm_xml() -> str:
 
 def mesh_files() -> list[Path]:
     """Mesh files the robot references, relative to the source meshes folder."""
-    return sorted(p.relative_to(franka_assets_dir() / "meshes") for p in (franka_assets_dir() / "meshes").rglob("*.stl"))
+    files = re.findall(r'file="([^"]+)"', _arm_xml())
+    return sorted(Path(f) for f in set(files))
 
 
 def build_robot_spec(base_xyyaw=(0.0, 0.0, 0.0)) -> mujoco.MjSpec:

@@ -29,8 +29,26 @@ def build_item(item_id: str, payload: str, ctx: StageContext) -> str:
 
     task = TaskProposal.model_validate_json(payload)
     settings = ctx.settings
-    spec = build_scene(task, seed=settings.seed, settings=settings, out_dir=ctx.run.scene_dir(item_id))
+    with _one_torch_thread():
+        spec = build_scene(task, seed=settings.seed, settings=settings, out_dir=ctx.run.scene_dir(item_id))
     return spec.scene_id
+
+
+class _one_torch_thread:
+    """SBERT ranks a few short texts per scene; with two build workers on two cores, torch's own
+    thread pool only thrashes (measured: seconds per scene under load). Restored afterwards, because
+    with one worker the item runs inline in the caller's process."""
+
+    def __enter__(self):
+        import torch
+
+        self.before = torch.get_num_threads()
+        torch.set_num_threads(1)
+
+    def __exit__(self, *exc):
+        import torch
+
+        torch.set_num_threads(self.before)
 
 
 def run_stage(run: RunFolder, settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
