@@ -89,7 +89,22 @@ def bench_run(root: Path, k: int = 3) -> dict:
         "misses": [m.model_dump() for m in report.misses],
         "missing_scenes": len(report.missing_scenes),
         "wall_s": round(wall, 3),
+        "hit_rank": {d.task_id: d.hit_rank for d in dets},
     }
+
+
+def clutter_drop(plain: dict, cluttered: dict) -> dict:
+    """hit@1 of both runs over the tasks built in both (the same tasks, with and without clutter)."""
+    both = sorted(set(plain["hit_rank"]) & set(cluttered["hit_rank"]))
+    if not both:
+        return {"common_scenes": 0}
+
+    def hit1(r: dict) -> float:
+        return sum(1 for t in both if r["hit_rank"][t] == 1) / len(both)
+
+    changed = [t for t in both if (plain["hit_rank"][t] == 1) != (cluttered["hit_rank"][t] == 1)]
+    return {"common_scenes": len(both), "hit1_plain": round(hit1(plain), 4), "hit1_clutter": round(hit1(cluttered), 4),
+            "drop": round(hit1(plain) - hit1(cluttered), 4), "changed": changed}
 
 
 def main() -> None:
@@ -107,7 +122,7 @@ def main() -> None:
     if args.clutter_run:
         out["clutter_run"] = bench_run(args.clutter_run)
         if args.run:
-            out["clutter_hit1_drop"] = round(out["run"]["hit_at"][1] - out["clutter_run"]["hit_at"][1], 4)
+            out["clutter_effect"] = clutter_drop(out["run"], out["clutter_run"])
     print(json.dumps(out, indent=None if args.json else 2, default=str))
 
 

@@ -88,6 +88,16 @@ def test_typical_hazard_objects_break_ties(kb):
     assert [(h.target_object, h.hazard_class) for h in hyps] == [
         ("shoe_0", "reduce_tripping_hazards"), ("cup_0", "reduce_tripping_hazards")]
     assert hyps[0].score == kb.hazard_classes["reduce_tripping_hazards"].severity
+    assert hyps[1].score < hyps[0].score and "not a typical object" in hyps[1].explanation
+
+
+def test_an_incidental_floor_object_does_not_outrank_the_litter(kb):
+    """A cup on the floor fires the generic tripping rule, but the wrapper beside it is the problem."""
+    floor = [g.obj("cup_0", "cup", pos=(0.9, -0.9, 0.05), size=(0.08, 0.08, 0.1)),
+             g.obj("wrapper_0", "wrapper", pos=(1.2, -0.9, 0.01), size=(0.1, 0.08, 0.02))]
+    hyps = RuleDetector(kb).detect(g.scene("s", "kitchen", g.kitchen_furniture() + floor), 3)
+    assert (hyps[0].target_object, hyps[0].hazard_class) == ("wrapper_0", "pick_up_floor_litter")
+    assert ("cup_0", "reduce_tripping_hazards") in [(h.target_object, h.hazard_class) for h in hyps]
 
 
 def test_candidates_cover_every_kb_class_that_fires(kb):

@@ -6,13 +6,14 @@ model's mood. They read only the scene graph (through the same predicates planni
 use), never the task.
 
 Ranking. Each (object, class) pair is one candidate, scored by the class's severity: the knowledge
-base uses severity to settle overlaps between classes, so nothing is added to it. Equal scores are
-broken, in order, by typicality (the object is on the class's curated list of typical hazard objects:
-a shoe in the walkway before a cup that happens to stand there), by specificity (a class with more
-preconditions that all hold explains the object more sharply), then by names, so the order is
-deterministic. When several objects are hazardous, the top of the list should cover them all rather
-than repeat one object under three classes, so each further hypothesis about an object already
-listed pays a diversity penalty.
+base uses severity to settle overlaps between classes. One exception: a class that lists its typical
+hazard objects (only "reduce tripping hazards" does, because it fires on *any* plain object on the
+floor) fires on other objects only weakly, so an apple or a cup that happens to lie on the floor
+scores ATYPICAL_PENALTY lower and does not outrank, say, the litter next to it. Equal scores are
+broken by typicality, by specificity (a class with more preconditions that all hold explains the
+object more sharply), then by names, so the order is deterministic. When several objects are
+hazardous, the top of the list should cover them all rather than repeat one object under three
+classes, so each further hypothesis about an object already listed pays a diversity penalty.
 """
 
 from __future__ import annotations
@@ -21,6 +22,8 @@ from dataclasses import dataclass
 
 from anomalygen.schema import Hypothesis, SceneGraph
 
+#: Score taken off when a class with a curated hazard-object list fires on an object not on it.
+ATYPICAL_PENALTY = 0.2
 #: Penalty for each hypothesis already listed about the same object (coverage of several hazards).
 REPEAT_PENALTY = 0.12
 
@@ -79,8 +82,9 @@ def candidates(graph: SceneGraph, kb=None) -> list[Candidate]:
             slots["container"] = m.bindings.get("$container") or (hc.default_containers[0].replace("_", " ") if hc.default_containers else "a safe place")
             slots["support"] = m.bindings.get("$support") or (hc.default_supports[0].replace("_", " ") if hc.default_supports else "a safe surface")
             solution = _fill(hc.solution, slots) if hc.solution else "; ".join(_fill(str(s), {}) for s in hc.recipe)
-            score = hc.severity
-            typical = category in getattr(hc, "hazard_objects", [])
+            curated = getattr(hc, "hazard_objects", None) or []
+            typical = not curated or category in curated
+            score = hc.severity - (0.0 if typical else ATYPICAL_PENALTY)
             cand = Candidate(
                 hazard_class=hc.id,
                 object=obj,
@@ -91,7 +95,8 @@ def candidates(graph: SceneGraph, kb=None) -> list[Candidate]:
                 specificity=len(hc.preconditions),
                 problem=f"{hc.name}: {obj} ({category.replace('_', ' ')}) — {hc.why}",
                 solution=solution,
-                explanation=f"{hc.id} holds because {_because(hc, graph, m.bindings, evaluate)}",
+                explanation=f"{hc.id} holds because {_because(hc, graph, m.bindings, evaluate)}"
+                + ("" if typical else f" (but a {category} is not a typical object of this class)"),
                 bindings=tuple(sorted(m.bindings.items())),
             )
             key = (obj, hc.id)
