@@ -117,6 +117,10 @@ def print_report(report: DetectionReport, *, console=None, max_misses: int = 20)
     for name, r in report.per_class.items():
         row(f"  {name}", r)
     console.print(table)
+    off = [(t, p, n) for t, row in report.confusion.items() for p, n in row.items() if p != t]
+    if off:
+        console.print("[bold]confusions[/bold] (true class -> top-1 class, count): "
+                      + ", ".join(f"{t} -> {p} x{n}" for t, p, n in sorted(off, key=lambda x: -x[2])), highlight=False)
     if report.misses:
         console.print(f"[bold]misses at rank 1[/bold] ({len(report.misses)}):")
         for m in report.misses[:max_misses]:
