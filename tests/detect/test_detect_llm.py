@@ -77,6 +77,8 @@ def test_llm_detector_end_to_end(scripted_server, tmp_path):
     assert report.judge_methods == {"exact": 2, "sbert": 1}
     manifest = run.load_manifest()
     assert manifest.llm_usage.requests == 4
+    # the real key reaches the server (settings cross to the item as JSON, which masks secrets)
+    assert all(h.get("Authorization", h.get("authorization")) == "Bearer sk-test-not-a-real-key" for h in srv.headers)
 
 
 def test_a_scene_whose_replies_never_validate_fails_alone(scripted_server, tmp_path):

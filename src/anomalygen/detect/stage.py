@@ -10,7 +10,6 @@ print the hit@k table.
 
 from __future__ import annotations
 
-import functools
 from typing import Any
 
 from anomalygen.errors import ItemFailed, UserError
@@ -29,13 +28,22 @@ def detection_path(run: RunFolder, task_id: str):
     return run.detections_dir / f"{task_id}.json"
 
 
-@functools.cache
-def _client(llm_json: str):
-    """One LLM client per process and configuration (its cache and HTTP pool are reused across scenes)."""
-    from anomalygen.config import LLMConfig
+_CLIENTS: dict[tuple[str, str], object] = {}
+
+
+def _client(llm):
+    """One LLM client per process and configuration (its cache and HTTP pool are reused across scenes).
+
+    Keyed by the config's JSON plus the secret itself: the JSON masks the API key, so rebuilding the
+    config from it would send '**********' to the server.
+    """
     from anomalygen.llm import get_client
 
-    return get_client(LLMConfig.model_validate_json(llm_json))
+    secret = llm.api_key.get_secret_value() if llm.api_key is not None else ""
+    key = (llm.model_dump_json(), secret)
+    if key not in _CLIENTS:
+        _CLIENTS[key] = get_client(llm)
+    return _CLIENTS[key]
 
 
 def make_detector(settings):
@@ -47,7 +55,7 @@ def make_detector(settings):
         return RuleDetector()
     if not settings.llm.configured:
         raise UserError(f"detector '{name}' needs an LLM: pass --backend openai|anthropic|llamacpp (or use --detector rules)")
-    client = _client(settings.llm.model_dump_json())
+    client = _client(settings.llm)
     if name == "llm":
         from anomalygen.detect.llm_detector import LLMDetector
 
@@ -62,7 +70,7 @@ def make_judge(settings):
 
     client = None
     if settings.llm.configured and settings.detect.llm_judge:
-        client = _client(settings.llm.model_dump_json())
+        client = _client(settings.llm)
     # Rule and hybrid hypotheses name a knowledge-base class, so the exact comparison decides them.
     decisive = settings.detect.detector in ("rules", "hybrid")
     return Judge(threshold=settings.detect.judge_threshold, llm_client=client, structured_decisive=decisive)
@@ -111,7 +119,10 @@ def _item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str,
     if graph is None:
         raise ItemFailed(f"no valid scene_graph.json in {scene_dir} (build the scene first)")
     spec = try_read_model(scene_dir / "scene.json", SceneSpec)
-    task = TaskProposal.model_validate(payload)
+    task = TaskProposal.model_validate(payload["task"])
+    if payload.get("llm_api_key"):
+        # StageContext carries settings as JSON, which masks the key ("**********"); restore it.
+        settings.llm.api_key = payload["llm_api_key"]
     detector = make_detector(settings)
     judge = make_judge(settings)
     client = getattr(detector, "client", None) or judge.llm
@@ -152,7 +163,8 @@ def run_stage(run: RunFolder, settings, *, force: bool = False, only: list[str] 
     if only and len(built) < len(chosen):
         missing = sorted({t.id for t in chosen} - {t.id for t in built})
         raise UserError(f"no built scene for: {', '.join(missing)} (run 'anomalygen build' first)")
-    items = [(t.id, t.model_dump(mode="json")) for t in built]
+    secret = settings.llm.api_key.get_secret_value() if settings.llm.api_key is not None else None
+    items = [(t.id, {"task": t.model_dump(mode="json"), "llm_api_key": secret}) for t in built]
     summary = run_items(run, STAGE, items, _item, settings=settings, is_done=_is_done_for(run, settings), force=force,
                         description=f"detect ({settings.detect.detector})")
     _record_llm_usage(run, summary)
