@@ -213,7 +213,7 @@ def _emit(mujoco, part: Part, body, scale: float, offset: np.ndarray, joints: li
             pos=list(np.asarray(g.pos) * scale + offset),
             quat=list(g.quat),
             rgba=list(g.rgba),
-            density=g.density,
+            density=g.mass_density,
         )
         if g.name:
             geom.name = g.name

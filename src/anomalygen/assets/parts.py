@@ -77,6 +77,12 @@ class Geom:
             local = (s[0], s[0], s[1] + s[0])
         return np.abs(quat_to_mat(self.quat)) @ np.asarray(local)
 
+    @property
+    def mass_density(self) -> float:
+        """Decorative (non-colliding) geoms are massless: a label or a mould spot must not shift the
+        centre of mass and make an object roll."""
+        return self.density if self.collide else 0.0
+
     def volume(self) -> float:
         s = self.size
         if self.kind == "box":
@@ -272,14 +278,14 @@ class Part:
         return lo, hi
 
     def mass(self) -> float:
-        return sum(g.volume() * g.density for p, _, _ in self.walk() for g in p.geoms)
+        return sum(g.volume() * g.mass_density for p, _, _ in self.walk() for g in p.geoms)
 
     def subtree_inertia(self, about: np.ndarray) -> float:
         """Rough moment of inertia of this subtree about a point (for joint damping/armature)."""
         total = 0.0
         for part, pos, rot in self.walk():
             for g in part.geoms:
-                m = g.volume() * g.density
+                m = g.volume() * g.mass_density
                 c = pos + rot @ np.asarray(g.pos)
                 total += m * (float(np.sum((c - about) ** 2)) + float(np.sum(g.half_extents() ** 2)) / 3)
         return total
@@ -289,7 +295,7 @@ class Part:
         m, acc = 0.0, np.zeros(3)
         for part, pos, rot in self.walk():
             for g in part.geoms:
-                gm = g.volume() * g.density
+                gm = g.volume() * g.mass_density
                 m += gm
                 acc += gm * (pos + rot @ np.asarray(g.pos))
         return acc / max(m, 1e-12)

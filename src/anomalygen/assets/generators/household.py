@@ -595,7 +595,7 @@ def _shoe(rng, slipper: bool):
     if slipper:
         r.ellipsoid((L * 0.4, w * 1.0, 0.03), (L * 0.45, 0, 0.02), c, 200)
     else:
-        r.ellipsoid((L * 0.95, w * 0.95, 0.05), (0, 0, 0.03), c, 300)
+        r.ellipsoid((L * 0.95, w * 0.95, 0.045), (0, 0, 0.055), c, 300)  # above the sole, so it rests flat
         r.box((L * 0.25, w * 0.9, 0.035), (-L * 0.7, 0, 0.05), c, 300)
     return _d(r, [colour_name(c)], length=2 * L)
 
