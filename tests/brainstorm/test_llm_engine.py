@@ -148,17 +148,19 @@ def test_tiny_gguf_mechanics(tmp_path):
 
     settings = Settings(
         quiet=True,
-        llm={"backend": "llamacpp", "cache_path": str(tmp_path / "c.sqlite"), "repair_retries": 0, "max_tokens": 384},
+        llm={"backend": "llamacpp", "cache_path": str(tmp_path / "c.sqlite"), "repair_retries": 0, "max_tokens": 96},
         brainstorm={"engine": "llm", "n": 1, "agents": 1, "rounds": 1},
     )
     run = RunFolder.create(tmp_path / "run", settings=settings)
-    from anomalygen.errors import UserError
+    summary = run_stage(run, settings)
+    # The 135M model seldom names real catalogue objects: ending as per-item errors is accepted, but
+    # the round must have run and the file must be well-formed either way.
+    from anomalygen.runfolder import read_jsonl
+    from anomalygen.schema import TaskProposal
 
-    try:
-        summary = run_stage(run, settings)
-    except UserError as exc:  # the 135M model rarely names real catalogue objects: a per-item error is fine
-        assert "no valid proposals" in str(exc)
-        assert run.errors("brainstorm") or True
-        return
-    assert summary.done == 1
-    assert run.load_tasks()
+    tasks = read_jsonl(run.tasks_path, TaskProposal)
+    assert summary.done == len(tasks) <= 1
+    if not tasks:
+        assert summary.failed >= 1 and run.errors("brainstorm")
+    manifest = json.loads(run.manifest_path.read_text())
+    assert manifest["llm_usage"]["requests"] >= 1

@@ -133,7 +133,7 @@ def to_proposal(
             room=idea.room,
             placement=idea.placement,
             person_at_risk=idea.person,
-            container=idea.container or idea.support,
+            container=idea.container,
             co_objects=list(idea.co_objects),
         ),
         auxiliary_items=auxiliary_items(idea, kb),
