@@ -247,6 +247,16 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
             continue
         aux.append(choose(cat, ObjectRole.AUXILIARY))
 
+    # Classes with both $target and $hazard (a closed window and a hot source) when the scenario
+    # names the target as its hazard object: $hazard is the co-object with the class's properties.
+    hazard_var = hazard
+    if hc is not None and hazard is target and {"$hazard", "$target"} <= variables:
+        hazard_var = _co_object_for(hc, kb, aux)
+        if hazard_var is None:
+            raise ItemFailed(f"no co-object can play $hazard for a {hc.id} scene")
+        hazard_var.role = ObjectRole.HAZARD
+        target.role = ObjectRole.TARGET
+
     # Initial joint states: the task's articulations and the class template.
     uses: dict[str, list[tuple[str, str]]] = {}
     for a in task.articulations:
@@ -307,7 +317,7 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
             lay.place_on_floor(hp, relevant=True, face=False, clear_of=fixtures)
         elif support is not None:
             edge = support_kind.endswith("_edge")
-            lay.place_on_surface(hp, support, _surface_of(support), edge=edge, inward=0.0 if edge else 0.13)
+            lay.place_on_surface(hp, support, _surface_of(support), edge=edge, inward=0.0 if edge else 0.13, near_side=0.4)
         elif kind == "inside" and parent is not None:
             ppl = placed.get(parent.name)
             if ppl is None:
@@ -351,7 +361,7 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
 
     focus = placed[hazard.name]
     lay.fit_base(focus, holder=placed.get(focus.inside) if focus.inside else None)
-    bindings = {"$hazard": hazard.name, "$target": target.name}
+    bindings = {"$hazard": hazard_var.name, "$target": target.name}
     if container is not None:
         bindings["$container"] = container.name
     if support_var is not None:
@@ -363,6 +373,21 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
     if kind == "inside" and parent is not None and container is None:
         bindings["$container"] = parent.name
     return lay, bindings, placed
+
+
+def _co_object_for(hc, kb, candidates) -> select.Chosen | None:
+    """The first candidate whose KB properties satisfy every has_property precondition on $hazard."""
+    calls = [c for c in hc.preconditions if c.name == "has_property" and c.args.get("object") == "$hazard"]
+    for ch in candidates:
+        info = kb.objects.get(ch.catalogue)
+        props = set(info.properties) if info is not None else set()
+        ok = True
+        for c in calls:
+            has = bool(props & {p.strip() for p in str(c.args.get("property", "")).split("|")})
+            ok &= has != c.negate
+        if ok:
+            return ch
+    return None
 
 
 def _table_height_ok(asset) -> bool:
@@ -458,7 +483,14 @@ def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
         if not p.fixed:
             body.add_freejoint(name=f"{p.name}/free")
             loose.append(p.name)
-        p.asset.attach(body, f"{p.name}/")
+        root = p.asset.attach(body, f"{p.name}/")
+        if not p.fixed:
+            # Rolling and torsional friction (condim 6): a needle or pencil must not roll for ever.
+            # A 1 mm contact margin stops needles and coins tunnelling into a table top.
+            for geom in _geoms_below(root):
+                geom.condim = 6
+                geom.friction = [max(geom.friction[0], 0.8), 0.01, 0.002]
+                geom.margin = max(geom.margin, 0.001)
     robot.add_suction_welds(spec, loose)
     task_objects = [p for p in placed.values() if p.role != ObjectRole.CLUTTER]
     add_observation_sensors(
@@ -469,6 +501,38 @@ def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
     )
     spec.add_key(name="init")
     return spec
+
+
+def _geoms_below(body) -> list:
+    out = list(body.geoms)
+    for child in body.bodies:
+        out.extend(_geoms_below(child))
+    return out
+
+
+def _latch_switched_on(model, placed: dict[str, Placed], mjspec) -> None:
+    """A spring-returned button set to 'on' is modelled as latched (a kettle's switch stays down):
+    its return spring is removed so the hazard state persists; friction keeps it where it is set."""
+    import mujoco
+
+    for p in placed.values():
+        if p.asset is None:
+            continue
+        for j in p.asset.joints:
+            value = p.joint_values.get(j.name)
+            if value is None or abs(value - j.closed_value) < 1e-9:
+                continue
+            jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{p.name}/{j.name}")
+            if jid < 0 or model.jnt_stiffness[jid] <= 0:
+                continue
+            stiffness = float(model.jnt_stiffness[jid])
+            model.jnt_stiffness[jid] = 0.0
+            dof = model.jnt_dofadr[jid]
+            hold = stiffness * abs(value - j.closed_value) * 1.5
+            model.dof_frictionloss[dof] = max(model.dof_frictionloss[dof], hold)
+            sj = mjspec.joint(f"{p.name}/{j.name}")
+            sj.stiffness = [0.0] * len(sj.stiffness) if hasattr(sj.stiffness, "__len__") else 0.0
+            sj.frictionloss = float(model.dof_frictionloss[dof])
 
 
 def _hold_gravity_hinges(model, placed: dict[str, Placed], mjspec) -> None:
@@ -485,7 +549,8 @@ def _hold_gravity_hinges(model, placed: dict[str, Placed], mjspec) -> None:
         if p.asset is None:
             continue
         for j in p.asset.joints:
-            if j.type != "hinge" or abs(j.axis[2]) > 0.7:
+            vertical_slide = j.type == "slide" and abs(j.axis[2]) > 0.7
+            if not vertical_slide and (j.type != "hinge" or abs(j.axis[2]) > 0.7):
                 continue
             jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{p.name}/{j.name}")
             if jid < 0:
@@ -493,7 +558,7 @@ def _hold_gravity_hinges(model, placed: dict[str, Placed], mjspec) -> None:
             body = model.jnt_bodyid[jid]
             mass = model.body_subtreemass[body]
             lever = float(np.linalg.norm(model.body_ipos[body])) + 0.5 * float(np.max(model.body_inertia[body]) / max(mass, 1e-6)) ** 0.5
-            friction = 1.3 * mass * g * max(lever, 0.02)
+            friction = 1.3 * mass * g * (1.0 if vertical_slide else max(lever, 0.02))
             dof = model.jnt_dofadr[jid]
             model.dof_frictionloss[dof] = max(model.dof_frictionloss[dof], friction)
             mjspec.joint(f"{p.name}/{j.name}").frictionloss = float(model.dof_frictionloss[dof])
@@ -520,6 +585,7 @@ def _attempt(task: TaskProposal, seed: int, settings, attempt: int) -> Built:
     model = mjspec.compile()
     data = mujoco.MjData(model)
     _hold_gravity_hinges(model, placed, mjspec)
+    _latch_switched_on(model, placed, mjspec)
     robot.set_home(model, data, tuple(lay.base))
     _set_joints(model, data, placed)
     mujoco.mj_forward(model, data)
@@ -530,6 +596,8 @@ def _attempt(task: TaskProposal, seed: int, settings, attempt: int) -> Built:
         return Built(spec, mjspec, model, data, report, None)
     nsteps = max(1, int(round(settings.build.settle_s / model.opt.timestep)))
     mujoco.mj_step(model, data, nstep=nsteps)
+    if val.max_loose_speed(model, data, placed) > val.MAX_LIN_VEL:
+        mujoco.mj_step(model, data, nstep=nsteps)  # something still rolls: give it one more settle
     mujoco.mj_forward(model, data)
     spec = _scene_spec(task, seed, lay, placed, bindings, model, data)
     graph = scene_graph(model, data, spec)

@@ -174,32 +174,41 @@ class Layout:
         edge: bool = False,
         inward: float = 0.0,
         label: str | None = None,
+        near_side: float | None = None,
     ) -> None:
         """Rest ``obj`` on a rectangle (world lo_xy, hi_xy, top z) of ``holder``.
 
         ``edge``: the footprint ends 1.5-7 cm from the surface edge that faces the robot (the
-        knowledge base counts <= 12 cm as "near the edge"). ``inward``: keep this far from all edges.
+        knowledge base counts <= 12 cm as "near the edge"). ``inward``: keep this far from all edges
+        (less when the object is too big for that). ``near_side``: the object's centre at most this
+        far from the robot-facing edge, so the arm reaches it from beside the support.
         """
         lo_xy, hi_xy, top = surface
+        to_base = self.base[:2] - (lo_xy + hi_xy) / 2
+        axis = int(np.argmax(np.abs(to_base)))
+        sign = np.sign(to_base[axis]) or -1.0
         for _ in range(TRIES):
             obj.yaw = float(self.rng.choice([0.0, math.pi / 2, math.pi, -math.pi / 2]) + self.rng.uniform(-0.15, 0.15))
             half = obj.world_half()
-            room = (hi_xy - lo_xy) / 2 - half[:2] - inward
-            if np.any(room < 0):
+            slack = (hi_xy - lo_xy) / 2 - half[:2]
+            if np.any(slack < 0):
                 obj.yaw = 0.0 if (obj.hi - obj.lo)[0] <= (obj.hi - obj.lo)[1] else math.pi / 2
                 half = obj.world_half()
-                room = (hi_xy - lo_xy) / 2 - half[:2] - inward
-                if np.any(room < -1e-6):
+                slack = (hi_xy - lo_xy) / 2 - half[:2]
+                if np.any(slack < -1e-6):
                     raise ItemFailed(f"{obj.name} ({2 * half[0]:.2f}x{2 * half[1]:.2f} m) does not fit on {holder.name}")
-            center = (lo_xy + hi_xy) / 2 + self.rng.uniform(-1, 1, size=2) * np.maximum(room, 0)
+            room = np.where(slack - inward >= 0, slack - inward, 0.0)
+            center = (lo_xy + hi_xy) / 2 + self.rng.uniform(-1, 1, size=2) * room
+            bound = hi_xy[axis] if sign > 0 else lo_xy[axis]
             if edge:
                 # The robot-facing edge of the surface: the side whose outward normal points to the base.
-                to_base = self.base[:2] - (lo_xy + hi_xy) / 2
-                axis = int(np.argmax(np.abs(to_base)))
-                sign = np.sign(to_base[axis]) or -1.0
                 gap = self.rng.uniform(*EDGE_BAND)
-                bound = hi_xy[axis] if sign > 0 else lo_xy[axis]
                 center[axis] = bound - sign * (half[axis] + gap)
+            elif near_side is not None:
+                depth = abs(center[axis] - bound)
+                if depth > near_side:
+                    lo_d = min(near_side, half[axis] + min(inward, max(slack[axis], 0.0)))
+                    center[axis] = bound - sign * self.rng.uniform(lo_d, max(lo_d, near_side))
             cl = (obj.hi + obj.lo) / 2
             c, s = math.cos(obj.yaw), math.sin(obj.yaw)
             offset = np.array([c * cl[0] - s * cl[1], s * cl[0] + c * cl[1]])

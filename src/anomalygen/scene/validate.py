@@ -50,6 +50,17 @@ def _who(model, spec, owner, geom) -> str:
     return "the robot" if o == -2 else "the room"
 
 
+def max_loose_speed(model, data, placed) -> float:
+    """Largest linear speed of any loose (free-jointed) object."""
+    best = 0.0
+    for p in placed.values():
+        if p.fixed:
+            continue
+        v = data.joint(f"{p.name}/free").qvel
+        best = max(best, float(np.linalg.norm(v[:3])), 0.1 * float(np.linalg.norm(v[3:])))
+    return best
+
+
 def validate(model, data, spec: SceneSpec, graph, hc) -> ValidationReport:
     """Physics and hazard checks of the current (settled) state."""
     owner = _owners(model, spec)
