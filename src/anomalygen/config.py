@@ -49,7 +49,7 @@ class BrainstormConfig(Section):
     n: int = Field(111, ge=1, description="number of proposals to keep")
     agents: int = Field(10, ge=1)
     rounds: int = Field(3, ge=1)
-    novelty_threshold: float = Field(0.92, gt=0, le=1, description="SBERT cosine above which a proposal is a duplicate")
+    novelty_threshold: float = Field(0.85, gt=0, le=1, description="SBERT cosine above which a proposal is a duplicate")
     tasks_file: str | None = Field(None, description="bring your own tasks.jsonl instead of brainstorming")
 
 

@@ -54,9 +54,13 @@ def generate_mode(
     per_run: int,
     agents: int = 10,
     rounds: int = 3,
-    novelty_threshold: float = 0.92,
+    novelty_threshold: float | None = None,
     embed_fn: Callable | None = None,
 ) -> list[TaskProposal]:
+    if novelty_threshold is None:
+        from anomalygen.config import BrainstormConfig
+
+        novelty_threshold = BrainstormConfig().novelty_threshold
     out: list[TaskProposal] = []
     for run in range(runs):
         engine = KnowledgeEngine(

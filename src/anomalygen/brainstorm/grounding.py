@@ -190,7 +190,16 @@ class Grounder:
                         continue
                     plan.append((sid, str(aspect), src))
                     break
-            idea = self._apply(rng, plan, agent=agent, agent_index=agent_index, round_=round_)
+            # Whatever is not borrowed should move away from the sources: a new idea, not a copy.
+            saved = self.seen
+            self.seen = dict(saved)
+            for _, src in chosen:
+                for key in (src.class_id, src.hazard, src.target, src.room, src.placement):
+                    self.seen[key] = self.seen.get(key, 0) + 2
+            try:
+                idea = self._apply(rng, plan, agent=agent, agent_index=agent_index, round_=round_)
+            finally:
+                self.seen = saved
             if idea is not None and all(idea.key() != src.key() for _, src in chosen):
                 return idea
         return None

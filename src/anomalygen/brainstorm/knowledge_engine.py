@@ -64,7 +64,7 @@ class KnowledgeEngine:
         mode: BrainstormMode = BrainstormMode.BRAINSTORM,
         agents: int = 10,
         rounds: int = 3,
-        novelty_threshold: float = 0.92,
+        novelty_threshold: float = 0.85,
         unique: bool = True,
         targets: list[str] | None = None,
         embed_fn: EmbedFn | None = None,
