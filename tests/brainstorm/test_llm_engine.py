@@ -164,3 +164,15 @@ def test_tiny_gguf_mechanics(tmp_path):
         assert summary.failed >= 1 and run.errors("brainstorm")
     manifest = json.loads(run.manifest_path.read_text())
     assert manifest["llm_usage"]["requests"] >= 1
+
+
+def test_llm_ablation_modes(scripted_server, tmp_path):
+    srv = scripted_server(Responder())
+    cfg = llm_config_for(srv, tmp_path, cache=False)
+    plain = _engine(cfg, agents=4, rounds=3, mode="plain").run(2)
+    assert [t.provenance.agent_role for t in plain] == [None]  # one role-less call asked for both
+    assert "You are the" not in srv.requests[-1]["messages"][0]["content"]
+    srv.requests.clear()
+    roleplay = _engine(cfg, agents=3, rounds=3, mode="roleplay").run(3)
+    assert {t.provenance.round for t in roleplay} == {1}
+    assert len({t.provenance.agent_role for t in roleplay}) == 3 and len(srv.requests) == 3
