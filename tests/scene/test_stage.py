@@ -34,6 +34,11 @@ def test_knowledge_engine_tasks_build_end_to_end(tmp_path):
     write_jsonl(run.tasks_path, generate(5, seed=3))
     summary = run_stage(run, Settings(workers=1, quiet=True))
     assert summary.done >= 4, summary.errors
+    from anomalygen.scene.stage import revalidate_run
+
+    rechecked = revalidate_run(run)
+    assert len(rechecked) == summary.done
+    assert all(reason is None for reason in rechecked.values()), rechecked
     for task in run.load_tasks():
         if task.id in summary.errors:
             assert "\n" not in summary.errors[task.id]

@@ -20,6 +20,7 @@ RewardSpec/SuccessSpec evaluation; ``env.graph()`` gives the current SceneGraph.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from pathlib import Path
 
@@ -142,34 +143,46 @@ class SceneEnv(gym.Env):
         return self._observe(), {}
 
     def step(self, action):
-        # Scalar Python maths on 7 numbers beats a dozen tiny numpy calls: this is the hot path.
-        mj, d = self._mj, self.data
+        # Scalar Python maths on 7 numbers beats a dozen tiny numpy/mju calls: this is the hot path.
+        d = self.data
         try:
             a = action.tolist()
         except AttributeError:
             a = list(action)
         dp, dr = self.max_delta_pos, self.max_delta_rot
-        mpos, cup = self._v_mpos, self._v_cup
-        for i in range(3):
-            # move the target, but keep it within 8 cm of the cup (no runaway target)
-            v = mpos[i] + (a[i] if -1.0 <= a[i] <= 1.0 else (1.0 if a[i] > 0 else -1.0)) * dp
-            c = cup[i]
-            mpos[i] = c - 0.08 if v < c - 0.08 else (c + 0.08 if v > c + 0.08 else v)
-        rx, ry, rz = (min(1.0, max(-1.0, a[3])) * dr, min(1.0, max(-1.0, a[4])) * dr, min(1.0, max(-1.0, a[5])) * dr)
+        mx, my, mz = self._v_mpos.tolist()
+        cx, cy, cz = self._v_cup.tolist()
+        ax = a[0] if -1.0 <= a[0] <= 1.0 else (1.0 if a[0] > 0 else -1.0)
+        ay = a[1] if -1.0 <= a[1] <= 1.0 else (1.0 if a[1] > 0 else -1.0)
+        az = a[2] if -1.0 <= a[2] <= 1.0 else (1.0 if a[2] > 0 else -1.0)
+        # move the target, but keep it within 8 cm of the cup (no runaway target)
+        mx = min(max(mx + ax * dp, cx - 0.08), cx + 0.08)
+        my = min(max(my + ay * dp, cy - 0.08), cy + 0.08)
+        mz = min(max(mz + az * dp, cz - 0.08), cz + 0.08)
+        self._v_mpos[:] = (mx, my, mz)
+        rx = min(1.0, max(-1.0, a[3])) * dr
+        ry = min(1.0, max(-1.0, a[4])) * dr
+        rz = min(1.0, max(-1.0, a[5])) * dr
         angle = (rx * rx + ry * ry + rz * rz) ** 0.5
         if angle > 1e-9:
-            axis = self._axis
-            axis[0], axis[1], axis[2] = rx / angle, ry / angle, rz / angle
-            mj.mju_axisAngle2Quat(self._dq, axis, angle)
-            mj.mju_mulQuat(self._qtmp, self._dq, self._v_mquat)
-            self._v_mquat[:] = self._qtmp
+            # world-frame rotation: q_new = q(axis, angle) * q_target
+            h = 0.5 * angle
+            sh = math.sin(h) / angle
+            w1, x1, y1, z1 = math.cos(h), rx * sh, ry * sh, rz * sh
+            w2, x2, y2, z2 = self._v_mquat.tolist()
+            w = w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2
+            x = w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2
+            y = w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2
+            z = w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2
+            n = (w * w + x * x + y * y + z * z) ** 0.5
+            self._v_mquat[:] = (w / n, x / n, y / n, z / n)
         if a[6] > 0.0:
             if self._held_eq < 0:
                 self._try_grab()
         elif self._held_eq >= 0:
             d.eq_active[self._held_eq] = 0
             self._held_eq = -1
-        mj.mj_step(self.model, d, self.frameskip)
+        self._mj.mj_step(self.model, d, self.frameskip)
         self.t += 1
         if self._use_sensors:  # inlined _observe fast path
             self._o_sens[:] = self._v_sens

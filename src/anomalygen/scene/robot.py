@@ -148,7 +148,7 @@ def build_robot_spec(base_xyyaw=(0.0, 0.0, 0.0)) -> mujoco.MjSpec:
     )
     cup.add_site(name="suction_site", pos=[0, 0, 0.031], size=[0.006, 0, 0], rgba=[1, 0.2, 0.2, 1])
     cup.add_site(name="ee_site", pos=[0, 0, 0.031], size=[0.004, 0, 0], rgba=[0.2, 1, 0.2, 0])
-    cup.add_camera(name="wrist", pos=[0.06, 0, -0.02], quat=_quat_look_down_wrist(), fovy=70.0)
+    cup.add_camera(name="wrist", pos=[0.05, 0, 0.0], xyaxes=_wrist_xyaxes(), fovy=65.0)
     # Position actuators: base then arm, in ROBOT_JOINTS order.
     for name, kp, frc in (("base_x", 4000, 1000), ("base_y", 4000, 1000), ("base_yaw", 2000, 500)):
         act = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
@@ -173,9 +173,16 @@ def build_robot_spec(base_xyyaw=(0.0, 0.0, 0.0)) -> mujoco.MjSpec:
     return spec
 
 
-def _quat_look_down_wrist() -> list[float]:
-    """Wrist camera looks along the cup's +z (MuJoCo cameras look along their -z)."""
-    return [0.0, 1.0, 0.0, 0.0]
+def _wrist_xyaxes(tilt: float = 0.3) -> list[float]:
+    """Wrist camera axes in the cup frame: looking out of the cup (+z), tilted ``tilt`` rad towards
+    the cup's +x (away from the base at the home pose), so it sees what lies ahead of the cup."""
+    look = np.array([np.sin(tilt), 0.0, np.cos(tilt)])
+    right = np.cross(look, [0.0, 0.0, -1.0])
+    if np.linalg.norm(right) < 1e-6:
+        right = np.array([0.0, 1.0, 0.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, look)
+    return [*right.tolist(), *up.tolist()]
 
 
 def add_suction_welds(spec: mujoco.MjSpec, object_bodies: list[str]) -> None:

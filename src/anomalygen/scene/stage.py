@@ -102,3 +102,24 @@ def write_contact_sheet(run: RunFolder, *, seed: int = 0, n: int = SHEET_N) -> P
     out = run.scenes_dir / "contact_sheet.png"
     atomic_write_bytes(out, buf.getvalue())
     return out
+
+
+def revalidate_run(run: RunFolder, settings=None) -> dict[str, str | None]:
+    """Re-check every built scene from its files alone: load scene.xml at its settled keyframe,
+    rebuild the scene graph and evaluate the hazard class's preconditions (and penetration) again.
+    Returns task id -> None when valid, else the reason. Used by tests and the acceptance run."""
+    from anomalygen.knowledge import load_kb
+    from anomalygen.scene.graph import load_scene, scene_graph
+    from anomalygen.scene.validate import validate
+
+    kb = load_kb()
+    out: dict[str, str | None] = {}
+    for task in run.load_tasks():
+        folder = run.scene_dir(task.id)
+        if not scene_ok(folder):
+            continue
+        model, data, spec = load_scene(folder)
+        graph = scene_graph(model, data, spec)
+        report = validate(model, data, spec, graph, kb.hazard_classes.get(task.hazard_class))
+        out[task.id] = None if report.ok else report.reason
+    return out
