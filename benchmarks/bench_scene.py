@@ -54,11 +54,11 @@ def _task(i: int):
 
 
 def bench_build(n: int) -> dict:
+    import torch
+
     from anomalygen.config import Settings
     from anomalygen.errors import ItemFailed
     from anomalygen.scene.build import build_scene
-
-    import torch
 
     torch.set_num_threads(1)  # as the build stage's workers do (scene/stage.py)
     settings = Settings()
@@ -151,7 +151,12 @@ def main(argv=None) -> int:
     scene = Path(build["scene_dir"]) / "s2"  # the knife-on-counter scene (robot + furniture + objects)
     if not (scene / "scene.json").exists():
         scene = next(p.parent for p in Path(build["scene_dir"]).glob("*/scene.json"))
-    result = {"build": build, "env": bench_env(scene, args.steps), "machine": f"{os.cpu_count()} cpu", "load_avg": os.getloadavg()[0]}
+    result = {
+        "build": build,
+        "env": bench_env(scene, args.steps),
+        "machine": f"{os.cpu_count()} cpu",
+        "load_avg": os.getloadavg()[0],
+    }
     print(json.dumps(result, indent=2))
     return 0
 

@@ -10,7 +10,18 @@ from anomalygen.config import Settings
 from anomalygen.schema import TaskProposal
 
 
-def make_task(task_id, hazard_class, target, hazard, placement, *, container=None, articulations=(), room="kitchen", co=()):
+def make_task(
+    task_id,
+    hazard_class,
+    target,
+    hazard,
+    placement,
+    *,
+    container=None,
+    articulations=(),
+    room="kitchen",
+    co=(),
+):
     return TaskProposal(
         id=task_id,
         name=f"task {task_id}",
@@ -19,7 +30,9 @@ def make_task(task_id, hazard_class, target, hazard, placement, *, container=Non
         category="household_hazard",
         hazard_class=hazard_class,
         target_asset=target,
-        scenario=dict(hazard_object=hazard, room=room, placement=placement, container=container, co_objects=list(co)),
+        scenario=dict(
+            hazard_object=hazard, room=room, placement=placement, container=container, co_objects=list(co)
+        ),
         articulations=[dict(object=o, part=p, initial_state=s) for o, p, s in articulations],
         provenance=dict(engine="knowledge", mode="brainstorm"),
     )
@@ -27,9 +40,18 @@ def make_task(task_id, hazard_class, target, hazard, placement, *, container=Non
 
 TASKS = {
     "floor": make_task("t-floor", "remove_choking_hazards", "Safe", "button_battery", "floor"),
-    "fridge": make_task("t-fridge", "close_open_refrigerator", "Refrigerator", "Refrigerator", "floor", articulations=[("Refrigerator", "door", "open")]),
+    "fridge": make_task(
+        "t-fridge",
+        "close_open_refrigerator",
+        "Refrigerator",
+        "Refrigerator",
+        "floor",
+        articulations=[("Refrigerator", "door", "open")],
+    ),
     "knife_edge": make_task("t-knife", "store_sharp_objects", "Table", "kitchen_knife", "counter_edge"),
-    "drawer": make_task("t-drawer", "secure_medications", "StorageFurniture", "pill_bottle", "inside:StorageFurniture"),
+    "drawer": make_task(
+        "t-drawer", "secure_medications", "StorageFurniture", "pill_bottle", "inside:StorageFurniture"
+    ),
 }
 
 

@@ -1,8 +1,6 @@
 """Scene building: the hazard is physically real in the settled scene, outputs are complete."""
 
-import json
 import math
-import os
 import subprocess
 import sys
 
@@ -13,8 +11,8 @@ import pytest
 from anomalygen.knowledge import load_kb
 from anomalygen.knowledge.predicates import evaluate
 from anomalygen.runfolder import read_model
-from anomalygen.schema import SceneGraph, SceneSpec
 from anomalygen.scene.graph import load_scene, scene_graph
+from anomalygen.schema import SceneGraph, SceneSpec
 
 from .conftest import TASKS
 
@@ -32,7 +30,13 @@ def test_outputs_written_and_valid(built_scenes):
     for key, folder in built_scenes.items():
         spec = read_model(folder / "scene.json", SceneSpec)
         assert spec.validation.ok, (key, spec.validation.reason)
-        for name in ("scene.xml", "scene_graph.json", "render_front.png", "render_top.png", "render_wrist.png"):
+        for name in (
+            "scene.xml",
+            "scene_graph.json",
+            "render_front.png",
+            "render_top.png",
+            "render_wrist.png",
+        ):
             assert (folder / name).stat().st_size > 100, name
         assert (folder / "assets" / "franka" / "collision" / "link0.stl").is_file()
         pen = next(c for c in spec.validation.checks if c.name == "max_penetration")
@@ -52,7 +56,9 @@ def test_robot_stands_at_its_base_pose(built_scenes):
 def test_scene_xml_loads_from_any_cwd(built_scenes, tmp_path):
     xml = built_scenes["floor"] / "scene.xml"
     code = f"import mujoco; m = mujoco.MjModel.from_xml_path({str(xml)!r}); print(m.nbody)"
-    out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, check=True)
+    out = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, check=True
+    )
     assert int(out.stdout.strip()) > 10
 
 
@@ -114,7 +120,12 @@ def test_graph_carries_no_task_text(built_scenes):
     for key, folder in built_scenes.items():
         text = (folder / "scene_graph.json").read_text().lower()
         task = TASKS[key]
-        for secret in (task.name.lower(), task.description.lower(), task.hazard_class.lower(), task.id.lower()):
+        for secret in (
+            task.name.lower(),
+            task.description.lower(),
+            task.hazard_class.lower(),
+            task.id.lower(),
+        ):
             assert secret not in text, (key, secret)
 
 

@@ -14,7 +14,7 @@ def test_spaces_and_step(built_scenes):
     assert obs.shape == env.observation_space.shape
     L = env.obs_layout
     assert L["robot_qpos"].stop - L["robot_qpos"].start == 10
-    for t in range(5):
+    for _ in range(5):
         obs, reward, terminated, truncated, _ = env.step(env.action_space.sample())
         assert np.all(np.isfinite(obs))
     assert truncated and not terminated

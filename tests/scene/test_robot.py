@@ -48,7 +48,11 @@ def test_suction_grabs_only_when_touching_and_carries_the_object():
     above = box_top + offset + [0, 0, 0.15]
     for i in range(1500):  # move above the box, then lower the cup onto its top, gradually
         f = min(1.0, i / 600)
-        goal = start + f * (above - start) if i < 800 else above + min(1.0, (i - 800) / 400) * (box_top + offset - [0, 0, 0.002] - above)
+        goal = (
+            start + f * (above - start)
+            if i < 800
+            else above + min(1.0, (i - 800) / 400) * (box_top + offset - [0, 0, 0.002] - above)
+        )
         data.mocap_pos[0] = goal
         mujoco.mj_step(model, data)
     assert robot.suction_on(model, data)

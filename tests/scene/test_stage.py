@@ -4,8 +4,8 @@ import pytest
 
 from anomalygen.config import Settings
 from anomalygen.runfolder import RunFolder, read_model, write_jsonl
-from anomalygen.schema import SceneSpec
 from anomalygen.scene.stage import run_stage
+from anomalygen.schema import SceneSpec
 
 from .conftest import TASKS, make_task
 

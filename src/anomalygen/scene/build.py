@@ -30,6 +30,9 @@ import numpy as np
 from anomalygen.errors import ItemFailed
 from anomalygen.rng import item_rng, stable_hash
 from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
+from anomalygen.scene import furniture, layout, robot, select
+from anomalygen.scene.layout import Layout, Placed
+from anomalygen.scene.sensors import add_observation_sensors
 from anomalygen.schema import (
     AssetRef,
     AssetSource,
@@ -38,11 +41,9 @@ from anomalygen.schema import (
     PlacedObject,
     SceneSpec,
     TaskProposal,
+    ValidationCheck,
     ValidationReport,
 )
-from anomalygen.scene import furniture, layout, robot, select
-from anomalygen.scene.layout import Layout, Placed
-from anomalygen.scene.sensors import add_observation_sensors
 
 log = logging.getLogger(__name__)
 SURFACE_PLACEMENTS = {"table", "low_table", "table_edge", "counter", "counter_edge", "shelf"}
@@ -132,7 +133,16 @@ def _placed(chosen: select.Chosen) -> Placed:
 def _support_placed(kind: str, name: str, rng, role=ObjectRole.SUPPORT) -> Placed:
     sup = furniture.sample_support(kind, rng)
     lo, hi = sup.aabb()
-    return Placed(name=name, catalogue=sup.category, role=role, lo=lo, hi=hi, fixed=True, support_geom=sup, front=np.array([-1.0, 0.0]))
+    return Placed(
+        name=name,
+        catalogue=sup.category,
+        role=role,
+        lo=lo,
+        hi=hi,
+        fixed=True,
+        support_geom=sup,
+        front=np.array([-1.0, 0.0]),
+    )
 
 
 def _surface_of(holder: Placed):
@@ -143,7 +153,9 @@ def _surface_of(holder: Placed):
     surfaces = list(holder.asset.surfaces)
     if not surfaces:
         lo, hi = holder.asset.aabb
-        return layout.surface_world(holder, (0.0, 0.0, float(hi[2])), (float(hi[0] - lo[0]) / 2 * 0.8, float(hi[1] - lo[1]) / 2 * 0.8))
+        return layout.surface_world(
+            holder, (0.0, 0.0, float(hi[2])), (float(hi[0] - lo[0]) / 2 * 0.8, float(hi[1] - lo[1]) / 2 * 0.8)
+        )
     best = max(surfaces, key=lambda s: s.half_size[0] * s.half_size[1])
     return layout.surface_world(holder, best.center, best.half_size)
 
@@ -210,7 +222,9 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
 
     hazard_is_target = select.resolve_name(sc.hazard_object) == select.resolve_name(task.target_asset)
     # Big things first: they bound what fits in/on them.
-    target = choose(task.target_asset, ObjectRole.HAZARD if hazard_is_target else ObjectRole.TARGET, rank=True)
+    target = choose(
+        task.target_asset, ObjectRole.HAZARD if hazard_is_target else ObjectRole.TARGET, rank=True
+    )
     parent = choose(parent_raw, ObjectRole.AUXILIARY) if parent_raw else None
 
     support_kind = kind if kind in SURFACE_PLACEMENTS else None
@@ -225,7 +239,9 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
 
     container = None
     variables = set(hc.variables) if hc is not None else set()
-    container_name = sc.container or (_first_known(hc.default_containers) if "$container" in variables else None)
+    container_name = sc.container or (
+        _first_known(hc.default_containers) if "$container" in variables else None
+    )
     if container_name:
         container = choose(container_name, ObjectRole.CONTAINER)
     support_var = None
@@ -267,10 +283,14 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
     if hc is not None and hc.articulation is not None:
         var_obj = {"$target": target, "$hazard": hazard}.get(hc.articulation.variable)
         if var_obj is not None:
-            uses.setdefault(var_obj.catalogue, []).append((hc.articulation.part, hc.articulation.initial_state))
+            uses.setdefault(var_obj.catalogue, []).append(
+                (hc.articulation.part, hc.articulation.initial_state)
+            )
     if kind == "inside" and parent is not None:
         cav = max(parent.asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
-        if cav.joint is not None and not any(p in ("door", "drawer", "lid") and s == "closed" for p, s in uses.get(parent.catalogue, [])):
+        if cav.joint is not None and not any(
+            p in ("door", "drawer", "lid") and s == "closed" for p, s in uses.get(parent.catalogue, [])
+        ):
             label = parent.asset.joint(cav.joint).label
             uses.setdefault(parent.catalogue, []).append((label, "open"))
     for cat, pairs in uses.items():
@@ -284,7 +304,12 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
     support: Placed | None = None
     if support_kind is not None:
         base_kind = support_kind.replace("_edge", "")
-        if target.catalogue == "Table" and base_kind == "table" and not hazard_is_target and _table_height_ok(target.asset):
+        if (
+            target.catalogue == "Table"
+            and base_kind == "table"
+            and not hazard_is_target
+            and _table_height_ok(target.asset)
+        ):
             support = placed.setdefault(target.name, _placed(target))
         else:
             support = _support_placed(base_kind, _instance_name(furniture.CATEGORY[base_kind], used), rng)
@@ -317,7 +342,9 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
             lay.place_on_floor(hp, relevant=True, face=False, clear_of=fixtures)
         elif support is not None:
             edge = support_kind.endswith("_edge")
-            lay.place_on_surface(hp, support, _surface_of(support), edge=edge, inward=0.0 if edge else 0.13, near_side=0.4)
+            lay.place_on_surface(
+                hp, support, _surface_of(support), edge=edge, inward=0.0 if edge else 0.13, near_side=0.4
+            )
         elif kind == "inside" and parent is not None:
             ppl = placed.get(parent.name)
             if ppl is None:
@@ -443,24 +470,59 @@ def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
     spec.visual.global_.offwidth = max(640, settings.build.render_width)
     spec.visual.global_.offheight = max(480, settings.build.render_height)
     spec.visual.quality.shadowsize = 512
-    tex = spec.add_texture(name="floor_tex", type=mujoco.mjtTexture.mjTEXTURE_2D, builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
-                           rgb1=[0.62, 0.58, 0.52], rgb2=[0.55, 0.5, 0.45], width=256, height=256)
+    tex = spec.add_texture(
+        name="floor_tex",
+        type=mujoco.mjtTexture.mjTEXTURE_2D,
+        builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
+        rgb1=[0.62, 0.58, 0.52],
+        rgb2=[0.55, 0.5, 0.45],
+        width=256,
+        height=256,
+    )
     mat = spec.add_material(name="floor_mat", texrepeat=[6, 6], reflectance=0.05)
     mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = tex.name
     center = layout.ROOM_CENTER
     half = layout.ROOM_HALF + 0.6
-    spec.worldbody.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[half[0], half[1], 0.05],
-                            pos=[center[0], center[1], 0], material="floor_mat")
+    spec.worldbody.add_geom(
+        name="floor",
+        type=mujoco.mjtGeom.mjGEOM_PLANE,
+        size=[half[0], half[1], 0.05],
+        pos=[center[0], center[1], 0],
+        material="floor_mat",
+    )
     wall_rgba = [0.86, 0.85, 0.8, 1]
-    spec.worldbody.add_geom(name="wall_back", type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.05, half[1], 1.3],
-                            pos=[center[0] + half[0] + 0.05, center[1], 1.3], rgba=wall_rgba)
-    spec.worldbody.add_geom(name="wall_left", type=mujoco.mjtGeom.mjGEOM_BOX, size=[half[0], 0.05, 1.3],
-                            pos=[center[0], center[1] + half[1] + 0.05, 1.3], rgba=wall_rgba)
-    spec.worldbody.add_light(name="sun", pos=[center[0], center[1], 3.5], dir=[0.2, 0.1, -1], type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
-                             diffuse=[0.6, 0.6, 0.6], specular=[0.1, 0.1, 0.1], castshadow=True)
-    spec.worldbody.add_light(name="fill", pos=[-1.0, -1.0, 2.5], dir=[0.5, 0.4, -0.6], diffuse=[0.35, 0.35, 0.35], castshadow=False)
+    spec.worldbody.add_geom(
+        name="wall_back",
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[0.05, half[1], 1.3],
+        pos=[center[0] + half[0] + 0.05, center[1], 1.3],
+        rgba=wall_rgba,
+    )
+    spec.worldbody.add_geom(
+        name="wall_left",
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[half[0], 0.05, 1.3],
+        pos=[center[0], center[1] + half[1] + 0.05, 1.3],
+        rgba=wall_rgba,
+    )
+    spec.worldbody.add_light(
+        name="sun",
+        pos=[center[0], center[1], 3.5],
+        dir=[0.2, 0.1, -1],
+        type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
+        diffuse=[0.6, 0.6, 0.6],
+        specular=[0.1, 0.1, 0.1],
+        castshadow=True,
+    )
+    spec.worldbody.add_light(
+        name="fill", pos=[-1.0, -1.0, 2.5], dir=[0.5, 0.4, -0.6], diffuse=[0.35, 0.35, 0.35], castshadow=False
+    )
 
-    focus = np.mean([p.world_center() for p in placed.values() if p.role != ObjectRole.CLUTTER] or [np.array([1.0, 0, 0.4])], axis=0)
+    focus = np.mean(
+        [p.world_center() for p in placed.values() if p.role != ObjectRole.CLUTTER]
+        or [np.array([1.0, 0, 0.4])],
+        axis=0,
+    )
     focus[2] = min(max(focus[2], 0.2), 0.8)
     # Front camera: behind the robot as seen from the task objects, raised, turned 30 degrees, so
     # the robot stands in the foreground and the scene behind it.
@@ -557,7 +619,10 @@ def _hold_gravity_hinges(model, placed: dict[str, Placed], mjspec) -> None:
                 continue
             body = model.jnt_bodyid[jid]
             mass = model.body_subtreemass[body]
-            lever = float(np.linalg.norm(model.body_ipos[body])) + 0.5 * float(np.max(model.body_inertia[body]) / max(mass, 1e-6)) ** 0.5
+            lever = (
+                float(np.linalg.norm(model.body_ipos[body]))
+                + 0.5 * float(np.max(model.body_inertia[body]) / max(mass, 1e-6)) ** 0.5
+            )
             friction = 1.3 * mass * g * (1.0 if vertical_slide else max(lever, 0.02))
             dof = model.jnt_dofadr[jid]
             model.dof_frictionloss[dof] = max(model.dof_frictionloss[dof], friction)
@@ -679,6 +744,12 @@ def build_scene(task: TaskProposal, *, seed: int, settings, out_dir: Path) -> Sc
             reason = str(exc)
             log.debug("%s attempt %d: %s", task.id, attempt, reason)
             continue
+        if built.report.ok and settings.llm.configured and settings.llm.vision:
+            try:
+                _vlm_check(task, built, settings)
+            except ItemFailed as exc:
+                built.report.ok = False
+                built.report.reason = str(exc)
         if built.report.ok:
             built.report.repairs = attempt
             break
@@ -688,6 +759,16 @@ def build_scene(task: TaskProposal, *, seed: int, settings, out_dir: Path) -> Sc
     if built is None:
         raise ItemFailed(f"no valid scene after {attempts} attempt(s): {reason}")
     return write_outputs(built, settings, Path(out_dir))
+
+
+def _vlm_check(task, built: Built, settings) -> None:
+    from anomalygen.scene.render import SceneRenderer, png_bytes
+    from anomalygen.scene.verify import verify_with_vlm
+
+    with SceneRenderer(built.model, settings.build.render_width, settings.build.render_height) as r:
+        png = png_bytes(r.render(built.data, "front"))
+    verify_with_vlm(task, built.spec, png, settings)
+    built.report.checks.append(ValidationCheck(name="vlm_verification", passed=True, detail=settings.llm.model or ""))
 
 
 def write_outputs(built: Built, settings, out_dir: Path) -> SceneSpec:

@@ -79,9 +79,13 @@ class SceneEnv(gym.Env):
         self._robot_qvel = np.array([m.jnt_dofadr[j] for j in jids])
         task_objects = [o for o in self.spec.objects if o.role.value != "clutter"]
         self.task_objects = [o.name for o in task_objects]
-        self._obj_bodies = np.array([name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in self.task_objects], dtype=int)
+        self._obj_bodies = np.array(
+            [name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in self.task_objects], dtype=int
+        )
         joint_names = [j.name for o in task_objects for j in o.joint_states]
-        self._obj_qpos = np.array([m.jnt_qposadr[name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j)] for j in joint_names], dtype=int)
+        self._obj_qpos = np.array(
+            [m.jnt_qposadr[name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j)] for j in joint_names], dtype=int
+        )
         # Suction: geom -> object body with a suction weld, and that weld's id.
         self._geom_to_eq = np.full(m.ngeom, -1, dtype=int)
         self._eq_rel = {}
@@ -112,7 +116,9 @@ class SceneEnv(gym.Env):
         from anomalygen.scene.sensors import GROUPS, sensor_layout
 
         layout = sensor_layout(m)
-        self._use_sensors = set(layout) == set(GROUPS) and all(layout[g].stop - layout[g].start == sizes[g] for g in GROUPS)
+        self._use_sensors = set(layout) == set(GROUPS) and all(
+            layout[g].stop - layout[g].start == sizes[g] for g in GROUPS
+        )
         if self._use_sensors:
             nsens = int(m.nsensordata)
             self.obs_layout = {**layout, "suction": slice(nsens, nsens + 1)}
@@ -134,7 +140,9 @@ class SceneEnv(gym.Env):
         mj, m, d = self._mj, self.model, self.data
         reset_to_initial(m, d)
         if self.init_noise > 0:
-            d.qpos[self._robot_qpos] += self.np_random.uniform(-self.init_noise, self.init_noise, size=len(self._robot_qpos))
+            d.qpos[self._robot_qpos] += self.np_random.uniform(
+                -self.init_noise, self.init_noise, size=len(self._robot_qpos)
+            )
             mj.mj_forward(m, d)
         # Start the mocap target at the cup's pose and switch on tracking (base held in place).
         robot.enable_ee_tracking(m, d)
@@ -256,7 +264,9 @@ class SceneEnv(gym.Env):
             if eq < 0 or d.contact.dist[k] > robot.SUCTION_RANGE:
                 continue
             body = self._eq_rel[eq]
-            relpos, relquat = robot.relative_pose(d.xpos[self._cup_body], d.xquat[self._cup_body], d.xpos[body], d.xquat[body])
+            relpos, relquat = robot.relative_pose(
+                d.xpos[self._cup_body], d.xquat[self._cup_body], d.xpos[body], d.xquat[body]
+            )
             self.model.eq_data[eq, 0:3] = 0.0
             self.model.eq_data[eq, 3:6] = relpos
             self.model.eq_data[eq, 6:10] = relquat

@@ -48,7 +48,10 @@ class Support:
         return float(max(2 * self.half[0], 2 * self.half[1], self.top - self.bottom))
 
     def aabb(self) -> tuple[np.ndarray, np.ndarray]:
-        return (np.array([-self.half[0], -self.half[1], self.bottom]), np.array([self.half[0], self.half[1], self.top]))
+        return (
+            np.array([-self.half[0], -self.half[1], self.bottom]),
+            np.array([self.half[0], self.half[1], self.top]),
+        )
 
 
 def sample_support(kind: str, rng: np.random.Generator) -> Support:
@@ -87,16 +90,41 @@ def emit(support: Support, body, rng: np.random.Generator) -> None:
     box = mujoco.mjtGeom.mjGEOM_BOX
     hx, hy, top, th = support.half[0], support.half[1], support.top, support.thickness
     wood = [float(v) for v in (0.55 + 0.2 * rng.random(), 0.4 + 0.15 * rng.random(), 0.28, 1.0)]
-    body.add_geom(name=f"{body.name}/top", type=box, size=[hx, hy, th / 2], pos=[0, 0, top - th / 2], rgba=wood, density=600)
+    body.add_geom(
+        name=f"{body.name}/top",
+        type=box,
+        size=[hx, hy, th / 2],
+        pos=[0, 0, top - th / 2],
+        rgba=wood,
+        density=600,
+    )
     if support.kind == "counter":
         # Solid cabinet under the worktop, slightly recessed so the top has an overhanging edge.
         h = (top - th) / 2
-        body.add_geom(type=box, size=[hx - 0.03, hy - 0.01, h], pos=[-0.01, 0, h], rgba=[0.85, 0.85, 0.82, 1], density=300)
+        body.add_geom(
+            type=box,
+            size=[hx - 0.03, hy - 0.01, h],
+            pos=[-0.01, 0, h],
+            rgba=[0.85, 0.85, 0.82, 1],
+            density=300,
+        )
     elif support.kind == "shelf":
         # A wall-mounted plank with two brackets against a back panel (fixed in the world).
-        body.add_geom(type=box, size=[0.01, hy, 0.14], pos=[hx + 0.01, 0, top - 0.14], rgba=[0.8, 0.8, 0.8, 1], density=600)
+        body.add_geom(
+            type=box,
+            size=[0.01, hy, 0.14],
+            pos=[hx + 0.01, 0, top - 0.14],
+            rgba=[0.8, 0.8, 0.8, 1],
+            density=600,
+        )
         for s in (-1, 1):
-            body.add_geom(type=box, size=[hx * 0.8, 0.01, 0.05], pos=[0.0, s * (hy - 0.03), top - th - 0.05], rgba=wood, density=600)
+            body.add_geom(
+                type=box,
+                size=[hx * 0.8, 0.01, 0.05],
+                pos=[0.0, s * (hy - 0.03), top - th - 0.05],
+                rgba=wood,
+                density=600,
+            )
     else:
         leg_h = (top - th) / 2
         for sx in (-1, 1):

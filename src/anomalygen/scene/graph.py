@@ -212,7 +212,9 @@ def scene_graph(model: mujoco.MjModel, data: mujoco.MjData, spec: SceneSpec) -> 
         if on_floor:
             relations.append(Relation(subject=obj.name, predicate="on_floor"))
         if container is not None:
-            relations.append(Relation(subject=obj.name, predicate="inside", object=spec.objects[container].name))
+            relations.append(
+                Relation(subject=obj.name, predicate="inside", object=spec.objects[container].name)
+            )
         for sup in supports[i]:
             if sup != "floor" and sup != container:
                 relations.append(Relation(subject=obj.name, predicate="on", object=spec.objects[sup].name))
@@ -230,7 +232,14 @@ def _near_relations(spec: SceneSpec, lo, hi, inside_of, supports) -> list[Relati
             gap = np.maximum(0.0, np.maximum(lo[i] - hi[j], lo[j] - hi[i]))
             dist = float(np.linalg.norm(gap))
             if dist < NEAR_DIST:
-                out.append(Relation(subject=spec.objects[i].name, predicate="near", object=spec.objects[j].name, distance=round(dist, 4)))
+                out.append(
+                    Relation(
+                        subject=spec.objects[i].name,
+                        predicate="near",
+                        object=spec.objects[j].name,
+                        distance=round(dist, 4),
+                    )
+                )
     return out
 
 

@@ -17,9 +17,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from anomalygen.errors import ItemFailed
-from anomalygen.schema import ObjectRole
 from anomalygen.scene.furniture import Support
 from anomalygen.scene.robot import BASE_RADIUS
+from anomalygen.schema import ObjectRole
 
 REGION_ORIGIN = np.array([0.8, -0.6, 0.0])  # world position of the cube corner (0, 0, 0)
 REGION_SIZE = np.array([1.1, 1.2, 1.0])
@@ -85,7 +85,9 @@ def face_robot_yaw(front: np.ndarray | None, target_dir: np.ndarray) -> float:
     return math.atan2(target_dir[1], target_dir[0]) - math.atan2(front[1], front[0])
 
 
-def overlaps(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], margin: float = 0.02) -> bool:
+def overlaps(
+    a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], margin: float = 0.02
+) -> bool:
     return bool(np.all(a[0] < b[1] + margin) and np.all(b[0] < a[1] + margin))
 
 
@@ -114,7 +116,9 @@ class Layout:
     # ---------------------------------------------------------------- checks
     def collides(self, obj: Placed, *, ignore: tuple[str, ...] = ()) -> bool:
         box = obj.footprint()
-        if np.any(box[0][:2] < ROOM_CENTER - ROOM_HALF - 0.3) or np.any(box[1][:2] > ROOM_CENTER + ROOM_HALF + 0.3):
+        if np.any(box[0][:2] < ROOM_CENTER - ROOM_HALF - 0.3) or np.any(
+            box[1][:2] > ROOM_CENTER + ROOM_HALF + 0.3
+        ):
             return True
         for other in self.items:
             if other.name in ignore or other.name == obj.name:
@@ -134,12 +138,18 @@ class Layout:
     def arm_box(self) -> tuple[np.ndarray, np.ndarray]:
         """World AABB of the arm at its home pose (forward of the base, raised)."""
         c, s = math.cos(self.base[2]), math.sin(self.base[2])
-        corners = [np.array([self.base[0] + c * x - s * y, self.base[1] + s * x + c * y]) for x in (-0.2, 0.42) for y in (-0.15, 0.15)]
+        corners = [
+            np.array([self.base[0] + c * x - s * y, self.base[1] + s * x + c * y])
+            for x in (-0.2, 0.42)
+            for y in (-0.15, 0.15)
+        ]
         xy = np.array(corners)
         return np.r_[xy.min(0), 0.35], np.r_[xy.max(0), 1.2]
 
     # ---------------------------------------------------------------- placing
-    def place_on_floor(self, obj: Placed, *, relevant: bool, face: bool = True, clear_of: list[Placed] | None = None) -> None:
+    def place_on_floor(
+        self, obj: Placed, *, relevant: bool, face: bool = True, clear_of: list[Placed] | None = None
+    ) -> None:
         """Stand ``obj`` on the floor at a proposal that overlaps nothing (furniture faces the robot)."""
         for attempt in range(2 * TRIES):
             # a crowded cube: fall back to anywhere in the room rather than fail the scene
@@ -157,7 +167,9 @@ class Layout:
                 z = -obj.lo[2] + (0.0 if obj.fixed else DROP_GAP)
             obj.pos = np.array([xy[0], xy[1], z])
             obj.pos[:2] -= obj.world_center()[:2] - obj.pos[:2]  # centre the footprint on the proposal
-            if clear_of is not None and any(_h_gap(obj.footprint(), f.footprint()) < WALKWAY_CLEAR for f in clear_of):
+            if clear_of is not None and any(
+                _h_gap(obj.footprint(), f.footprint()) < WALKWAY_CLEAR for f in clear_of
+            ):
                 continue
             if not self.collides(obj):
                 obj.support = "floor"
@@ -188,7 +200,9 @@ class Layout:
         axis = int(np.argmax(np.abs(to_base)))
         sign = np.sign(to_base[axis]) or -1.0
         for _ in range(TRIES):
-            obj.yaw = float(self.rng.choice([0.0, math.pi / 2, math.pi, -math.pi / 2]) + self.rng.uniform(-0.15, 0.15))
+            obj.yaw = float(
+                self.rng.choice([0.0, math.pi / 2, math.pi, -math.pi / 2]) + self.rng.uniform(-0.15, 0.15)
+            )
             half = obj.world_half()
             slack = (hi_xy - lo_xy) / 2 - half[:2]
             if np.any(slack < 0):
@@ -196,7 +210,9 @@ class Layout:
                 half = obj.world_half()
                 slack = (hi_xy - lo_xy) / 2 - half[:2]
                 if np.any(slack < -1e-6):
-                    raise ItemFailed(f"{obj.name} ({2 * half[0]:.2f}x{2 * half[1]:.2f} m) does not fit on {holder.name}")
+                    raise ItemFailed(
+                        f"{obj.name} ({2 * half[0]:.2f}x{2 * half[1]:.2f} m) does not fit on {holder.name}"
+                    )
             room = np.where(slack - inward >= 0, slack - inward, 0.0)
             center = (lo_xy + hi_xy) / 2 + self.rng.uniform(-1, 1, size=2) * room
             bound = hi_xy[axis] if sign > 0 else lo_xy[axis]
@@ -219,7 +235,9 @@ class Layout:
                 return
         raise ItemFailed(f"no free spot for {obj.name} on {holder.name}")
 
-    def place_in_cavity(self, obj: Placed, holder: Placed, cavity_world: tuple[np.ndarray, np.ndarray]) -> None:
+    def place_in_cavity(
+        self, obj: Placed, holder: Placed, cavity_world: tuple[np.ndarray, np.ndarray]
+    ) -> None:
         """Put ``obj`` on the floor of a cavity (world AABB), centred with a little jitter."""
         lo, hi = cavity_world
         obj.yaw = holder.yaw

@@ -22,7 +22,6 @@ _GL: dict[str, object] = {}
 
 
 def _gl_context(width: int, height: int):
-    import mujoco
 
     os.environ.setdefault("MUJOCO_GL", "egl")
     ctx = _GL.get("ctx")
@@ -73,7 +72,11 @@ class SceneRenderer:
         """RGB uint8 image (height, width, 3) from a named fixed camera."""
         import mujoco
 
-        cam_id = camera if isinstance(camera, int) else mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_CAMERA, camera)
+        cam_id = (
+            camera
+            if isinstance(camera, int)
+            else mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_CAMERA, camera)
+        )
         if cam_id < 0:
             raise KeyError(f"no camera {camera!r}")
         self.camera.type = mujoco.mjtCamera.mjCAMERA_FIXED
@@ -82,7 +85,9 @@ class SceneRenderer:
         with _LOCK:  # one GL context per process: render calls of different models take turns
             _gl_context(self.width, self.height)
             mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self.con)
-            mujoco.mjv_updateScene(self.model, data, self.option, None, self.camera, mujoco.mjtCatBit.mjCAT_ALL, self.scene)
+            mujoco.mjv_updateScene(
+                self.model, data, self.option, None, self.camera, mujoco.mjtCatBit.mjCAT_ALL, self.scene
+            )
             mujoco.mjr_render(self.viewport, self.scene, self.con)
             mujoco.mjr_readPixels(rgb, None, self.viewport, self.con)
         return np.flipud(rgb).copy()

@@ -60,7 +60,13 @@ def franka_assets_dir() -> Path:
         from anomalygen.errors import UserError
 
         raise UserError("gymnasium-robotics is not installed (it provides the Franka Panda model)")
-    path = Path(list(found.submodule_search_locations)[0]) / "envs" / "assets" / "kitchen_franka" / "franka_assets"
+    path = (
+        Path(list(found.submodule_search_locations)[0])
+        / "envs"
+        / "assets"
+        / "kitchen_franka"
+        / "franka_assets"
+    )
     if not (path / "chain.xml").is_file():  # pragma: no cover - broken installation
         from anomalygen.errors import UserError
 
@@ -88,14 +94,15 @@ def _arm_xml() -> str:
     assets = re.sub(r'<mesh name="\w+_viz"[^>]*/>', "", assets)
     chain = _strip_include((root / "chain.xml").read_text())
     chain = re.sub(r'mesh="(\w+)_viz"', r'mesh="\1_col"', chain)
-    chain = chain.replace("robot:panda0_joint", "panda_joint").replace('name="panda0_link', 'name="panda_link')
+    chain = chain.replace("robot:panda0_joint", "panda_joint").replace(
+        'name="panda0_link', 'name="panda_link'
+    )
     chain = re.sub(r"<body name=\"panda0_(left|right)finger\".*?</body>", "", chain, flags=re.S)
     chain = re.sub(r"<site name='end_effector'[^>]*/>", "", chain)
     chain = chain.replace('<body name="panda_link0"', f'<body name="panda_link0" pos="0 0 {BASE_HEIGHT}"', 1)
     return (
         f'<mujoco model="panda"><compiler angle="radian" meshdir="{root / "meshes"}"/>'
         f'{assets}<worldbody><body name="base">{chain}</body></worldbody></mujoco>'
-
     )
 
 
@@ -121,9 +128,15 @@ def build_robot_spec(base_xyyaw=(0.0, 0.0, 0.0)) -> mujoco.MjSpec:
     # ``base_xyyaw`` is applied by ``set_home`` (scenes store it in their "init" keyframe).
     base = spec.body("base")
     base.gravcomp = 1.0
-    base.add_joint(name="base_x", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0], damping=200.0, armature=1.0)
-    base.add_joint(name="base_y", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 1, 0], damping=200.0, armature=1.0)
-    base.add_joint(name="base_yaw", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], damping=100.0, armature=1.0)
+    base.add_joint(
+        name="base_x", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0], damping=200.0, armature=1.0
+    )
+    base.add_joint(
+        name="base_y", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 1, 0], damping=200.0, armature=1.0
+    )
+    base.add_joint(
+        name="base_yaw", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], damping=100.0, armature=1.0
+    )
     base.add_geom(
         name="base_geom",
         type=mujoco.mjtGeom.mjGEOM_CYLINDER,
@@ -165,7 +178,14 @@ def build_robot_spec(base_xyyaw=(0.0, 0.0, 0.0)) -> mujoco.MjSpec:
         act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
     # End-effector tracking target for delta-pose control (inactive by default).
     target = spec.worldbody.add_body(name="ee_target", mocap=True, pos=[0, 0, 1])
-    target.add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.01, 0, 0], contype=0, conaffinity=0, rgba=[0, 1, 0, 0.0], group=4)
+    target.add_geom(
+        type=mujoco.mjtGeom.mjGEOM_SPHERE,
+        size=[0.01, 0, 0],
+        contype=0,
+        conaffinity=0,
+        rgba=[0, 1, 0, 0.0],
+        group=4,
+    )
     eq = spec.add_equality(name="ee_track", type=mujoco.mjtEq.mjEQ_WELD, name1="suction", name2="ee_target")
     eq.objtype = mujoco.mjtObj.mjOBJ_BODY
     eq.active = False
@@ -190,7 +210,9 @@ def add_suction_welds(spec: mujoco.MjSpec, object_bodies: list[str]) -> None:
     import mujoco
 
     for body in object_bodies:
-        eq = spec.add_equality(name=SUCTION_PREFIX + body, type=mujoco.mjtEq.mjEQ_WELD, name1="suction", name2=body)
+        eq = spec.add_equality(
+            name=SUCTION_PREFIX + body, type=mujoco.mjtEq.mjEQ_WELD, name1="suction", name2=body
+        )
         eq.objtype = mujoco.mjtObj.mjOBJ_BODY
         eq.active = False
         eq.solref = [0.01, 1.0]

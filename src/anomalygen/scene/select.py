@@ -44,7 +44,20 @@ class Chosen:
         return self.size >= FIXED_SIZE or self.catalogue in _ALWAYS_FIXED
 
 
-_ALWAYS_FIXED = {"Refrigerator", "StorageFurniture", "Dishwasher", "WashingMachine", "Oven", "Door", "Window", "Table", "Toilet", "counter", "shelf", "medicine_cabinet"}
+_ALWAYS_FIXED = {
+    "Refrigerator",
+    "StorageFurniture",
+    "Dishwasher",
+    "WashingMachine",
+    "Oven",
+    "Door",
+    "Window",
+    "Table",
+    "Toilet",
+    "counter",
+    "shelf",
+    "medicine_cabinet",
+}
 
 
 @lru_cache(maxsize=1)
@@ -72,7 +85,11 @@ def resolve_name(name: str) -> str:
     if not hits:
         raise ItemFailed(f"object {name!r} is not in the asset catalogue and retrieval found nothing")
     hit = hits[0]
-    found = getattr(hit, "name", None) or getattr(hit, "category", None) or (hit[0] if isinstance(hit, tuple) else str(hit))
+    found = (
+        getattr(hit, "name", None)
+        or getattr(hit, "category", None)
+        or (hit[0] if isinstance(hit, tuple) else str(hit))
+    )
     found = getattr(found, "name", found)
     if found not in names:
         raise ItemFailed(f"object {name!r} retrieved {found!r}, which has no generator")
@@ -121,11 +138,15 @@ def needed_parts(task: TaskProposal, catalogue: str, hc) -> list[ArticulationUse
     return out
 
 
-def plausibility_problem(asset, catalogue: str, kb, parts: list[ArticulationUse], *, cap: float | None) -> str | None:
+def plausibility_problem(
+    asset, catalogue: str, kb, parts: list[ArticulationUse], *, cap: float | None
+) -> str | None:
     """The knowledge-based verification of a candidate: None when plausible, else why not."""
     rng = kb_size_range(kb, catalogue)
     if rng is not None and not (rng[0] * 0.8 <= asset.size <= rng[1] * 1.25):
-        return f"{catalogue} candidate is {asset.size:.2f} m, outside the plausible {rng[0]:.2f}-{rng[1]:.2f} m"
+        return (
+            f"{catalogue} candidate is {asset.size:.2f} m, outside the plausible {rng[0]:.2f}-{rng[1]:.2f} m"
+        )
     if cap is not None and asset.size > cap * 1.001:
         return f"{catalogue} candidate ({asset.size:.2f} m) does not fit its {cap:.2f} m space"
     for part in parts:
@@ -217,7 +238,9 @@ def set_articulations(chosen: Chosen, uses: list[tuple[str, str]], rng: np.rando
         joints = joints_with_label(chosen.asset, label)
         if state in ("open", "on") and len(joints) > 1 and "|" in label:
             # 'door|drawer': opening one kind is enough for the hazard; prefer the first alternative found
-            first = next(kb_label(x) for x in label.split("|") if any(kb_label(j.label) == kb_label(x) for j in joints))
+            first = next(
+                kb_label(x) for x in label.split("|") if any(kb_label(j.label) == kb_label(x) for j in joints)
+            )
             joints = [j for j in joints if kb_label(j.label) == first]
         for joint in joints:
             chosen.joint_values[joint.name] = open_value(joint, state, rng)

@@ -12,27 +12,29 @@ from __future__ import annotations
 GROUPS = ("robot_qpos", "robot_qvel", "ee_pos", "ee_quat", "object_pos", "object_quat", "object_joints")
 
 
-def add_observation_sensors(spec, robot_joints: list[str], objects: list[str], object_joints: list[str]) -> None:
+def add_observation_sensors(
+    spec, robot_joints: list[str], objects: list[str], object_joints: list[str]
+) -> None:
     import mujoco
 
-    S, O = mujoco.mjtSensor, mujoco.mjtObj
+    S, Obj = mujoco.mjtSensor, mujoco.mjtObj
 
     def add(group, item, stype, objtype, objname):
         s = spec.add_sensor(name=f"obs:{group}:{item}", type=stype, objtype=objtype, objname=objname)
         return s
 
     for j in robot_joints:
-        add("robot_qpos", j, S.mjSENS_JOINTPOS, O.mjOBJ_JOINT, j)
+        add("robot_qpos", j, S.mjSENS_JOINTPOS, Obj.mjOBJ_JOINT, j)
     for j in robot_joints:
-        add("robot_qvel", j, S.mjSENS_JOINTVEL, O.mjOBJ_JOINT, j)
-    add("ee_pos", "ee_site", S.mjSENS_FRAMEPOS, O.mjOBJ_SITE, "ee_site")
-    add("ee_quat", "ee_site", S.mjSENS_FRAMEQUAT, O.mjOBJ_XBODY, "suction")
+        add("robot_qvel", j, S.mjSENS_JOINTVEL, Obj.mjOBJ_JOINT, j)
+    add("ee_pos", "ee_site", S.mjSENS_FRAMEPOS, Obj.mjOBJ_SITE, "ee_site")
+    add("ee_quat", "ee_site", S.mjSENS_FRAMEQUAT, Obj.mjOBJ_XBODY, "suction")
     for o in objects:
-        add("object_pos", o, S.mjSENS_FRAMEPOS, O.mjOBJ_XBODY, o)
+        add("object_pos", o, S.mjSENS_FRAMEPOS, Obj.mjOBJ_XBODY, o)
     for o in objects:
-        add("object_quat", o, S.mjSENS_FRAMEQUAT, O.mjOBJ_XBODY, o)
+        add("object_quat", o, S.mjSENS_FRAMEQUAT, Obj.mjOBJ_XBODY, o)
     for j in object_joints:
-        add("object_joints", j, S.mjSENS_JOINTPOS, O.mjOBJ_JOINT, j)
+        add("object_joints", j, S.mjSENS_JOINTPOS, Obj.mjOBJ_JOINT, j)
 
 
 def sensor_layout(model) -> dict[str, slice]:

@@ -51,7 +51,9 @@ class _one_torch_thread:
         torch.set_num_threads(self.before)
 
 
-def run_stage(run: RunFolder, settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
+def run_stage(
+    run: RunFolder, settings, *, force: bool = False, only: list[str] | None = None
+) -> StageSummary:
     tasks = run.load_tasks()
     if only:
         wanted = set(only)

@@ -30,7 +30,11 @@ def _owners(model, spec: SceneSpec) -> np.ndarray:
 
 def _contacts(model, data):
     n = data.ncon
-    return np.asarray(data.contact.geom1[:n]), np.asarray(data.contact.geom2[:n]), np.asarray(data.contact.dist[:n])
+    return (
+        np.asarray(data.contact.geom1[:n]),
+        np.asarray(data.contact.geom2[:n]),
+        np.asarray(data.contact.dist[:n]),
+    )
 
 
 def initial_overlap(model, data, spec: SceneSpec) -> str | None:
@@ -74,8 +78,23 @@ def validate(model, data, spec: SceneSpec, graph, hc) -> ValidationReport:
                 self_pen, self_worst = float(-d), _who(model, spec, owner, a)
         elif -d > pen:
             pen, worst = float(-d), f"{_who(model, spec, owner, a)} / {_who(model, spec, owner, b)}"
-    checks.append(ValidationCheck(name="max_penetration", passed=pen <= MAX_PENETRATION, value=pen, limit=MAX_PENETRATION, detail=worst))
-    checks.append(ValidationCheck(name="self_contact_penetration", passed=True, value=self_pen, detail=f"informational: {self_worst}" if self_worst else "informational"))
+    checks.append(
+        ValidationCheck(
+            name="max_penetration",
+            passed=pen <= MAX_PENETRATION,
+            value=pen,
+            limit=MAX_PENETRATION,
+            detail=worst,
+        )
+    )
+    checks.append(
+        ValidationCheck(
+            name="self_contact_penetration",
+            passed=True,
+            value=self_pen,
+            detail=f"informational: {self_worst}" if self_worst else "informational",
+        )
+    )
 
     lin, ang = 0.0, 0.0
     for o in spec.objects:
@@ -83,8 +102,16 @@ def validate(model, data, spec: SceneSpec, graph, hc) -> ValidationReport:
             continue
         v = data.joint(f"{o.name}/free").qvel
         lin, ang = max(lin, float(np.linalg.norm(v[:3]))), max(ang, float(np.linalg.norm(v[3:])))
-    checks.append(ValidationCheck(name="settled_linear_velocity", passed=lin <= MAX_LIN_VEL, value=lin, limit=MAX_LIN_VEL))
-    checks.append(ValidationCheck(name="settled_angular_velocity", passed=ang <= MAX_ANG_VEL, value=ang, limit=MAX_ANG_VEL))
+    checks.append(
+        ValidationCheck(
+            name="settled_linear_velocity", passed=lin <= MAX_LIN_VEL, value=lin, limit=MAX_LIN_VEL
+        )
+    )
+    checks.append(
+        ValidationCheck(
+            name="settled_angular_velocity", passed=ang <= MAX_ANG_VEL, value=ang, limit=MAX_ANG_VEL
+        )
+    )
 
     lost = [g.name for g in graph.objects if g.position[2] < -0.02 or not np.all(np.isfinite(g.position))]
     checks.append(ValidationCheck(name="objects_in_room", passed=not lost, detail=", ".join(lost)))
@@ -101,11 +128,21 @@ def validate(model, data, spec: SceneSpec, graph, hc) -> ValidationReport:
             name = ("not " if call.negate else "") + call.name
             checks.append(ValidationCheck(name=f"precondition:{name}", passed=passed, detail=detail))
     else:
-        checks.append(ValidationCheck(name="precondition:none", passed=True, detail="hazard class 'other': no machine-checkable preconditions"))
+        checks.append(
+            ValidationCheck(
+                name="precondition:none",
+                passed=True,
+                detail="hazard class 'other': no machine-checkable preconditions",
+            )
+        )
 
     failed = [c for c in checks if not c.passed]
     reason = ""
     if failed:
         c = failed[0]
-        reason = f"{c.name} failed" + (f": {c.detail}" if c.detail else "") + (f" ({c.value:.4g} > {c.limit:.4g})" if c.value is not None and c.limit is not None else "")
+        reason = (
+            f"{c.name} failed"
+            + (f": {c.detail}" if c.detail else "")
+            + (f" ({c.value:.4g} > {c.limit:.4g})" if c.value is not None and c.limit is not None else "")
+        )
     return ValidationReport(ok=not failed, checks=checks, reason=reason)
