@@ -2,14 +2,13 @@
 
 import json
 
-from support.fixtures import llm_config_for, scripted_server  # noqa: F401
-from support.openai_server import text
-
 from anomalygen.config import Settings
 from anomalygen.errors import ItemFailed
 from anomalygen.runfolder import read_model
 from anomalygen.scene.build import build_scene
 from anomalygen.schema import SceneSpec
+from support.fixtures import llm_config_for, scripted_server  # noqa: F401
+from support.openai_server import text
 
 from .conftest import TASKS
 

@@ -768,7 +768,9 @@ def _vlm_check(task, built: Built, settings) -> None:
     with SceneRenderer(built.model, settings.build.render_width, settings.build.render_height) as r:
         png = png_bytes(r.render(built.data, "front"))
     verify_with_vlm(task, built.spec, png, settings)
-    built.report.checks.append(ValidationCheck(name="vlm_verification", passed=True, detail=settings.llm.model or ""))
+    built.report.checks.append(
+        ValidationCheck(name="vlm_verification", passed=True, detail=settings.llm.model or "")
+    )
 
 
 def write_outputs(built: Built, settings, out_dir: Path) -> SceneSpec:

@@ -34,10 +34,17 @@ def verify_with_vlm(task, spec, front_png: bytes, settings) -> None:
 
     client = shared_client(settings.llm)
     objects = ", ".join(f"{o.name} ({o.asset.category})" for o in spec.objects)
-    messages = [{"role": "user", "content": PROMPT.format(name=task.name, description=task.description, objects=objects)}]
+    messages = [
+        {
+            "role": "user",
+            "content": PROMPT.format(name=task.name, description=task.description, objects=objects),
+        }
+    ]
     try:
         verdict = client.complete(messages, schema=SceneVerdict, images=[front_png], temperature=0.0)
     except Exception as exc:  # noqa: BLE001 - any LLM failure fails this attempt, not the batch
         raise ItemFailed(f"VLM check failed: {type(exc).__name__}: {str(exc).splitlines()[0][:160]}") from exc
     if not verdict.fits:
-        raise ItemFailed(f"VLM rejected the scene: {verdict.reason.strip().splitlines()[0][:160] if verdict.reason else 'no reason'}")
+        raise ItemFailed(
+            f"VLM rejected the scene: {verdict.reason.strip().splitlines()[0][:160] if verdict.reason else 'no reason'}"
+        )
