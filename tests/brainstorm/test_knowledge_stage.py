@@ -37,7 +37,8 @@ def test_111_unique_valid_covering_proposals(run111):
     assert len(tasks) == 111
     assert len({t.id for t in tasks}) == 111
     assert len({t.name.lower() for t in tasks}) == 111
-    assert len({(t.hazard_class, t.scenario.hazard_object, t.scenario.placement, t.scenario.room) for t in tasks}) == 111
+    sc = [(t.hazard_class, t.scenario.hazard_object, t.scenario.placement, t.scenario.room, t.scenario.person_at_risk) for t in tasks]
+    assert len(set(sc)) == 111
     assert all(t.id.startswith(f"t{i:04d}-") for i, t in enumerate(tasks, start=1))
     assert [p for t in tasks for p in proposal_problems(t, kb)] == []
     assert {t.category.value for t in tasks} == {"household_hazard", "hygiene", "child_safety"}

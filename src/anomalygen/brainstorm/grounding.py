@@ -66,6 +66,10 @@ class Grounder:
         self.role = role
         self.rich = rich  # role-play modes add people, co-objects and perspective
         self.targets = [t for t in (targets or usable_targets(kb)) if classes_for_target(kb, t)]
+        #: With the whole catalogue open, agents think hazard-first (every class gets a fair share of
+        #: targets); when a protocol hands them a fixed set of targets (the ablation), they pick
+        #: among those by interest, as the paper's agents pick from the assets they are given.
+        self.hazard_first = targets is None
         self.benign = kb.benign_objects()
         #: How often the group has already used a class/object/room/placement (set by the engine in
         #: brainstorm mode, where agents see the shared pool): choices lean away from repeats.
@@ -93,7 +97,21 @@ class Grounder:
 
     # ---------------------------------------------------------------- fresh ideas
     def pick_target(self, rng: np.random.Generator) -> str:
-        return weighted(rng, self.targets, self._w("object_target" if self.role is None else "object", self.targets))
+        if self.role is None:
+            return weighted(rng, self.targets)
+        if not self.hazard_first:
+            return weighted(rng, self.targets, self._w("object", self.targets))
+        # Interest in an object times the interest in the hazards it can be part of, each hazard's
+        # mass shared among its targets: an open fridge (one target) is as thinkable as a fragile
+        # object near an edge (many targets).
+        objects = self._w("object", self.targets) or {}
+        classes = self._class_weights(list(self.kb.hazard_classes.values()))
+        weights = {
+            t: objects.get(t, 1.0)
+            * sum(classes[hc.id] / len(class_targets(self.kb, hc)) for hc in classes_for_target(self.kb, t))
+            for t in self.targets
+        }
+        return weighted(rng, self.targets, weights)
 
     def pick_class(self, rng: np.random.Generator, target: str) -> HazardClass:
         options = classes_for_target(self.kb, target)

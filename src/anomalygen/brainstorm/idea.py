@@ -44,8 +44,9 @@ class Idea:
     borrowed: tuple[str, ...] = ()
 
     def key(self) -> tuple:
-        """What makes two ideas the same scenario (texts aside)."""
-        return (self.class_id, self.hazard, self.placement, self.room)
+        """What makes two ideas the same scenario (texts aside). The person at risk counts: an open
+        fridge matters differently to a parent storing baby milk than to a teenager."""
+        return (self.class_id, self.hazard, self.placement, self.room, self.person)
 
 
 @dataclass
