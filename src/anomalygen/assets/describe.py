@@ -40,7 +40,7 @@ _TAG_TEXT = {
     "large_furniture": "large piece of furniture or appliance with doors",
     "pinch": "can pinch fingers",
     "moving_blades": "moving blades",
-    "drowning_risk": "can hold water, drowning risk for toddlers",
+    "drowning_risk": "can hold water, drowning risk for small children",
     "climbable": "children can climb on it",
     "lockable": "lockable storage for dangerous items",
     "lidded": "has a lid, safe storage container",
@@ -112,18 +112,27 @@ def size_words(size: float) -> str:
     return "very large"
 
 
-def describe(name: str, asset: Asset, features: list[str]) -> str:
+def base_text(name: str) -> str:
+    """What every variant of a name shares: what it is and its hazards (from the tag table)."""
     _, _, group, tag_list = object_table()[name]
-    vocab = vocabulary()
-    blurb = vocab["household"].get(name) or TARGET_BLURBS.get(name) or f"{name} ({group})"
+    blurb = vocabulary()["household"].get(name) or TARGET_BLURBS.get(name) or f"{name} ({group})"
+    parts = [f"{name.replace('_', ' ')}: {blurb}"]
+    parts += [_TAG_TEXT[t] for t in sorted(set(tag_list)) if t in _TAG_TEXT and t != "food"]
+    return "; ".join(parts)
+
+
+def variant_text(name: str, asset: Asset, features: list[str]) -> str:
+    """What this variant adds: size, mass, look, moving parts, size-derived hazards. Short, so a
+    catalogue of thousands embeds quickly (see ``retrieval.embeddings``)."""
+    tag_list = object_table()[name][3]
     size = asset.size
     dims = asset.aabb[1] - asset.aabb[0]
-    parts = [f"{size_words(size)} {name.replace('_', ' ')}: {blurb}"]
     d = ".1f" if size < 0.1 else ".0f"
     mass = f"{asset.mass * 1000:.0f} g" if asset.mass < 0.5 else f"{asset.mass:.1f} kg"
-    parts.append(
-        f"about {size * 100:{d}} cm across ({dims[0] * 100:{d}} x {dims[1] * 100:{d}} x {dims[2] * 100:{d}} cm), {mass}"
-    )
+    parts = [
+        f"{size_words(size)} {name.replace('_', ' ')}, about {size * 100:{d}} cm across "
+        f"({dims[0] * 100:{d}} x {dims[1] * 100:{d}} x {dims[2] * 100:{d}} cm), {mass}"
+    ]
     if features:
         parts.append(", ".join(features))
     labels = sorted({j.label for j in asset.joints})
@@ -133,15 +142,16 @@ def describe(name: str, asset: Asset, features: list[str]) -> str:
         parts.append("can hold things inside")
     if asset.surfaces:
         parts.append("has surfaces to put things on")
-    all_tags = set(tag_list)
-    if size < 0.045:
-        all_tags.add("choking_size")
-    for t in sorted(all_tags):
-        if t in _TAG_TEXT and t != "food":
-            parts.append(_TAG_TEXT[t])
-    if size >= 0.06 and "choking_size" not in all_tags:
+    if size < 0.045 and "choking_size" not in tag_list:
+        parts.append(_TAG_TEXT["choking_size"])
+    if size >= 0.06 and "choking_size" not in tag_list:
         parts.append("too big to swallow")
     return "; ".join(parts)
+
+
+def describe(name: str, asset: Asset, features: list[str]) -> str:
+    """The full retrieval/display text: the variant's facts, then what the name always implies."""
+    return f"{variant_text(name, asset, features)}; {base_text(name)}"
 
 
 def properties(name: str, size: float) -> list[str]:
