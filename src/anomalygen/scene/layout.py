@@ -133,18 +133,23 @@ class Layout:
             closest = np.clip(self.base[:2], box[0][:2], box[1][:2])
             if float(np.linalg.norm(closest - self.base[:2])) < BASE_RADIUS + 0.08:
                 return True
-        return overlaps(box, self.arm_box(), margin=0.03)
+        return any(overlaps(box, arm, margin=0.03) for arm in self.arm_boxes())
 
-    def arm_box(self) -> tuple[np.ndarray, np.ndarray]:
-        """World AABB of the arm at its home pose (forward of the base, raised)."""
+    def arm_boxes(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """World AABBs of the arm at its home pose: the column above the base and the forearm with
+        the cup, which hangs 0.3 m forward with its lowest point at ~1.01 m (above counters)."""
         c, s = math.cos(self.base[2]), math.sin(self.base[2])
-        corners = [
-            np.array([self.base[0] + c * x - s * y, self.base[1] + s * x + c * y])
-            for x in (-0.2, 0.42)
-            for y in (-0.15, 0.15)
-        ]
-        xy = np.array(corners)
-        return np.r_[xy.min(0), 0.35], np.r_[xy.max(0), 1.2]
+        out = []
+        for (x0, x1), (z0, z1) in (((-0.2, 0.12), (0.3, 1.35)), ((0.12, 0.42), (0.98, 1.35))):
+            xy = np.array(
+                [
+                    [self.base[0] + c * x - s * y, self.base[1] + s * x + c * y]
+                    for x in (x0, x1)
+                    for y in (-0.15, 0.15)
+                ]
+            )
+            out.append((np.r_[xy.min(0), z0], np.r_[xy.max(0), z1]))
+        return out
 
     # ---------------------------------------------------------------- placing
     def place_on_floor(

@@ -39,9 +39,10 @@ if TYPE_CHECKING:  # pragma: no cover
 ARM_JOINTS = tuple(f"panda_joint{i}" for i in range(1, 8))
 BASE_JOINTS = ("base_x", "base_y", "base_yaw")
 ROBOT_JOINTS = BASE_JOINTS + ARM_JOINTS
-# A tucked arm pose with the cup pointing straight down 0.3 m in front of the base at 0.75 m height
-# (found by forward kinematics; tests check it). Tucked so the robot fits close to furniture.
-HOME_ARM = (0.0, -0.84, 0.0, -2.51, 0.0, 0.1, -0.785)
+# A tucked arm pose with the cup pointing straight down 0.3 m in front of the base at 1.01 m height
+# (found by forward kinematics; tests check it): tucked and above counter height, so the base can
+# drive up to tables and counters without the arm hitting them.
+HOME_ARM = (0.0, -0.5, 0.0, -1.55, 0.0, -0.55, -0.785)
 BASE_HEIGHT = 0.30  # top of the mobile base, where the arm's link0 stands
 BASE_RADIUS = 0.22
 SUCTION_RANGE = 0.012  # metres: how far from the cup face an object may be and still be grabbed
