@@ -121,18 +121,18 @@ def base_text(name: str) -> str:
     return "; ".join(parts)
 
 
-def variant_text(name: str, asset: Asset, features: list[str]) -> str:
+def variant_text(name: str, asset: Asset, features: list[str], *, dims: bool = True) -> str:
     """What this variant adds: size, mass, look, moving parts, size-derived hazards. Short, so a
     catalogue of thousands embeds quickly (see ``retrieval.embeddings``)."""
     tag_list = object_table()[name][3]
     size = asset.size
-    dims = asset.aabb[1] - asset.aabb[0]
+    ext = asset.aabb[1] - asset.aabb[0]
     d = ".1f" if size < 0.1 else ".0f"
     mass = f"{asset.mass * 1000:.0f} g" if asset.mass < 0.5 else f"{asset.mass:.1f} kg"
-    parts = [
-        f"{size_words(size)} {name.replace('_', ' ')}, about {size * 100:{d}} cm across "
-        f"({dims[0] * 100:{d}} x {dims[1] * 100:{d}} x {dims[2] * 100:{d}} cm), {mass}"
-    ]
+    head = f"{size_words(size)} {name.replace('_', ' ')}, about {size * 100:{d}} cm across"
+    if dims:
+        head += f" ({ext[0] * 100:{d}} x {ext[1] * 100:{d}} x {ext[2] * 100:{d}} cm), {mass}"
+    parts = [head]
     if features:
         parts.append(", ".join(features))
     labels = sorted({j.label for j in asset.joints})

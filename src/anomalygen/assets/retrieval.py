@@ -3,9 +3,9 @@
 The catalogue is a list of (name, seed) variants with their descriptions; it is deterministic, so its
 hash identifies the embeddings. An entry's vector combines the embedding of what every variant of its
 name shares (``base_text``: what it is, its hazards; embedded once per name) with the embedding of its
-short variant text (size, look, moving parts). Embedding cost grows with tokens, so this is ~2.5x
-cheaper than embedding each full description, which is what keeps a 1,000-asset catalogue in budget. Embeddings are cached in memory and on disk
-(``$ANOMALYGEN_CACHE_DIR`` or ``~/.cache/anomalygen/asset_embeddings/<hash>.npy``), so a scene builder
+short variant text (size, look, moving parts; no per-axis dimensions). Embedding cost grows with
+tokens, and this embeds far fewer tokens than the full descriptions would. Embeddings are cached in
+memory and on disk (``$ANOMALYGEN_CACHE_DIR`` or ``~/.cache/anomalygen/asset_embeddings/<hash>.npy``), so a scene builder
 retrieving for hundreds of tasks embeds the catalogue once.
 """
 
@@ -56,7 +56,7 @@ def _entries(variants_per_name: int) -> tuple[CatalogueEntry, ...]:
                     round(a.size, 4),
                     tuple(properties(name, a.size)),
                     base_text(name),
-                    variant_text(name, a, a.features),
+                    variant_text(name, a, a.features, dims=False),
                 )
             )
     return tuple(out)
