@@ -70,7 +70,9 @@ class Grounder:
         #: targets); when a protocol hands them a fixed set of targets (the ablation), they pick
         #: among those by interest, as the paper's agents pick from the assets they are given.
         self.hazard_first = targets is None
-        self.benign = kb.benign_objects()
+        # Co-objects: safe clutter that normally rests on furniture. Things that live on the floor
+        # (shoes, balls, books) would become a second, tripping, hazard wherever a scene puts them.
+        self.benign = [b for b in kb.benign_objects() if "floor" not in kb.objects[b].supports]
         #: How often the group has already used a class/object/room/placement (set by the engine in
         #: brainstorm mode, where agents see the shared pool): choices lean away from repeats.
         self.seen: dict[str, int] = {}
