@@ -28,22 +28,11 @@ def detection_path(run: RunFolder, task_id: str):
     return run.detections_dir / f"{task_id}.json"
 
 
-_CLIENTS: dict[tuple[str, str], object] = {}
-
-
 def _client(llm):
-    """One LLM client per process and configuration (its cache and HTTP pool are reused across scenes).
+    """One LLM client per process and configuration (its cache and HTTP pool are reused across scenes)."""
+    from anomalygen.llm import shared_client
 
-    Keyed by the config's JSON plus the secret itself: the JSON masks the API key, so rebuilding the
-    config from it would send '**********' to the server.
-    """
-    from anomalygen.llm import get_client
-
-    secret = llm.api_key.get_secret_value() if llm.api_key is not None else ""
-    key = (llm.model_dump_json(), secret)
-    if key not in _CLIENTS:
-        _CLIENTS[key] = get_client(llm)
-    return _CLIENTS[key]
+    return shared_client(llm)
 
 
 def make_detector(settings):
@@ -120,9 +109,6 @@ def _item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str,
         raise ItemFailed(f"no valid scene_graph.json in {scene_dir} (build the scene first)")
     spec = try_read_model(scene_dir / "scene.json", SceneSpec)
     task = TaskProposal.model_validate(payload["task"])
-    if payload.get("llm_api_key"):
-        # StageContext carries settings as JSON, which masks the key ("**********"); restore it.
-        settings.llm.api_key = payload["llm_api_key"]
     detector = make_detector(settings)
     judge = make_judge(settings)
     client = getattr(detector, "client", None) or judge.llm
@@ -163,8 +149,7 @@ def run_stage(run: RunFolder, settings, *, force: bool = False, only: list[str] 
     if only and len(built) < len(chosen):
         missing = sorted({t.id for t in chosen} - {t.id for t in built})
         raise UserError(f"no built scene for: {', '.join(missing)} (run 'anomalygen build' first)")
-    secret = settings.llm.api_key.get_secret_value() if settings.llm.api_key is not None else None
-    items = [(t.id, {"task": t.model_dump(mode="json"), "llm_api_key": secret}) for t in built]
+    items = [(t.id, {"task": t.model_dump(mode="json")}) for t in built]
     summary = run_items(run, STAGE, items, _item, settings=settings, is_done=_is_done_for(run, settings), force=force,
                         description=f"detect ({settings.detect.detector})")
     _record_llm_usage(run, summary)
