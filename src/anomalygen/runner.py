@@ -8,6 +8,7 @@ Every stage uses this one code path, locally (inline or a process pool) or on Ra
 from __future__ import annotations
 
 import os
+import sys
 import tempfile
 import time
 import traceback
@@ -165,6 +166,9 @@ def _run_ray(todo, fn, ctx, settings, advance) -> dict[str, tuple[bool, Any]]:
             kwargs["address"] = settings.ray_address
         else:
             kwargs["num_cpus"] = settings.workers
+            # Like the spawn pool, workers of a local instance see the driver's import path, so item
+            # functions defined outside the installed package (tests, user plugins) unpickle there too.
+            kwargs["runtime_env"] = {"env_vars": {"PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}}
             kwargs["_temp_dir"] = tempfile.mkdtemp(prefix="ray-", dir=os.environ.get("ANOMALYGEN_RAY_TMP"))
         ray.init(**kwargs)
         started_here = True
