@@ -90,7 +90,6 @@ def run_pipeline(run: RunFolder, settings, *, force: bool = False, stages: list[
     index = run.report_dir / "index.html"
     if index.is_file():
         outcome["report"] = str(index)
-        if not settings.quiet:
-            print(f"report: {index.resolve()}")
+        print(f"report: {index.resolve()}")
     outcome["wall_s"] = round(time.perf_counter() - started, 3)
     return outcome
