@@ -8,6 +8,7 @@ import pytest
 from anomalygen.runfolder import RunFolder, atomic_write_bytes, write_jsonl, write_model
 from anomalygen.schema import (
     AssetRef,
+    BrainstormMode,
     Detection,
     Engine,
     HazardCategory,
@@ -23,7 +24,6 @@ from anomalygen.schema import (
     StageRecord,
     SubTaskResult,
     TaskProposal,
-    BrainstormMode,
 )
 
 TASKS = [
@@ -57,7 +57,6 @@ def _render(i: int) -> np.ndarray:
 
 
 def _video(path, i: int) -> None:
-    import imageio.v3 as iio
 
     frames = np.stack([np.roll(_render(i), 4 * f, axis=1) for f in range(8)])
     path.parent.mkdir(parents=True, exist_ok=True)

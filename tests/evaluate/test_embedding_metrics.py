@@ -3,10 +3,14 @@
 import numpy as np
 import pytest
 
-from anomalygen.evaluate.image_metrics import embed_images, image_similarity
-from anomalygen.evaluate.text_metrics import _word_piece_bags, mean_wmd, sbert_similarity, word_movers_distance
-from anomalygen.runfolder import RunFolder
 from anomalygen.evaluate import run_metrics as rm
+from anomalygen.evaluate.image_metrics import embed_images, image_similarity
+from anomalygen.evaluate.text_metrics import (
+    _word_piece_bags,
+    mean_wmd,
+    sbert_similarity,
+    word_movers_distance,
+)
 
 
 def test_wmd_zero_for_identical_and_ordered_by_meaning():

@@ -50,7 +50,7 @@ def success_bars(rates: dict[str, tuple[int, int]], title: str = "Success by cat
     values = [s / n if n else 0.0 for s, n in rates.values()]
     fig, ax = plt.subplots(figsize=(max(4.5, 0.9 * len(labels) + 2), 3.5))
     bars = ax.bar(labels, values, color="#4c72b0")
-    for bar, (s, n) in zip(bars, rates.values()):
+    for bar, (s, n) in zip(bars, rates.values(), strict=False):
         ax.text(bar.get_x() + bar.get_width() / 2, bar.get_height() + 0.02, f"{s}/{n}", ha="center", fontsize=9)
     ax.set_ylim(0, 1.12)
     ax.set_ylabel("success rate")

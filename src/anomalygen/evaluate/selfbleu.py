@@ -117,8 +117,8 @@ def _bleu_from_counts(numerators: list[int], denominators: list[int], hyp_len: i
         bp = 0.0
     else:
         bp = math.exp(1 - ref_len / hyp_len)
-    p_n = [(num + EPSILON) / den if num == 0 else num / den for num, den in zip(numerators, denominators)]
-    s = (w * math.log(p) for w, p in zip(WEIGHTS, p_n) if p > 0)
+    p_n = [(num + EPSILON) / den if num == 0 else num / den for num, den in zip(numerators, denominators, strict=False)]
+    s = (w * math.log(p) for w, p in zip(WEIGHTS, p_n, strict=False) if p > 0)
     return bp * math.exp(math.fsum(s))
 
 

@@ -83,8 +83,8 @@ def word_movers_distance(a: dict[int, float], b: dict[int, float], vecs: np.ndar
 
     if not a or not b:
         return 1.0  # nothing to move: treat an empty text as maximally unlike (cosine distance 1)
-    ia, wa = zip(*sorted(a.items()))
-    ib, wb = zip(*sorted(b.items()))
+    ia, wa = zip(*sorted(a.items()), strict=False)
+    ib, wb = zip(*sorted(b.items()), strict=False)
     cost = 1.0 - vecs[list(ia)] @ vecs[list(ib)].T
     np.clip(cost, 0.0, 2.0, out=cost)
     wa_arr = np.asarray(wa, dtype=np.float64)
