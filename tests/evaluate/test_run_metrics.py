@@ -60,3 +60,23 @@ def test_sample_pairs_is_seeded_and_distinct():
     b = sample_pairs(50, 100, np.random.default_rng(3))
     assert a == b and len(set(a)) == 100 and all(0 <= i < j < 50 for i, j in a)
     assert len(sample_pairs(5, 100, np.random.default_rng(0))) == 10
+
+
+def test_mixed_brainstorm_modes_get_ablation_rows(tmp_path):
+    from anomalygen.config import Settings
+    from anomalygen.evaluate.stage import evaluate_run
+    from anomalygen.runfolder import write_jsonl
+
+    from .conftest import build_synthetic_run
+
+    run = build_synthetic_run(tmp_path / "modes", stages=("brainstorm",))
+    tasks = rm.load_tasks(run)
+    for t in tasks[:2]:
+        t.provenance.mode = "plain"
+    write_jsonl(run.tasks_path, tasks)
+    s = Settings(quiet=True)
+    s.evaluate.baselines = False
+    s.evaluate.wmd_pairs = 5
+    rows = {r.name: r for r in evaluate_run(run, s).diversity if r.kind == "run"}
+    assert set(rows) == {"modes", "modes [mode=plain]", "modes [mode=brainstorm]"}
+    assert rows["modes [mode=plain]"].tasks == 2 and rows["modes [mode=brainstorm]"].tasks == 3

@@ -38,7 +38,9 @@ def diversity_table(
     image_metrics: bool = True,
     vit_weights: str | None = None,
     timings: dict | None = None,
+    groups: dict[str, Sequence[str]] | None = None,
 ) -> list[DiversityRow]:
+    """``groups``: extra run rows, e.g. texts per brainstorm mode (the paper's ablation on one run)."""
     timings = {} if timings is None else timings
     rows = []
     if run_texts:
@@ -51,6 +53,9 @@ def diversity_table(
             row.image_embedder = embedder_name(vit_weights)
             timings["image"] = round(time.perf_counter() - t0, 4)
         rows.append(row)
+    for label, texts in (groups or {}).items():
+        if len(texts) >= 2:
+            rows.append(text_row(f"{run_name} [{label}]", "run", texts, seed=seed, wmd_pairs=wmd_pairs, timings=timings))
     if baselines:
         for stem, display in BASELINES.items():
             rows.append(text_row(display, "baseline", baseline_texts(stem), seed=seed, wmd_pairs=wmd_pairs, timings=timings))

@@ -38,6 +38,9 @@ def evaluate_run(run: RunFolder, settings) -> Evaluation:
     timings: dict[str, float] = {}
 
     renders = rm.scene_renders(run)
+    by_mode: dict[str, list[str]] = {}
+    for t in tasks:
+        by_mode.setdefault(f"mode={t.provenance.mode}", []).append(task_text(t.name, t.description))
     rows = diversity_table(
         run.root.name,
         [task_text(t.name, t.description) for t in tasks],
@@ -48,6 +51,7 @@ def evaluate_run(run: RunFolder, settings) -> Evaluation:
         image_metrics=cfg.image_metrics,
         vit_weights=cfg.vit_weights,
         timings=timings,
+        groups=by_mode if len(by_mode) > 1 else None,  # brainstorm ablation rows when modes are mixed
     )
     not_run = [name for name, present in (
         ("brainstorm", bool(tasks)), ("build", bool(scenes)), ("detect", bool(detections)),
