@@ -65,8 +65,7 @@ def collect_gallery(run: RunFolder) -> list[GalleryItem]:
         render = run.scene_dir(tid) / "render_front.png"
         videos = []
         for res in sorted(results.get(tid, []), key=lambda r: r.seed):
-            src = run.skill_dir(tid, res.seed) / (res.video or "video.mp4")
-            if src.is_file():
+            if _find_video(run, tid, res.seed, res.video) is not None:
                 videos.append(f"videos/{tid}_seed{res.seed}.mp4")
         det = detections.get(tid)
         seeds = results.get(tid, [])
@@ -85,13 +84,20 @@ def collect_gallery(run: RunFolder) -> list[GalleryItem]:
     return items
 
 
+def _find_video(run: RunFolder, task_id: str, seed: int, declared: str | None = None) -> Path | None:
+    """The skill's video: the declared path (relative to the seed folder or the run), else any mp4 there."""
+    folder = run.skill_dir(task_id, seed)
+    candidates = [folder / declared, run.root / declared] if declared else []
+    candidates += [folder / "video.mp4", *sorted(folder.glob("*.mp4"))]
+    return next((p for p in candidates if p.is_file()), None)
+
+
 def _copy_videos(run: RunFolder, gallery: list[GalleryItem]) -> None:
     target = run.report_dir / "videos"
     for item in gallery:
         for rel in item.videos:
             seed = int(rel.rsplit("_seed", 1)[1].removesuffix(".mp4"))
-            res_path = run.skill_dir(item.task_id, seed)
-            src = next((p for p in (res_path / "video.mp4", *res_path.glob("*.mp4")) if p.is_file()), None)
+            src = _find_video(run, item.task_id, seed)
             if src is None:
                 continue
             dst = run.report_dir / rel
