@@ -1,0 +1,110 @@
+"""Decompose a fix into typed sub-tasks: knowledge-base recipes -> ``schema.Plan``.
+
+Each recipe step becomes one sub-task with a method (motion-planned primitive by default, as the
+paper picks primitives for reaching and placing), typed parameters naming scene instances, a
+RewardSpec built from composable terms (so the same step can be learned by SAC instead), and a
+SuccessSpec of knowledge-base predicates. Role variables are kept in the predicates and resolved
+through ``Plan.bindings`` when evaluated, so a plan stays readable and checkable.
+"""
+
+from __future__ import annotations
+
+from anomalygen.errors import ItemFailed
+from anomalygen.schema import (
+    Engine,
+    Plan,
+    PredicateCall,
+    RewardSpec,
+    RewardTerm,
+    SceneSpec,
+    SkillMethod,
+    SubTask,
+    SuccessSpec,
+)
+
+LIFT_HEIGHT = 0.12  # metres above the start height for a pick
+
+
+def _resolve(value: str, bindings: dict[str, str]) -> str:
+    return bindings.get(value, value) if value.startswith("$") else value
+
+
+def _joint_of(spec: SceneSpec | None, instance: str) -> tuple[str | None, float | None]:
+    """The articulated joint of ``instance`` (first one) and its closed value, from the scene spec."""
+    if spec is None:
+        return None, None
+    for obj in spec.objects:
+        if obj.name == instance and obj.joint_states:
+            js = obj.joint_states[0]
+            return js.name, js.closed_value
+    return None, None
+
+
+def _height_of(spec: SceneSpec | None, instance: str) -> float:
+    if spec is not None:
+        for obj in spec.objects:
+            if obj.name == instance:
+                return float(obj.pos[2])
+    return 0.0
+
+
+def step_to_subtask(index: int, action: str, args: dict[str, str], bindings: dict[str, str],
+                    spec: SceneSpec | None, final_success: list[PredicateCall]) -> SubTask:
+    """One recipe step -> one sub-task (primitive, with a reward spec for RL fallback)."""
+    obj = _resolve(args.get("object", "$hazard"), bindings)
+    sid = f"s{index + 1}_{action}"
+    # Success of a step: the class predicates that talk about this step's arguments.
+    vars_here = set(args.values())
+    own = [p for p in final_success if vars_here & {str(v) for v in p.args.values()}]
+    if action == "pick":
+        z = _height_of(spec, obj) + LIFT_HEIGHT
+        return SubTask(id=sid, description=f"grasp {obj} by suction and lift it", method=SkillMethod.PRIMITIVE,
+                       primitive="grasp", params={"object": obj, "lift": LIFT_HEIGHT},
+                       reward=RewardSpec(terms=[RewardTerm(kind="distance", a="ee", b=obj, weight=1.0),
+                                                RewardTerm(kind="lifted", a=obj, target=z, weight=2.0),
+                                                RewardTerm(kind="action_penalty", weight=0.01)]))
+    if action in ("place_inside", "place_on"):
+        dest_key = "container" if action == "place_inside" else "support"
+        dest = _resolve(args.get(dest_key, f"${dest_key}"), bindings)
+        kind = "inside" if action == "place_inside" else "distance"
+        return SubTask(id=sid, description=f"move {obj} {'into' if kind == 'inside' else 'onto'} {dest} and release it",
+                       method=SkillMethod.PRIMITIVE, primitive="move_to", params={"object": obj, "region": dest, "release": True},
+                       reward=RewardSpec(terms=[RewardTerm(kind=kind, a=obj, b=dest, weight=2.0),
+                                                RewardTerm(kind="action_penalty", weight=0.01)]),
+                       success=SuccessSpec(predicates=own))
+    if action in ("close_joint", "open_joint", "switch_off"):
+        target_obj = _resolve(args.get("object", "$target"), bindings)
+        joint, closed = _joint_of(spec, target_obj)
+        prim = {"close_joint": "push", "open_joint": "pull", "switch_off": "push"}[action]
+        params: dict = {"object": target_obj}
+        if args.get("part"):
+            params["part"] = args["part"]
+        terms = [RewardTerm(kind="action_penalty", weight=0.01)]
+        if joint is not None:
+            params["joint"] = joint
+            params["target"] = float(closed if action != "open_joint" else (closed or 0.0) + 1.0)
+            terms.insert(0, RewardTerm(kind="joint", joint=joint, target=params["target"], weight=2.0))
+            terms.insert(1, RewardTerm(kind="distance", a="ee", b=target_obj, weight=0.5))
+        return SubTask(id=sid, description=f"{action.replace('_', ' ')} of {target_obj}", method=SkillMethod.PRIMITIVE,
+                       primitive=prim, params=params, reward=RewardSpec(terms=terms), success=SuccessSpec(predicates=own))
+    if action == "move_away_from_edge":
+        return SubTask(id=sid, description=f"move {obj} away from the edge of its surface", method=SkillMethod.PRIMITIVE,
+                       primitive="move_to", params={"object": obj, "region": "surface_centre", "release": True},
+                       reward=RewardSpec(terms=[RewardTerm(kind="action_penalty", weight=0.01)]),
+                       success=SuccessSpec(predicates=own))
+    raise ItemFailed(f"recipe action {action!r} has no sub-task mapping")
+
+
+def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, spec: SceneSpec | None = None,
+                 source: str = "ground_truth") -> Plan:
+    """A plan from the knowledge-base recipe of ``hazard_class``."""
+    from anomalygen.knowledge.base import load_kb
+
+    kb = load_kb()
+    cls = kb.hazard_classes.get(hazard_class)
+    if cls is None:
+        raise ItemFailed(f"hazard class {hazard_class!r} is not in the knowledge base; no recipe to plan from")
+    subtasks = [step_to_subtask(i, step.action, dict(step.args), bindings, spec, list(cls.success))
+                for i, step in enumerate(cls.recipe)]
+    return Plan(task_id=task_id, source=source, engine=Engine.KNOWLEDGE, subtasks=subtasks,
+                success=SuccessSpec(predicates=list(cls.success)), bindings=dict(bindings))
