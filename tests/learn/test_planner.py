@@ -24,3 +24,27 @@ def test_store_plan_is_pick_then_place_inside():
     assert "inside" in kinds
     # the final step carries the class's success predicate
     assert plan.subtasks[1].success.predicates[0].name == "inside"
+
+
+def _task(tid, hazard_class):
+    from anomalygen.schema import Engine, HazardCategory, Provenance, Scenario, TaskProposal
+
+    return TaskProposal(id=tid, name="n", explanation="e", description="d", category=HazardCategory.HOUSEHOLD_HAZARD,
+                        hazard_class=hazard_class, target_asset="knife",
+                        scenario=Scenario(hazard_object="knife", room="kitchen", placement="counter_edge"),
+                        provenance=Provenance(engine=Engine.KNOWLEDGE, mode="plain"))
+
+
+def test_plan_stage_writes_plans_and_fails_one_item(tmp_path):
+    from anomalygen.config import Settings
+    from anomalygen.learn.plan_stage import run_stage
+    from anomalygen.runfolder import RunFolder, read_model, write_jsonl
+
+    run = RunFolder.create(tmp_path / "r")
+    write_jsonl(run.tasks_path, [_task("a", "store_sharp_objects"), _task("b", "no_such_class")])
+    summary = run_stage(run, Settings(quiet=True))
+    assert summary.done == 1 and summary.failed == 1 and "b" in summary.errors
+    plan = read_model(run.plan_path("a"), Plan)
+    assert plan.source == "ground_truth" and len(plan.subtasks) == 2
+    again = run_stage(run, Settings(quiet=True))
+    assert again.skipped == 1
