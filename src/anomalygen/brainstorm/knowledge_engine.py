@@ -142,7 +142,9 @@ class KnowledgeEngine:
                         idea = grounder.recombine(rng, others, agent=self.agents[i], agent_index=i, round_=r)
                     if idea is None:
                         idea = grounder.fresh(rng, agent=self.agents[i], agent_index=i, round_=r)
-                    texts = realise(idea, self.kb, rng, perspective=self.mode != BrainstormMode.PLAIN)
+                    # wording draws from its own stream, so changing phrase banks never changes scenarios
+                    words = item_rng(self.seed, "realise", self.mode.value, r, i, attempt, len(drafts))
+                    texts = realise(idea, self.kb, words, perspective=self.mode != BrainstormMode.PLAIN)
                     drafts.append((i, idea, texts))
             drafts = self._prefilter(drafts, needs)
             if not drafts:

@@ -9,12 +9,15 @@ choices come from the caller's generator, so the same seed gives the same words.
 
 from __future__ import annotations
 
+import json
 import re
+from functools import lru_cache
 
 import numpy as np
 
 from anomalygen.brainstorm.idea import Idea, Texts
 from anomalygen.knowledge import KnowledgeBase
+from anomalygen.knowledge.base import KNOWLEDGE_DIR
 
 _NICE_NAMES = {
     "StorageFurniture": "cabinet",
@@ -83,25 +86,6 @@ _ACTION_VERBS = {
     "move_away_from_edge": ["Move back", "Push back", "Re-centre", "Secure"],
 }
 
-_NAME_FRAMES = [
-    "{Verb} the {hazard} {place}",
-    "{Verb} the {hazard} in the {room}",
-    "{Hazard} {place}",
-    "{Mechanism_cap}",
-    "{Verb} the {hazard} before {person_short} gets to it",
-    "{Class}: the {hazard} in the {room}",
-    "The {hazard} {place}",
-    "{Verb} the {room} {hazard}",
-]
-_ARTIC_NAME_FRAMES = [
-    "{Verb} the {hazard} {part}",
-    "{Verb} the {part} of the {room} {hazard}",
-    "{Hazard} {part} left {state}",
-    "{Class} in the {room}",
-    "{Mechanism_cap}",
-    "The {room} {hazard} with its {part} {state}",
-]
-
 _EXPLANATION_FRAMES = [
     "{why}",
     "{Hazard_a} {place} is {mechanism}. {why}",
@@ -112,55 +96,11 @@ _EXPLANATION_FRAMES = [
     "It is {mechanism}, and {at_risk} are at risk. {why}",
 ]
 
-_CONTEXT_FRAMES = [
-    "{Hazard_a} has been left {place}{co}.",
-    "After {occasion}, {hazard_a} ended up {place}{co}.",
-    "Someone put {hazard_a} down {place}{co} and forgot about it.",
-    "{Hazard_a} sits {place}{co}.",
-    "In the {room}, {hazard_a} is {place}{co}.",
-    "There is {hazard_a} {place}{co}, left behind after {occasion}.",
-]
-_ARTIC_CONTEXT_FRAMES = [
-    "The {part} of the {hazard} in the {room} has been left {state}{co}.",
-    "After {occasion}, nobody {undo} the {part} of the {hazard}{co}.",
-    "In the {room}, the {hazard} stands with its {part} {state}{co}.",
-    "The {room} {hazard} was left with its {part} {state}{co}.",
-]
-_RISK_FRAMES = [
-    "{Person} is around and could get hurt.",
-    "This puts {person} at risk.",
-    "{Person} often comes through here.",
-    "It would only take a moment for {person} to get into trouble.",
-    "{Person} is the one most likely to suffer from it.",
-    "",
-]
-_FIX_FRAMES = [
-    "The robot should {solution}",
-    "To resolve it, the robot will {solution}",
-    "A suction-gripper arm can fix this: {solution}",
-    "Fix: {solution}",
-    "The robot's job is to {solution}",
-]
-_PERSPECTIVE_FRAMES = [
-    "As the {role}, someone who {perspective}, I would flag this.",
-    "This caught the eye of the {role}, who {perspective}.",
-    "The {role}, who {perspective}, raised it.",
-    "Flagged by the {role}, who {perspective}.",
-]
-
-#: Ways to say each recipe step (the description's fix sentence is built from the class's recipe).
-_STEP_WORDS = {
-    "pick": ["pick up the {object}", "lift the {object}", "grab the {object} with its suction cup", "take hold of the {object}"],
-    "place_inside": ["put it in the {container}", "drop it into the {container}", "store it inside the {container}", "tuck it away in the {container}"],
-    "place_on": ["lay it on the {support}", "set it down on the {support}", "rest it on top of the {support}"],
-    "open_joint": ["open the {container} {label}", "pull the {container} {label} open", "swing the {object} {label} open"],
-    "close_joint": ["close the {label}", "push the {label} shut", "swing the {label} closed", "shut the {label} again"],
-    "switch_off": ["turn the {label} to off", "switch it off at the {label}", "twist the {label} back to zero"],
-    "move_away_from_edge": ["slide the {object} back from the edge", "move the {object} towards the middle", "push the {object} to a safer spot further in"],
-}
-_STEP_JOIN = [" and then ", ", then ", " and ", "; after that, "]
 
 _UNDO = {"open": "closed", "closed": "opened", "on": "switched off", "off": "switched on"}
+
+
+FIX_LEAD_P = 0.3
 
 
 def nice(name: str) -> str:
@@ -194,14 +134,26 @@ def place_phrase(placement: str, room: str, rng: np.random.Generator) -> str:
     return str(rng.choice(_PLACE.get(placement, ["in the {room}"]))).format(room=room_words(room))
 
 
+_ALTERNATIVES = re.compile(r"\[([^\[\]]*)\]")
+
+
 def _choice(rng: np.random.Generator, options: list[str]) -> str:
-    return str(options[int(rng.integers(len(options)))])
+    """One option; any ``[a|b|c]`` inside it is a further independent choice (phrase-bank syntax)."""
+    text = str(options[int(rng.integers(len(options)))])
+    while "[" in text:
+        text = _ALTERNATIVES.sub(lambda m: _pick(rng, m.group(1).split("|")), text, count=1)
+    return text
 
 
-def _join(items: list[str]) -> str:
+def _pick(rng: np.random.Generator, options: list[str]) -> str:
+    return options[int(rng.integers(len(options)))]
+
+
+def _join(items: list[str], rng: np.random.Generator | None = None) -> str:
     if len(items) <= 1:
         return "".join(items)
-    return ", ".join(items[:-1]) + " and " + items[-1]
+    last = " and " if rng is None else _pick(rng, [" and ", " plus ", " as well as ", " and also ", ", and "])
+    return ", ".join(items[:-1]) + last + items[-1]
 
 
 def fix_phrase(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, part: str) -> str:
@@ -209,7 +161,7 @@ def fix_phrase(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, part: st
     hc = kb.hazard_classes[idea.class_id]
     names = {
         "object": nice(idea.hazard),
-        "container": nice(idea.container) if idea.container else "a safe place",
+        "container": (_pick(rng, ["", "", "nearby ", "closest ", "usual ", "proper ", "right "]) + nice(idea.container)) if idea.container else "a safe place",
         "support": nice(idea.support) if idea.support else "a raised surface",
     }
     pieces = []
@@ -221,75 +173,178 @@ def fix_phrase(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, part: st
             label = "door"
         obj_var = step.args.get("object")
         obj = names["container"] if obj_var == "$container" else names["object"]
-        pieces.append(_choice(rng, _STEP_WORDS[step.action]).format(object=obj, container=names["container"], support=names["support"], label=label))
+        container = obj if step.action == "open_joint" else names["container"]
+        pieces.append(_choice(rng, bank()["steps"][step.action]).format(object=obj, container=container, support=names["support"], label=label))
     out = pieces[0]
     for p in pieces[1:]:
-        out += _choice(rng, _STEP_JOIN) + p
+        out += _choice(rng, bank()["step_join"]) + p
     return out
 
 
+
+
+@lru_cache(maxsize=1)
+def bank() -> dict:
+    """The phrase banks (data/knowledge/phrasing.json), loaded once."""
+    return json.loads((KNOWLEDGE_DIR / "phrasing.json").read_text(encoding="utf-8"))
+
+
+def _adjective(kb: KnowledgeBase, obj: str, rng: np.random.Generator) -> str:
+    """A word for what makes the object dangerous (its first knowledge-base property with words)."""
+    info = kb.objects.get(obj)
+    options = [bank()["adjective"][p] for p in (info.properties if info else []) if p in bank()["adjective"]]
+    return _choice(rng, options[0]) if options else ""
+
+
+def _object_np(obj: str, adj: str, rng: np.random.Generator) -> str:
+    """How the hazard object is referred to: 'the bare knife', 'a knife', 'someone's knife'."""
+    core = f"{adj} {obj}" if adj else obj
+    form = int(rng.integers(4))
+    if form == 0:
+        return f"the {core}"
+    if form == 1:
+        return article(core)
+    if form == 2:
+        return f"that {core}"
+    return f"{_pick(rng, ['the', 'a', 'one', 'this'])} {_pick(rng, ['forgotten', 'stray', 'abandoned', 'misplaced', 'lone', 'unattended'])} {core}".replace("a a", "an a").replace("a u", "an u")
+
+
+def _tidy(text: str) -> str:
+    """Collapse spaces and a doubled word ('the window window' when the part is the object)."""
+    text = re.sub(r"\s+", " ", text).strip()
+    return re.sub(r"\b(\w+) \1\b", r"\1", text)
+
+
+def _words(text: str) -> int:
+    return len(text.split())
+
+
+def _name(slots: dict[str, str], frames: list[str], rng: np.random.Generator) -> str:
+    """A 3-8 word title; frames that come out too long or short are redrawn, then a plain fallback."""
+    for _ in range(4):
+        name = cap(_choice(rng, frames).format(**slots)).rstrip(".")
+        if 3 <= _words(name) <= 8:
+            return name
+    return cap(f"{slots['Verb']} the {slots['obj']}")
+
+
 def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspective: bool = True) -> Texts:
-    """Words for an idea. ``perspective`` adds the agent's point of view (role-play modes)."""
+    """Words for an idea. ``perspective`` adds the agent's point of view (role-play modes).
+
+    Every slot (opening, how the object/place/person are said, the harm, the role's concern, the fix
+    lead and steps, the sentence layout) is an independent draw, so two texts about similar
+    scenarios rarely share a four-word run; all words still come from the idea's own fields.
+    """
+    b = bank()
     hc = kb.hazard_classes[idea.class_id]
     room = room_words(idea.room)
     hazard = nice(idea.hazard)
     container = nice(idea.container) if idea.container else "a safe place"
     support = nice(idea.support) if idea.support else "a raised surface"
     articulated = hc.articulation is not None and hc.hazard_variable == "$target"
-    part = kb.articulation_part(hc, idea.hazard) or "door" if articulated else ""
+    part = (kb.articulation_part(hc, idea.hazard) or "door") if articulated else ""
     state = hc.articulation.initial_state if hc.articulation else ""
-    place = place_phrase(idea.placement, idea.room, rng)
     person = idea.person or hc.at_risk
-    co_names = [nice(c) for c in idea.co_objects if c not in (idea.hazard, idea.container)]
-    co = ""
-    if co_names:
-        co = _choice(rng, [" next to {x}", ", beside {x}", " among {x}", ", close to {x}"]).format(
-            x=_join([article(c) for c in co_names])
-        )
-    slots = {
-        "hazard": hazard,
-        "Hazard": cap(hazard),
-        "hazard_a": article(hazard),
-        "Hazard_a": cap(article(hazard)),
-        "hazard_the": f"the {hazard}",
-        "place": place,
-        "room": room,
-        "person": person,
-        "Person": cap(person),
-        "person_short": person.split(" who ")[0],
-        "mechanism": hc.mechanism,
-        "Mechanism_cap": cap(hc.mechanism),
-        "why": hc.why,
-        "why_lower": hc.why[:1].lower() + hc.why[1:],
-        "at_risk": hc.at_risk,
-        "Class": hc.name,
-        "part": part,
-        "state": {"on": "running", "off": "off"}.get(state, state),
-        "undo": _UNDO.get(state, "fixed"),
-        "occasion": _choice(rng, _OCCASIONS),
-        "co": co,
-    }
+    if person == hc.at_risk:  # the class-level phrase reads as a list; its first part is the people
+        person = person.split(",")[0].split(":")[0]
+    person_short = person.split(" who ")[0]
+    first, _, rest = person.partition(" ")
+    if first in ("a", "the") and rest and rng.random() < 0.5:  # 'our toddler', 'any guest': same person, other words
+        person = _pick(rng, ["any", "our"] if first == "a" else ["our"]) + " " + rest
+    adj = "" if articulated else _adjective(kb, idea.hazard, rng)
     verbs = _VERBS.get(hc.id) or _ACTION_VERBS.get(hc.recipe[-1].action) or ["Fix"]
-    slots["Verb"] = _choice(rng, verbs)
-    frames = _ARTIC_NAME_FRAMES if articulated else _NAME_FRAMES
-    name = cap(_choice(rng, frames).format(**slots)).rstrip(".")
+    verb = _choice(rng, verbs)
+    risk = _choice(rng, b["risk_word"][hc.id])
+    pshort = "" if articulated else place_phrase_bank(idea.placement, room, rng)
+    co_names = [nice(c) for c in idea.co_objects if c not in (idea.hazard, idea.container)]
+    co = _choice(rng, b["co"]).format(x=_join([article(c) for c in co_names], rng)) if co_names else ""
+    state_words = b["state"].get(state, ["as it is"])
+
+    # ---- name
+    slots = {
+        "Verb": verb, "obj": hazard, "Obj": cap(hazard), "room": room, "Room": cap(room), "risk": risk, "Risk": cap(risk),
+        "pshort": pshort, "person_short": person_short, "part": part,
+        "adj_obj": f"{adj} {hazard}" if adj else hazard, "Adj_obj": cap(f"{adj} {hazard}" if adj else hazard),
+        "state_word": {"on": "running", "open": "open", "closed": "shut"}.get(state, state),
+    }
+    name = _name(slots, b["artic_name_frames"] if articulated else b["name_frames"], rng)
+
+    # ---- description pieces
+    if articulated:
+        owner = _choice(rng, [f"the {room} {hazard}", f"the {hazard}", f"the {hazard} in the {room}"])
+        scene = owner if part in hazard else _choice(rng, [f"the {part} of {owner}", f"{owner}'s {part}"])
+        scene += " " + _choice(rng, state_words) + co
+        if room not in scene:
+            scene += f" in the {room}"
+    else:
+        place = pshort  # the same words as the name, so title and description never disagree
+        np_ = _object_np(hazard, adj, rng)
+        if not adj and room not in place and rng.random() < 0.3:  # 'the kitchen knife': the room as a modifier
+            np_ = np_.replace(hazard, f"{room} {hazard}", 1)
+        scene = f"{np_} {_choice(rng, b['lie'])} {place}{co}"
+        if room not in scene and not idea.placement.startswith(("inside:", "on:")) or room not in scene and rng.random() < 0.5:
+            scene += _choice(rng, b["room_mention"]).format(room=room)
+    harm = _choice(rng, b["harm"][hc.id]).format(person=person, obj=hazard)
+    lead = _choice(rng, b["fix_lead"]) + " " if rng.random() < FIX_LEAD_P else ""
+    fix = f"{lead}{fix_phrase(idea, kb, rng, part)}."
+    opening = _choice(rng, b["opening"])
+    role_sentence = ""
+    if perspective and idea.agent and idea.agent in kb.roles and rng.random() < 0.75:
+        role = kb.roles[idea.agent]
+        lead = _choice(rng, b["role_lead"]).format(role=role.name.lower(), Role=role.name)
+        view = _choice(rng, b["role_view"].get(role.id, [role.perspective]))
+        role_sentence = f"{lead} {view}"
+
+    layout = int(rng.integers(8))
+    if layout == 0:
+        body = [f"{opening} {scene}, so {harm}."]
+    elif layout == 1:
+        body = [f"{cap(scene)}.", f"{cap(harm)}."] if not role_sentence else [f"{cap(scene)}; {harm}."]
+    elif layout == 2:
+        body = [f"{cap(harm)}: {scene}."]
+    elif layout == 3:
+        body = [f"{opening} {scene} and {harm}."]
+    elif layout == 4:
+        body = [f"Because {scene}, {harm}."]
+    elif layout == 5:
+        body = [f"{cap(harm)}, since {scene}."]
+    elif layout == 6:
+        body = [f"{cap(scene)}, which means {harm}."]
+    else:
+        body = [f"{cap(_pick(rng, ['if', 'as long as', 'while', 'now that']))} {scene}, {harm}."]
+    if role_sentence:
+        if rng.random() < 0.5:
+            body = [f"{cap(role_sentence)}."] + body
+        else:
+            body = body + [f"{cap(role_sentence)}."]
+    body.append(cap(fix))
+    description = " ".join(cap(x.strip()) for x in body if x.strip())
+    description = _tidy(description)
+    name = _tidy(name)
 
     solution = hc.solution.format(hazard=hazard, container=container, support=support) if hc.solution else ""
     success = hc.success_text.format(hazard=hazard, container=container, support=support) if hc.success_text else ""
-    explanation = _choice(rng, _EXPLANATION_FRAMES).format(**slots)
-
-    sentences = [_choice(rng, _ARTIC_CONTEXT_FRAMES if articulated else _CONTEXT_FRAMES).format(**slots)]
-    risk = _choice(rng, _RISK_FRAMES).format(**slots)
-    if risk:
-        sentences.append(risk)
-    if perspective and idea.agent and rng.random() < 0.4:
-        role = kb.roles[idea.agent] if idea.agent in kb.roles else None
-        if role is not None:
-            persp = role.perspective
-            sentences.insert(
-                int(rng.integers(0, 2)) * len(sentences),
-                _choice(rng, _PERSPECTIVE_FRAMES).format(role=role.name.lower(), perspective=persp),
-            )
-    sentences.append(_choice(rng, _FIX_FRAMES).format(solution=fix_phrase(idea, kb, rng, part) + "."))
-    description = " ".join(s.strip() for s in sentences if s.strip())
+    ex_slots = {
+        "why": hc.why, "why_lower": hc.why[:1].lower() + hc.why[1:], "mechanism": hc.mechanism, "person": person,
+        "Person": cap(person), "at_risk": hc.at_risk, "hazard_the": f"the {hazard}", "Hazard_a": cap(article(hazard)),
+        "place": pshort or f"in the {room}",
+    }
+    explanation = _choice(rng, _EXPLANATION_FRAMES).format(**ex_slots)
     return Texts(name=name, explanation=explanation, description=description, solution=solution, success_condition=success)
+
+
+def place_phrase_bank(placement: str, room: str, rng: np.random.Generator) -> str:
+    """Where the object is, from the phrase bank (containers/supports name the catalogue object)."""
+    if placement.startswith("inside:"):
+        return _choice(rng, ["inside the {x}", "at the back of the {x}", "tucked into the {x}", "deep in the {x}", "in the {x}"]).format(
+            x=nice(placement.split(":", 1)[1])
+        )
+    if placement.startswith("on:"):
+        return _choice(rng, ["on top of the {x}", "on the {x}", "atop the {x}", "perched on the {x}"]).format(x=nice(placement.split(":", 1)[1]))
+    options = bank()["place"].get(placement, ["in the {room}"])
+    if room != "kitchen":  # sinks, hobs and kettles only stand in kitchens
+        options = [o for o in options if not any(w in o for w in _KITCHEN_ONLY)] or options
+    return _choice(rng, options).format(room=room)
+
+
+_KITCHEN_ONLY = ("sink", "hob", "chopping", "kettle", "toaster", "bread bin")
