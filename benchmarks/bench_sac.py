@@ -1,0 +1,41 @@
+"""Benchmark: SAC learns to close a cabinet door from a random start (test scene, paper settings).
+
+Acceptance: >= 80% success (deterministic evaluation episodes) within a budget that runs <= 20 min on
+2 cores. Prints the learning curve and writes it as JSON.
+
+    .venv/bin/python benchmarks/bench_sac.py --steps 20000 --out /tmp/bench_sac.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--steps", type=int, default=20000)
+    ap.add_argument("--eval-every", type=int, default=2000)
+    ap.add_argument("--eval-episodes", type=int, default=10)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--out", default=None)
+    args = ap.parse_args()
+
+    from anomalygen.learn.door_env import DoorCloseEnv
+    from anomalygen.learn.sac import train_sac
+
+    t0 = time.perf_counter()
+    _, res = train_sac(DoorCloseEnv, args.steps, seed=args.seed, eval_every=args.eval_every,
+                       eval_episodes=args.eval_episodes, log=lambda s: print(s, flush=True))
+    summary = {"task": "close cabinet door (random start 0.5-1.3 rad)", "steps": args.steps,
+               "best_success": res.best_success, "best_step": res.best_step, "wall_s": time.perf_counter() - t0,
+               "curve": res.curve, "passed": res.best_success >= 0.8}
+    print(json.dumps({k: v for k, v in summary.items() if k != "curve"}))
+    if args.out:
+        with open(args.out, "w") as fh:
+            json.dump(summary, fh, indent=2)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,131 @@
+"""Close-a-cabinet-door env on the test scene: the SAC benchmark task and the SAC test task.
+
+The paper's action: 6-D end-effector delta (translation, axis-angle rotation) plus suction, horizon
+100, frameskip 2. The cup follows a mocap target through the robot's ``ee_track`` weld (the arm's
+position actuators are made limp; gravity compensation holds the arm), so a step is just physics.
+The reward is a RewardSpec evaluated on the state dict, exactly as for scene sub-tasks; success is
+the door within ``closed_tol`` of closed (the knowledge base's ``joint closed`` check).
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from anomalygen.learn.reward import evaluate_spec
+from anomalygen.schema import RewardSpec, RewardTerm
+
+DOOR_REWARD = RewardSpec(terms=[
+    RewardTerm(kind="joint", joint="cabinet_0:door_hinge", target=0.0, weight=2.0),
+    RewardTerm(kind="distance", a="ee", b="cabinet_0:door_handle", weight=0.5),
+    RewardTerm(kind="action_penalty", weight=0.01),
+])
+
+
+class DoorCloseEnv(gym.Env):
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+
+    def __init__(self, frameskip: int = 2, horizon: int = 100, open_range=(0.5, 1.3), closed_tol: float = 0.1,
+                 reward: RewardSpec = DOOR_REWARD, max_delta_pos: float = 0.03, max_delta_rot: float = 0.1):
+        import mujoco
+
+        from anomalygen.learn.testbed import build
+
+        self._mj = mujoco
+        tb = build(with_objects=False, door_open=open_range[1])
+        self.model, self.data = tb.model, tb.data
+        m = self.model
+        for name in ("panda_joint%d" % i for i in range(1, 8)):
+            a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+            m.actuator_gainprm[a, 0] = 0.0
+            m.actuator_biasprm[a, :3] = 0.0
+        self._home = mujoco.MjData(m)
+        self._home.qpos[:] = self.data.qpos
+        self._home.ctrl[:] = self.data.ctrl
+        self.frameskip, self.horizon = frameskip, horizon
+        self.open_range, self.closed_tol, self.reward_spec = open_range, closed_tol, reward
+        self.dp, self.dr = max_delta_pos, max_delta_rot
+        self.action_space = spaces.Box(-1.0, 1.0, shape=(7,), dtype=np.float32)
+        self.observation_space = spaces.Box(-np.inf, np.inf, shape=(14,), dtype=np.float64)
+        self._site_ee = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "ee_site")
+        self._site_h = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "cabinet_0:door_handle")
+        self._eq = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, "ee_track")
+        self._mocap = m.body_mocapid[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "ee_target")]
+        self._cup = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "suction")
+        self._t = 0
+        self._action = np.zeros(7)
+        self._renderer = None
+
+    # -- state for rewards, success and observations
+    @property
+    def door(self) -> float:
+        return float(self.data.joint("cabinet_0:door_hinge").qpos[0])
+
+    def state(self) -> dict:
+        d = self.data
+        quat = np.zeros(4)
+        self._mj.mju_mat2Quat(quat, d.site_xmat[self._site_ee])
+        return {"ee": {"pos": d.site_xpos[self._site_ee].copy(), "quat": quat},
+                "objects": {"cabinet_0:door_handle": {"pos": d.site_xpos[self._site_h].copy(), "quat": [1, 0, 0, 0], "size": [0.02] * 3}},
+                "joints": {"cabinet_0:door_hinge": self.door}, "regions": {}, "action": self._action}
+
+    def _obs(self) -> np.ndarray:
+        ee, h = self.data.site_xpos[self._site_ee], self.data.site_xpos[self._site_h]
+        q = self.door
+        return np.concatenate([ee, h, h - ee, [q, np.sin(q), np.cos(q)], self.data.mocap_pos[self._mocap] - ee, [self._t / self.horizon]])[:14]
+
+    def success(self) -> bool:
+        return self.door < self.closed_tol  # at (or pushed just past) the closed stop
+
+    # -- gym API
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        mj, m, d = self._mj, self.model, self.data
+        d.qpos[:] = self._home.qpos
+        d.qvel[:] = 0
+        d.ctrl[:] = self._home.ctrl
+        d.joint("cabinet_0:door_hinge").qpos[0] = self.np_random.uniform(*self.open_range)
+        mj.mj_forward(m, d)
+        d.mocap_pos[self._mocap] = d.xpos[self._cup]
+        d.mocap_quat[self._mocap] = d.xquat[self._cup]
+        m.eq_data[self._eq, :] = 0.0
+        m.eq_data[self._eq, 6] = 1.0
+        m.eq_data[self._eq, 10] = 1.0
+        d.eq_active[self._eq] = 1
+        mj.mj_forward(m, d)
+        self._t = 0
+        self._action = np.zeros(7)
+        return self._obs(), {}
+
+    def step(self, action):
+        mj, d = self._mj, self.data
+        a = np.clip(np.asarray(action, dtype=float), -1, 1)
+        self._action = a
+        pos = d.mocap_pos[self._mocap] + self.dp * a[:3]
+        # keep the target near the cup so the weld never yanks the arm
+        ee = d.xpos[self._cup]
+        d.mocap_pos[self._mocap] = ee + np.clip(pos - ee, -0.08, 0.08)
+        dq = np.zeros(4)
+        mj.mju_axisAngle2Quat(dq, a[3:6] / (np.linalg.norm(a[3:6]) + 1e-9), self.dr * min(1.0, np.linalg.norm(a[3:6])))
+        q = np.zeros(4)
+        mj.mju_mulQuat(q, d.mocap_quat[self._mocap], dq)  # rotation in the gripper frame
+        d.mocap_quat[self._mocap] = q / np.linalg.norm(q)
+        for _ in range(self.frameskip):
+            mj.mj_step(self.model, d)
+        self._t += 1
+        reward = evaluate_spec(self.reward_spec, self.state())
+        ok = self.success()
+        truncated = self._t >= self.horizon
+        return self._obs(), reward, False, truncated, {"success": ok, "is_success": ok}
+
+    def render(self):
+        if self._renderer is None:
+            self._renderer = self._mj.Renderer(self.model, 240, 320)
+        self._renderer.update_scene(self.data, "front")
+        return self._renderer.render()
+
+    def close(self):
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
