@@ -152,7 +152,7 @@ def _pick(rng: np.random.Generator, options: list[str]) -> str:
 def _join(items: list[str], rng: np.random.Generator | None = None) -> str:
     if len(items) <= 1:
         return "".join(items)
-    last = " and " if rng is None else _pick(rng, [" and ", " plus ", " as well as ", " and also ", ", and "])
+    last = " and " if rng is None else _pick(rng, [" and ", " plus ", " and also ", ", and ", " and even ", " together with "])
     return ", ".join(items[:-1]) + last + items[-1]
 
 
@@ -206,13 +206,15 @@ def _object_np(obj: str, adj: str, rng: np.random.Generator) -> str:
         return article(core)
     if form == 2:
         return f"that {core}"
-    return f"{_pick(rng, ['the', 'a', 'one', 'this'])} {_pick(rng, ['forgotten', 'stray', 'abandoned', 'misplaced', 'lone', 'unattended'])} {core}".replace("a a", "an a").replace("a u", "an u")
+    det = _pick(rng, ["the", "a", "one", "this"])
+    det = "an" if det == "a" and not obj.endswith("s") else det
+    return f"{det} {_pick(rng, ['abandoned', 'unattended', 'misplaced'])} {obj}" if det == "an" else f"{det} {_pick(rng, ['forgotten', 'stray', 'lone', 'misplaced'])} {obj}"
 
 
 def _tidy(text: str) -> str:
     """Collapse spaces and a doubled word ('the window window' when the part is the object)."""
     text = re.sub(r"\s+", " ", text).strip()
-    return re.sub(r"\b(\w+) \1\b", r"\1", text)
+    return re.sub(r"\b(\w+) \1\b", r"\1", text, flags=re.IGNORECASE)
 
 
 def _words(text: str) -> int:
@@ -237,7 +239,7 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     """
     b = bank()
     hc = kb.hazard_classes[idea.class_id]
-    room = room_words(idea.room)
+    room = _choice(rng, b["room_synonyms"].get(idea.room, [room_words(idea.room)]))
     hazard = nice(idea.hazard)
     container = nice(idea.container) if idea.container else "a safe place"
     support = nice(idea.support) if idea.support else "a raised surface"
@@ -257,7 +259,12 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     risk = _choice(rng, b["risk_word"][hc.id])
     pshort = "" if articulated else place_phrase_bank(idea.placement, room, rng)
     co_names = [nice(c) for c in idea.co_objects if c not in (idea.hazard, idea.container)]
-    co = _choice(rng, b["co"]).format(x=_join([article(c) for c in co_names], rng)) if co_names else ""
+    if "co_objects" not in idea.borrowed and len(co_names) > 1:
+        # background clutter is detail: name one piece, unless borrowing the setting is the idea's point
+        co_names = [co_names[int(rng.integers(len(co_names)))]]
+    co_words = [article(c) for c in co_names]
+    co_words = [w if not w.startswith(("a ", "an ")) or rng.random() < 0.5 else f"{_pick(rng, ['the', 'one', 'that'])} {c}" for w, c in zip(co_words, co_names)]
+    co = _choice(rng, b["co"]).format(x=_join(co_words, rng)) if co_names else ""
     state_words = b["state"].get(state, ["as it is"])
 
     # ---- name
@@ -272,7 +279,7 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     # ---- description pieces
     if articulated:
         owner = _choice(rng, [f"the {room} {hazard}", f"the {hazard}", f"the {hazard} in the {room}"])
-        scene = owner if part in hazard else _choice(rng, [f"the {part} of {owner}", f"{owner}'s {part}"])
+        scene = owner if part in hazard else (f"the {part} of {owner}" if " in " in owner else _choice(rng, [f"the {part} of {owner}", f"{owner}'s {part}"]))
         scene += " " + _choice(rng, state_words) + co
         if room not in scene:
             scene += f" in the {room}"
@@ -282,9 +289,12 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
         if not adj and room not in place and rng.random() < 0.3:  # 'the kitchen knife': the room as a modifier
             np_ = np_.replace(hazard, f"{room} {hazard}", 1)
         scene = f"{np_} {_choice(rng, b['lie'])} {place}{co}"
-        if room not in scene and not idea.placement.startswith(("inside:", "on:")) or room not in scene and rng.random() < 0.5:
+        if room not in scene:
             scene += _choice(rng, b["room_mention"]).format(room=room)
-    harm = _choice(rng, b["harm"][hc.id]).format(person=person, obj=hazard)
+    harm = _choice(rng, b["harm"][hc.id])
+    if not re.match(r"(a|an|the|our|any|whoever|someone|everyone) ", person):  # plural people: no "'s"
+        harm = re.sub(r"\{person\}'s (\w+)", r"the \1 of {person}", harm)
+    harm = harm.format(person=person, obj=hazard)
     lead = _choice(rng, b["fix_lead"]) + " " if rng.random() < FIX_LEAD_P else ""
     fix = f"{lead}{fix_phrase(idea, kb, rng, part)}."
     opening = _choice(rng, b["opening"])
