@@ -20,7 +20,7 @@ def _state(rng: np.random.Generator) -> dict:
         "ee": {"pos": rng.uniform(-1, 1, 3).tolist(), "quat": [1.0, 0.0, 0.0, 0.0]},
         "suction": 0.0,
         "objects": {
-            "cup_0": {"pos": rng.uniform(-1, 1, 3).tolist(), "quat": (q := rng.normal(size=4) / 2).tolist(), "size": [0.1, 0.1, 0.12]},
+            "cup_0": {"pos": rng.uniform(-1, 1, 3).tolist(), "quat": (rng.normal(size=4) / 2).tolist(), "size": [0.1, 0.1, 0.12]},
             "cabinet_0:door": {"pos": rng.uniform(-1, 1, 3).tolist(), "quat": [1.0, 0.0, 0.0, 0.0], "size": [0.4, 0.02, 0.6]},
         },
         "joints": {"cabinet_0:door_hinge": float(rng.uniform(0, 1.5))},

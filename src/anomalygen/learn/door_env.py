@@ -36,7 +36,7 @@ class DoorCloseEnv(gym.Env):
         tb = build(with_objects=False, door_open=open_range[1])
         self.model, self.data = tb.model, tb.data
         m = self.model
-        for name in ("panda_joint%d" % i for i in range(1, 8)):
+        for name in (f"panda_joint{i}" for i in range(1, 8)):
             a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
             m.actuator_gainprm[a, 0] = 0.0
             m.actuator_biasprm[a, :3] = 0.0
