@@ -48,3 +48,22 @@ def test_plan_stage_writes_plans_and_fails_one_item(tmp_path):
     assert plan.source == "ground_truth" and len(plan.subtasks) == 2
     again = run_stage(run, Settings(quiet=True))
     assert again.skipped == 1
+
+
+def test_detected_source_plans_the_top_hypothesis(tmp_path):
+    from anomalygen.config import Settings
+    from anomalygen.learn.plan_stage import run_stage
+    from anomalygen.runfolder import RunFolder, read_model, write_jsonl
+    from anomalygen.schema import Detection, Hypothesis
+
+    run = RunFolder.create(tmp_path / "r")
+    write_jsonl(run.tasks_path, [_task("a", "store_sharp_objects")])
+    hyps = [Hypothesis(rank=2, problem="p", solution="s", target_object="cup_0", hazard_class="store_sharp_objects"),
+            Hypothesis(rank=1, problem="p", solution="s", target_object="scissors_0", hazard_class="store_sharp_objects")]
+    write_jsonl(run.detections_path, [Detection(task_id="a", scene_id="a", detector="rules", hypotheses=hyps)])
+    settings = Settings(quiet=True)
+    settings.learn.plan_source = "detected"
+    assert run_stage(run, settings).done == 1
+    plan = read_model(run.plan_path("a"), Plan)
+    assert plan.source == "detected" and plan.bindings["$hazard"] == "scissors_0"
+    assert plan.subtasks[0].params["object"] == "scissors_0"
