@@ -1,10 +1,12 @@
 """Text realisation: name, explanation, description, solution and success condition from an Idea.
 
-Why not one template: diversity metrics (Self-BLEU, SBERT similarity) read the *text*, and a single
-sentence frame would make every task look alike however different the scenarios were. Each field is
-built from several interchangeable sentence frames, filled with slot phrases that themselves vary
-(how a place, a person, an object or a fix is said), and agents add their own perspective. All
-choices come from the caller's generator, so the same seed gives the same words.
+Why phrase banks and not sentence frames: diversity metrics (Self-BLEU, SBERT similarity) read the
+*text*, and a few fixed frames make every text share most of its four-word runs with some other text
+(Self-BLEU 0.80 on a 111-task run). Here every slot (opening, how the object, place, room and person
+are said, the class's harm, the role's remark, the fix's lead and steps, the sentence layout) is an
+independent draw from data/knowledge/phrasing.json, whose phrases hold further ``[a|b|c]`` choices.
+All the words still come from the idea's own fields, so a text never claims what the scenario lacks.
+Every choice comes from the caller's generator: the same seed gives the same words.
 """
 
 from __future__ import annotations
@@ -41,29 +43,7 @@ _NICE_NAMES = {
     "medicine_cabinet": "medicine cabinet",
 }
 
-_PLACE = {
-    "floor": ["on the {room} floor", "lying on the floor of the {room}", "down on the {room} floor", "on the floor by the wall"],
-    "walkway": [
-        "in the middle of the {room} walkway",
-        "right where people walk through the {room}",
-        "across the path through the {room}",
-        "in the open stretch of the {room} floor",
-    ],
-    "table": ["on the {room} table", "on top of the table in the {room}", "on the table", "among the things on the table"],
-    "low_table": ["on the low coffee table", "on a low table in the {room}", "on the little table at toddler height", "on the low side table"],
-    "table_edge": ["at the very edge of the table", "hanging over the table's edge", "close to the rim of the {room} table", "on the table corner"],
-    "counter": ["on the {room} counter", "on the worktop", "out on the counter", "on the kitchen counter next to the sink"],
-    "counter_edge": ["right at the edge of the counter", "on the lip of the worktop", "balanced at the front edge of the counter", "at the counter's edge"],
-    "shelf": ["on a shelf", "up on the {room} shelf", "on the open shelf", "on a shelf among other things"],
-}
-
 _ROOM_WORDS = {"living_room": "living room", "laundry_room": "laundry room"}
-
-_OCCASIONS = [
-    "dinner", "a birthday party", "the weekly shop", "a busy morning", "movie night", "homework time",
-    "a long day at work", "unpacking the groceries", "a visit from the grandparents", "a rushed breakfast",
-    "a weekend of DIY", "the school run", "a late-night snack", "spring cleaning",
-]
 
 _VERBS = {
     "dispose_spoiled_food": ["Throw out", "Bin", "Dispose of", "Get rid of", "Discard"],
@@ -97,9 +77,6 @@ _EXPLANATION_FRAMES = [
 ]
 
 
-_UNDO = {"open": "closed", "closed": "opened", "on": "switched off", "off": "switched on"}
-
-
 FIX_LEAD_P = 0.3
 
 
@@ -112,7 +89,12 @@ def nice(name: str) -> str:
 
 def article(phrase: str) -> str:
     first = phrase.split()[0] if phrase else ""
-    if first.lower() in {"some", "the"} or phrase.endswith("s") and not phrase.endswith("ss") and first not in ("a", "an"):
+    if (
+        first.lower() in {"some", "the"}
+        or phrase.endswith("s")
+        and not phrase.endswith("ss")
+        and first not in ("a", "an")
+    ):
         return phrase if first.lower() in {"some", "the"} else f"some {phrase}"
     return ("an " if phrase[:1].lower() in "aeiou" else "a ") + phrase
 
@@ -123,15 +105,6 @@ def cap(text: str) -> str:
 
 def room_words(room: str) -> str:
     return _ROOM_WORDS.get(room, room.replace("_", " "))
-
-
-def place_phrase(placement: str, room: str, rng: np.random.Generator) -> str:
-    if placement.startswith("inside:"):
-        options = ["inside the {x}", "at the back of the {x}", "tucked into the {x}"]
-        return str(rng.choice(options)).format(x=nice(placement.split(":", 1)[1]))
-    if placement.startswith("on:"):
-        return str(rng.choice(["on top of the {x}", "on the {x}"])).format(x=nice(placement.split(":", 1)[1]))
-    return str(rng.choice(_PLACE.get(placement, ["in the {room}"]))).format(room=room_words(room))
 
 
 _ALTERNATIVES = re.compile(r"\[([^\[\]]*)\]")
@@ -152,7 +125,11 @@ def _pick(rng: np.random.Generator, options: list[str]) -> str:
 def _join(items: list[str], rng: np.random.Generator | None = None) -> str:
     if len(items) <= 1:
         return "".join(items)
-    last = " and " if rng is None else _pick(rng, [" and ", " plus ", " and also ", ", and ", " and even ", " together with "])
+    last = (
+        " and "
+        if rng is None
+        else _pick(rng, [" and ", " plus ", " and also ", ", and ", " and even ", " together with "])
+    )
     return ", ".join(items[:-1]) + last + items[-1]
 
 
@@ -161,26 +138,37 @@ def fix_phrase(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, part: st
     hc = kb.hazard_classes[idea.class_id]
     names = {
         "object": nice(idea.hazard),
-        "container": (_pick(rng, ["", "", "nearby ", "closest ", "usual ", "proper ", "right "]) + nice(idea.container)) if idea.container else "a safe place",
+        "container": (
+            _pick(rng, ["", "", "nearby ", "closest ", "usual ", "proper ", "right "]) + nice(idea.container)
+        )
+        if idea.container
+        else "a safe place",
         "support": nice(idea.support) if idea.support else "a raised surface",
     }
     pieces = []
     for step in hc.recipe:
         label = step.args.get("label", "")
         if "|" in label or not label:
-            label = part or (kb.articulation_part(hc, idea.container) if idea.container else None) or label.split("|")[0] or "door"
+            label = (
+                part
+                or (kb.articulation_part(hc, idea.container) if idea.container else None)
+                or label.split("|")[0]
+                or "door"
+            )
         if step.action == "open_joint" and step.args.get("object") == "$container":
             label = "door"
         obj_var = step.args.get("object")
         obj = names["container"] if obj_var == "$container" else names["object"]
         container = obj if step.action == "open_joint" else names["container"]
-        pieces.append(_choice(rng, bank()["steps"][step.action]).format(object=obj, container=container, support=names["support"], label=label))
+        pieces.append(
+            _choice(rng, bank()["steps"][step.action]).format(
+                object=obj, container=container, support=names["support"], label=label
+            )
+        )
     out = pieces[0]
     for p in pieces[1:]:
         out += _choice(rng, bank()["step_join"]) + p
     return out
-
-
 
 
 @lru_cache(maxsize=1)
@@ -208,7 +196,11 @@ def _object_np(obj: str, adj: str, rng: np.random.Generator) -> str:
         return f"that {core}"
     det = _pick(rng, ["the", "a", "one", "this"])
     det = "an" if det == "a" and not obj.endswith("s") else det
-    return f"{det} {_pick(rng, ['abandoned', 'unattended', 'misplaced'])} {obj}" if det == "an" else f"{det} {_pick(rng, ['forgotten', 'stray', 'lone', 'misplaced'])} {obj}"
+    return (
+        f"{det} {_pick(rng, ['abandoned', 'unattended', 'overlooked'])} {obj}"
+        if det == "an"
+        else f"{det} {_pick(rng, ['forgotten', 'stray', 'lone', 'misplaced'])} {obj}"
+    )
 
 
 def _tidy(text: str) -> str:
@@ -251,8 +243,10 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
         person = person.split(",")[0].split(":")[0]
     person_short = person.split(" who ")[0]
     first, _, rest = person.partition(" ")
-    if first in ("a", "the") and rest and rng.random() < 0.5:  # 'our toddler', 'any guest': same person, other words
-        person = _pick(rng, ["any", "our"] if first == "a" else ["our"]) + " " + rest
+    if (
+        first in ("a", "the") and rest and rng.random() < 0.5
+    ):  # 'our toddler', 'any guest': same person, other words
+        person = _pick(rng, ["any", "our"]) + " " + rest if first == "a" else person
     adj = "" if articulated else _adjective(kb, idea.hazard, rng)
     verbs = _VERBS.get(hc.id) or _ACTION_VERBS.get(hc.recipe[-1].action) or ["Fix"]
     verb = _choice(rng, verbs)
@@ -263,15 +257,29 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
         # background clutter is detail: name one piece, unless borrowing the setting is the idea's point
         co_names = [co_names[int(rng.integers(len(co_names)))]]
     co_words = [article(c) for c in co_names]
-    co_words = [w if not w.startswith(("a ", "an ")) or rng.random() < 0.5 else f"{_pick(rng, ['the', 'one', 'that'])} {c}" for w, c in zip(co_words, co_names)]
+    co_words = [
+        w
+        if not w.startswith(("a ", "an ")) or rng.random() < 0.5
+        else f"{_pick(rng, ['the', 'one', 'that'])} {c}"
+        for w, c in zip(co_words, co_names, strict=True)
+    ]
     co = _choice(rng, b["co"]).format(x=_join(co_words, rng)) if co_names else ""
     state_words = b["state"].get(state, ["as it is"])
 
     # ---- name
     slots = {
-        "Verb": verb, "obj": hazard, "Obj": cap(hazard), "room": room, "Room": cap(room), "risk": risk, "Risk": cap(risk),
-        "pshort": pshort, "person_short": person_short, "part": part,
-        "adj_obj": f"{adj} {hazard}" if adj else hazard, "Adj_obj": cap(f"{adj} {hazard}" if adj else hazard),
+        "Verb": verb,
+        "obj": hazard,
+        "Obj": cap(hazard),
+        "room": room,
+        "Room": cap(room),
+        "risk": risk,
+        "Risk": cap(risk),
+        "pshort": pshort,
+        "person_short": person_short,
+        "part": part,
+        "adj_obj": f"{adj} {hazard}" if adj else hazard,
+        "Adj_obj": cap(f"{adj} {hazard}" if adj else hazard),
         "state_word": {"on": "running", "open": "open", "closed": "shut"}.get(state, state),
     }
     name = _name(slots, b["artic_name_frames"] if articulated else b["name_frames"], rng)
@@ -279,15 +287,25 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     # ---- description pieces
     if articulated:
         owner = _choice(rng, [f"the {room} {hazard}", f"the {hazard}", f"the {hazard} in the {room}"])
-        scene = owner if part in hazard else (f"the {part} of {owner}" if " in " in owner else _choice(rng, [f"the {part} of {owner}", f"{owner}'s {part}"]))
+        scene = (
+            owner
+            if part in hazard
+            else (
+                f"the {part} of {owner}"
+                if " in " in owner
+                else _choice(rng, [f"the {part} of {owner}", f"{owner}'s {part}"])
+            )
+        )
         scene += " " + _choice(rng, state_words) + co
         if room not in scene:
             scene += f" in the {room}"
     else:
         place = pshort  # the same words as the name, so title and description never disagree
         np_ = _object_np(hazard, adj, rng)
-        if not adj and room not in place and rng.random() < 0.3:  # 'the kitchen knife': the room as a modifier
-            np_ = np_.replace(hazard, f"{room} {hazard}", 1)
+        if (
+            not adj and room not in place and rng.random() < 0.3
+        ):  # 'the kitchen knife': the room as a modifier
+            np_ = re.sub(r"^a ([aeiou])", r"an \1", np_.replace(hazard, f"{room} {hazard}", 1))
         scene = f"{np_} {_choice(rng, b['lie'])} {place}{co}"
         if room not in scene:
             scene += _choice(rng, b["room_mention"]).format(room=room)
@@ -302,7 +320,10 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     if perspective and idea.agent and idea.agent in kb.roles and rng.random() < 0.75:
         role = kb.roles[idea.agent]
         lead = _choice(rng, b["role_lead"]).format(role=role.name.lower(), Role=role.name)
-        view = _choice(rng, b["role_view"].get(role.id, [role.perspective]))
+        views = b["role_view"].get(role.id, [role.perspective])
+        if articulated:  # a fridge or window is shut, not put away
+            views = [v for v in views if not any(w in v for w in ("put away", "belongs", "should go"))]
+        view = _choice(rng, views).format(obj=hazard)
         role_sentence = f"{lead} {view}"
 
     layout = int(rng.integers(8))
@@ -333,24 +354,47 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     name = _tidy(name)
 
     solution = hc.solution.format(hazard=hazard, container=container, support=support) if hc.solution else ""
-    success = hc.success_text.format(hazard=hazard, container=container, support=support) if hc.success_text else ""
+    success = (
+        hc.success_text.format(hazard=hazard, container=container, support=support) if hc.success_text else ""
+    )
     ex_slots = {
-        "why": hc.why, "why_lower": hc.why[:1].lower() + hc.why[1:], "mechanism": hc.mechanism, "person": person,
-        "Person": cap(person), "at_risk": hc.at_risk, "hazard_the": f"the {hazard}", "Hazard_a": cap(article(hazard)),
+        "why": hc.why,
+        "why_lower": hc.why[:1].lower() + hc.why[1:],
+        "mechanism": hc.mechanism,
+        "person": person,
+        "Person": cap(person),
+        "at_risk": hc.at_risk,
+        "hazard_the": f"the {hazard}",
+        "Hazard_a": cap(article(hazard)),
         "place": pshort or f"in the {room}",
     }
     explanation = _choice(rng, _EXPLANATION_FRAMES).format(**ex_slots)
-    return Texts(name=name, explanation=explanation, description=description, solution=solution, success_condition=success)
+    return Texts(
+        name=name,
+        explanation=explanation,
+        description=description,
+        solution=solution,
+        success_condition=success,
+    )
 
 
 def place_phrase_bank(placement: str, room: str, rng: np.random.Generator) -> str:
     """Where the object is, from the phrase bank (containers/supports name the catalogue object)."""
     if placement.startswith("inside:"):
-        return _choice(rng, ["inside the {x}", "at the back of the {x}", "tucked into the {x}", "deep in the {x}", "in the {x}"]).format(
+        return _choice(
+            rng,
+            [
+                "inside the {x}",
+                "at the back of the {x}",
+                "tucked into the {x}",
+                "deep in the {x}",
+                "in the {x}",
+            ],
+        ).format(x=nice(placement.split(":", 1)[1]))
+    if placement.startswith("on:"):
+        return _choice(rng, ["on top of the {x}", "on the {x}", "atop the {x}", "perched on the {x}"]).format(
             x=nice(placement.split(":", 1)[1])
         )
-    if placement.startswith("on:"):
-        return _choice(rng, ["on top of the {x}", "on the {x}", "atop the {x}", "perched on the {x}"]).format(x=nice(placement.split(":", 1)[1]))
     options = bank()["place"].get(placement, ["in the {room}"])
     if room != "kitchen":  # sinks, hobs and kettles only stand in kitchens
         options = [o for o in options if not any(w in o for w in _KITCHEN_ONLY)] or options
