@@ -85,3 +85,335 @@ def push_joint(env_like, joint: str, goal: float, point_site: str, *, tol: float
             on_step()
     ok = abs(q() - goal) <= tol or sign * (goal - q()) <= 0
     return PrimitiveResult(ok, steps, f"{joint} = {q():.3f} (goal {goal:.3f})")
+
+
+# --------------------------------------------------------------------------- primitives on built scenes
+#
+# The functions below work on a scene built by the scene stage (``scene.graph.load_scene``). One
+# :class:`Driver` owns the model/data, the mocap end-effector target and the frame hook. The arm is
+# driven through the ``ee_track`` weld: the cup follows the mocap body, which is moved along straight
+# interpolated waypoints at most ``dp`` metres per control step (``frameskip`` physics steps each).
+# The mobile base is placed kinematically: a collision-free pose facing the target at arm's reach is
+# chosen from a fixed ring of candidates (deterministic; no base path planning yet), and a held object
+# is carried rigidly with it. Given the seed, every run is identical.
+
+PRE_CONTACT = 0.03  # metres off the surface before the straight approach along the normal
+BASE_REACH = (0.55, 0.45, 0.65, 0.75)  # base-to-target horizontal distances tried, in order
+
+
+class Driver:
+    """Owns a loaded scene and moves the suction cup / base; counts control steps, calls ``on_step``."""
+
+    def __init__(self, model, data, spec, *, frameskip: int = 5, dp: float = 0.012, on_step=None,
+                 rng: np.random.Generator | None = None):
+        import mujoco
+
+        from anomalygen.scene import robot
+
+        self.model, self.data, self.spec = model, data, spec
+        self.frameskip, self.dp, self.on_step = int(frameskip), float(dp), on_step
+        self.steps = 0
+        # The seed only turns the ring of candidate base poses, so seeds try different approach sides.
+        self.ring_offset = float(rng.uniform(0.0, 2 * np.pi / 24)) if rng is not None else 0.0
+        self._mocap = robot.enable_ee_tracking(model, data)
+        self._cup = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "suction")
+        self._site_ee = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "suction_site")
+        mujoco.mj_forward(model, data)
+        r = data.xmat[self._cup].reshape(3, 3)
+        self._site_local = r.T @ (data.site_xpos[self._site_ee] - data.xpos[self._cup])
+        self._robot_geoms = set(robot.robot_geom_ids(model).tolist())
+        self._floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "floor")
+
+    # ---------------------------------------------------------------- low level
+    def step(self) -> None:
+        import mujoco
+
+        for _ in range(self.frameskip):
+            mujoco.mj_step(self.model, self.data)
+        self.steps += 1
+        if self.on_step is not None:
+            self.on_step(self)
+
+    def settle(self, n: int = 20) -> None:
+        for _ in range(n):
+            self.step()
+
+    @property
+    def site(self) -> np.ndarray:
+        return self.data.site_xpos[self._site_ee].copy()
+
+    def goto(self, target, quat=None, *, tol: float = 0.012, max_steps: int = 250) -> bool:
+        """Move the cup face (``suction_site``) to ``target`` with the cup oriented as ``quat``."""
+        import mujoco
+
+        d = self.data
+        target = np.asarray(target, dtype=float)
+        if quat is not None:
+            d.mocap_quat[self._mocap] = quat
+        for _ in range(max_steps):
+            rq = np.zeros(9)
+            mujoco.mju_quat2Mat(rq, d.mocap_quat[self._mocap])
+            want = target - rq.reshape(3, 3) @ self._site_local
+            delta = want - d.mocap_pos[self._mocap]
+            n = np.linalg.norm(delta)
+            if n > self.dp:
+                delta *= self.dp / n
+            cup = d.xpos[self._cup]
+            d.mocap_pos[self._mocap] = cup + np.clip(d.mocap_pos[self._mocap] + delta - cup, -0.08, 0.08)
+            self.step()
+            if np.linalg.norm(self.site - target) < tol:
+                return True
+        return bool(np.linalg.norm(self.site - target) < 2 * tol)
+
+    # ---------------------------------------------------------------- scene queries
+    def body_id(self, name: str) -> int:
+        import mujoco
+
+        return mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name)
+
+    def aabb(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """World AABB of all geoms of body ``name`` and its descendants (collision geoms first)."""
+        from anomalygen.scene import robot
+        from anomalygen.scene.graph import geom_world_aabbs
+
+        mask = robot._subtree_geoms(self.model, self.body_id(name))
+        lo, hi = geom_world_aabbs(self.model, self.data)
+        coll = mask & (self.model.geom_contype | self.model.geom_conaffinity).astype(bool)
+        use = coll if coll.any() else mask
+        return lo[use].min(axis=0), hi[use].max(axis=0)
+
+    def _robot_in_collision(self) -> bool:
+        d = self.data
+        for i in range(d.ncon):
+            g1, g2 = int(d.contact.geom1[i]), int(d.contact.geom2[i])
+            r1, r2 = g1 in self._robot_geoms, g2 in self._robot_geoms
+            if r1 != r2 and self._floor not in (g1, g2) and d.contact.dist[i] < -0.002:
+                other = g2 if r1 else g1
+                held = self.held
+                if held is not None and self._in_body(other, held):
+                    continue
+                return True
+        return False
+
+    def _in_body(self, geom: int, name: str) -> bool:
+        from anomalygen.scene import robot
+
+        return bool(robot._subtree_geoms(self.model, self.body_id(name))[geom])
+
+    @property
+    def held(self) -> str | None:
+        from anomalygen.scene import robot
+
+        return robot.held_object(self.model, self.data)
+
+    # ---------------------------------------------------------------- base
+    def place_base_near(self, point, *, reach=BASE_REACH) -> bool:
+        """Put the base at a collision-free pose facing ``point`` at arm's reach (kinematic move).
+
+        Candidates: rings of 24 headings at each distance in ``reach``, tried nearest-to-current first.
+        A held object is carried rigidly with the base. Returns False (base unchanged) if none is free.
+        """
+        import mujoco
+
+        from anomalygen.scene import robot
+
+        m, d = self.model, self.data
+        p = np.asarray(point, dtype=float)
+        cur = np.array([d.joint(j).qpos[0] for j in robot.BASE_JOINTS])
+        if np.hypot(*(p[:2] - cur[:2])) < 0.62 and self._facing(cur, p):
+            return True
+        saved = (d.qpos.copy(), d.qvel.copy(), d.mocap_pos.copy(), d.mocap_quat.copy())
+        held = self.held
+        hb = self.body_id(held) if held else -1
+        hq = m.jnt_qposadr[m.body_jntadr[hb]] if held and m.body_jntadr[hb] >= 0 else -1
+        for r in reach:
+            angles = self.ring_offset + np.linspace(0, 2 * np.pi, 24, endpoint=False)
+            cands = [p[:2] + r * np.array([np.cos(a), np.sin(a)]) for a in angles]
+            cands.sort(key=lambda b: float(np.hypot(*(b - cur[:2]))))
+            for b in cands:
+                yaw = float(np.arctan2(p[1] - b[1], p[0] - b[0]))
+                self._move_base_rigid(cur, np.array([b[0], b[1], yaw]), saved, hq)
+                mujoco.mj_forward(m, d)
+                if not self._robot_in_collision():
+                    for j, v in zip(robot.BASE_JOINTS, (b[0], b[1], yaw), strict=True):
+                        d.actuator(j).ctrl[0] = v
+                    d.qvel[:] = 0.0
+                    self.settle(10)
+                    return True
+        d.qpos[:], d.qvel[:], d.mocap_pos[:], d.mocap_quat[:] = saved
+        mujoco.mj_forward(m, d)
+        return False
+
+    @staticmethod
+    def _facing(base, p) -> bool:
+        want = np.arctan2(p[1] - base[1], p[0] - base[0])
+        return abs((want - base[2] + np.pi) % (2 * np.pi) - np.pi) < 0.6
+
+    def _move_base_rigid(self, cur, new, saved, hq) -> None:
+        """Set base joints to ``new`` and carry the mocap target (and a held object) rigidly along."""
+        import mujoco
+
+        from anomalygen.scene import robot
+
+        d = self.data
+        qpos0, _, mpos0, mquat0 = saved
+        d.qpos[:] = qpos0
+        for j, v in zip(robot.BASE_JOINTS, new, strict=True):
+            d.joint(j).qpos[0] = v
+        dyaw = new[2] - cur[2]
+        c, s = np.cos(dyaw), np.sin(dyaw)
+        rz = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+        qz = np.array([np.cos(dyaw / 2), 0, 0, np.sin(dyaw / 2)])
+        base0 = np.array([cur[0], cur[1], 0.0])
+        base1 = np.array([new[0], new[1], 0.0])
+
+        def carry(pos, quat):
+            q = np.zeros(4)
+            mujoco.mju_mulQuat(q, qz, quat)
+            return rz @ (pos - base0) + base1, q
+
+        d.mocap_pos[self._mocap], d.mocap_quat[self._mocap] = carry(mpos0[self._mocap], mquat0[self._mocap])
+        if hq >= 0:
+            d.qpos[hq:hq + 3], d.qpos[hq + 3:hq + 7] = carry(qpos0[hq:hq + 3], qpos0[hq + 3:hq + 7])
+
+
+def _top_contact(drv: Driver, obj: str):
+    """Grasp point and outward normal: the centre of the object's top face (AABB), normal +z."""
+    lo, hi = drv.aabb(obj)
+    return np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2]]), np.array([0.0, 0.0, 1.0])
+
+
+def approach(drv: Driver, obj: str) -> PrimitiveResult:
+    """Base near ``obj``, cup to 0.03 m + a clearance above its top face, cup facing the surface."""
+    from anomalygen.learn.ik import quat_z_to
+
+    s0 = drv.steps
+    point, normal = _top_contact(drv, obj)
+    if not drv.place_base_near(point):
+        return PrimitiveResult(False, drv.steps - s0, f"no collision-free base pose near {obj}")
+    quat = quat_z_to(-normal)
+    hover = point + normal * (PRE_CONTACT + 0.12)
+    drv.goto(drv.site + np.array([0, 0, max(0.0, hover[2] - drv.site[2])]), quat, max_steps=120)
+    drv.goto(hover, quat, max_steps=200)
+    ok = drv.goto(point + normal * PRE_CONTACT, quat, max_steps=200)
+    return PrimitiveResult(ok, drv.steps - s0, f"pre-contact {'reached' if ok else 'not reached'} above {obj}")
+
+
+def grasp(drv: Driver, obj: str, *, lift: float = 0.12) -> PrimitiveResult:
+    """Approach, move along the normal until the cup touches, switch suction on, lift by ``lift``."""
+    from anomalygen.learn.ik import quat_z_to
+    from anomalygen.scene import robot
+
+    s0 = drv.steps
+    res = approach(drv, obj)
+    if not res.success and "base" in res.detail:
+        return res
+    point, normal = _top_contact(drv, obj)
+    quat = quat_z_to(-normal)
+    grabbed = False
+    for k in range(40):  # descend 2.5 mm per waypoint until suction catches
+        target = point + normal * (PRE_CONTACT - 0.0025 * k)
+        drv.goto(target, quat, max_steps=12, tol=0.004)
+        if robot.object_distance_to_cup(drv.model, drv.data, obj) < robot.SUCTION_RANGE * 0.8:
+            grabbed = robot.suction_on(drv.model, drv.data, obj)
+            if grabbed:
+                break
+    if not grabbed:
+        return PrimitiveResult(False, drv.steps - s0, f"suction did not catch {obj} "
+                               f"(cup-object distance {robot.object_distance_to_cup(drv.model, drv.data, obj):.3f} m)")
+    drv.goto(drv.site + np.array([0, 0, lift]), quat, max_steps=150)
+    return PrimitiveResult(True, drv.steps - s0, f"holding {obj}, lifted {lift:.2f} m")
+
+
+def release(drv: Driver) -> PrimitiveResult:
+    from anomalygen.scene import robot
+
+    s0 = drv.steps
+    held = drv.held
+    robot.suction_off(drv.model, drv.data)
+    drv.settle(15)
+    return PrimitiveResult(held is not None, drv.steps - s0, f"released {held}" if held else "nothing held")
+
+
+def _drop_point(drv: Driver, region: str, obj: str) -> np.ndarray:
+    """Where to hold the object's bottom before release: above the container opening / support centre."""
+    lo, hi = drv.aabb(region)
+    return np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 0.04])
+
+
+def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True) -> PrimitiveResult:
+    """Carry the held ``obj`` above ``region`` (container opening or support top centre), lower, release."""
+    from anomalygen.learn.ik import quat_z_to
+
+    s0 = drv.steps
+    if drv.held != obj:
+        return PrimitiveResult(False, 0, f"{obj} is not held")
+    goal = _drop_point(drv, region, obj)
+    olo, ohi = drv.aabb(obj)
+    below = drv.site[2] - olo[2]  # cup face to object bottom
+    quat = quat_z_to(np.array([0.0, 0.0, -1.0]))
+    carry_z = max(drv.site[2], goal[2] + below + 0.1)
+    drv.goto(np.array([*drv.site[:2], carry_z]), quat, max_steps=150)
+    if not drv.place_base_near(goal):
+        return PrimitiveResult(False, drv.steps - s0, f"no collision-free base pose near {region}")
+    drv.goto(np.array([*goal[:2], carry_z]), quat, max_steps=250)
+    ok = drv.goto(goal + np.array([0, 0, below]), quat, max_steps=200, tol=0.02)
+    if release_after:
+        release(drv)
+        drv.goto(drv.site + np.array([0, 0, 0.1]), quat, max_steps=60)
+    return PrimitiveResult(ok, drv.steps - s0, f"{obj} {'lowered' if ok else 'not fully lowered'} over {region}")
+
+
+def surface_centre_of(drv: Driver, obj: str) -> str | None:
+    """The support under ``obj`` according to the scene spec."""
+    for o in drv.spec.objects:
+        if o.name == obj:
+            return o.support if o.support and o.support != "floor" else None
+    return None
+
+
+def part_point_local(drv: Driver, joint: str) -> tuple[int, np.ndarray]:
+    """A point on the moving part, in the part body frame: the AABB centre pushed out far from a hinge."""
+    j = drv.model.joint(joint)
+    body = int(j.bodyid[0])
+    name = drv.model.body(body).name
+    lo, hi = drv.aabb(name)
+    c = (lo + hi) / 2
+    if drv.model.jnt_type[j.id] == 3:  # hinge: 80 % of the way from the axis to the far edge
+        anchor = drv.data.xanchor[j.id]
+        axis = drv.data.xaxis[j.id]
+        corners = np.array([[x, y, c[2]] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])])
+        rel = corners - anchor
+        perp = rel - np.outer(rel @ axis, axis)
+        far = corners[int(np.argmax(np.linalg.norm(perp, axis=1)))]
+        c = anchor + (far - anchor) * 0.8
+        c = c + axis * (np.dot((lo + hi) / 2 - anchor, axis) - np.dot(c - anchor, axis))
+    r = drv.data.xmat[body].reshape(3, 3)
+    return body, r.T @ (c - drv.data.xpos[body])
+
+
+def push_part(drv: Driver, joint: str, goal: float, *, tol: float = 0.08, max_steps: int = 500,
+              standoff: float = 0.06) -> PrimitiveResult:
+    """``push_joint`` for a built scene: no handle site, so the contact point is derived from the part."""
+    s0 = drv.steps
+    d = drv.data
+    body, local = part_point_local(drv, joint)
+
+    def h() -> np.ndarray:
+        return d.xpos[body] + d.xmat[body].reshape(3, 3) @ local
+
+    def q() -> float:
+        return float(d.joint(joint).qpos[0])
+
+    if not drv.place_base_near(h()):
+        return PrimitiveResult(False, 0, f"no collision-free base pose near {joint}")
+    sign = -1.0 if goal < q() else 1.0
+    for extra in (0.15, 0.0):
+        v = sign * joint_motion_direction(drv.model, d, joint, h())
+        drv.goto(h() - (standoff + extra) * v, max_steps=200, tol=0.02)
+    while drv.steps - s0 < max_steps and abs(q() - goal) > tol and sign * (goal - q()) > 0:
+        v = sign * joint_motion_direction(drv.model, d, joint, h())
+        drv.goto(h() + 0.06 * v, max_steps=1, tol=0.0)
+    ok = abs(q() - goal) <= tol or sign * (goal - q()) <= 0
+    drv.goto(drv.site - 0.1 * sign * joint_motion_direction(drv.model, d, joint, h()), max_steps=40)
+    return PrimitiveResult(ok, drv.steps - s0, f"{joint} = {q():.3f} (goal {goal:.3f})")

@@ -1,0 +1,124 @@
+"""Run one plan on its built scene: each sub-task by its method, success checked on the scene graph.
+
+Primitive sub-tasks are executed by :mod:`anomalygen.learn.primitives` on one shared
+:class:`~anomalygen.learn.primitives.Driver`, so the state flows from one step to the next (a grasp
+is followed by a move with the object still held). A sub-task succeeds when its SuccessSpec holds on
+``scene_graph`` right after it (or, with an empty spec, when the primitive reports success); the task
+succeeds when the plan's SuccessSpec holds on the final, settled state. Sub-tasks whose method is SAC
+or CEM are not trained here (that needs a per-sub-task environment the SAC helper owns); they are
+reported as not executed, with that reason, and the plan continues.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from anomalygen.schema import Plan, PredicateResult, SkillMethod, SkillResult, SubTask, SubTaskResult
+
+
+def _joint_for(spec, obj: str, part: str | None) -> tuple[str | None, float | None]:
+    for o in spec.objects:
+        if o.name == obj:
+            states = [j for j in o.joint_states if part is None or j.label == part] or list(o.joint_states)
+            if states:
+                return states[0].name, states[0].closed_value
+    return None, None
+
+
+def run_subtask(drv, st: SubTask, plan: Plan):
+    """Execute one primitive sub-task on the driver; returns a PrimitiveResult."""
+    from anomalygen.learn import primitives as P
+
+    prm = dict(st.params)
+    obj = str(prm.get("object", plan.bindings.get("$hazard", "")))
+    prim = st.primitive or ""
+    if prim in ("grasp", "pick"):
+        return P.grasp(drv, obj, lift=float(prm.get("lift", 0.12)))
+    if prim == "approach":
+        return P.approach(drv, obj)
+    if prim == "release":
+        return P.release(drv)
+    if prim in ("move_to", "place_inside", "place_on"):
+        region = str(prm.get("region") or prm.get("container") or prm.get("support") or "")
+        if region == "surface_centre":
+            region = P.surface_centre_of(drv, obj) or ""
+            if not region:
+                return P.PrimitiveResult(False, 0, f"{obj} stands on no support to re-centre it on")
+        if drv.held != obj:  # move_to without a preceding grasp (move_away_from_edge): pick first
+            g = P.grasp(drv, obj)
+            if not g.success:
+                return g
+        return P.move_to(drv, obj, region, release_after=bool(prm.get("release", True)))
+    if prim in ("push", "pull", "close_joint", "open_joint", "switch_off"):
+        joint = prm.get("joint")
+        closed = prm.get("target")
+        if joint is None:
+            joint, closed = _joint_for(drv.spec, obj, prm.get("part"))
+        if joint is None:
+            return P.PrimitiveResult(False, 0, f"{obj} has no articulated joint to {prim}")
+        goal = float(closed if closed is not None else 0.0)
+        return P.push_part(drv, str(joint), goal)
+    return P.PrimitiveResult(False, 0, f"primitive {prim!r} is not implemented")
+
+
+def _evaluate(calls, model, data, spec, bindings) -> list[PredicateResult]:
+    from anomalygen.knowledge.predicates import evaluate_all
+    from anomalygen.scene.graph import scene_graph
+
+    return evaluate_all(list(calls), scene_graph(model, data, spec), bindings)
+
+
+def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: str | Path | None = None,
+                 max_wall_s: float = 600.0) -> SkillResult:
+    """Load the scene, run the plan's sub-tasks in order, check success, optionally record a video."""
+    from anomalygen.learn.primitives import Driver
+    from anomalygen.rng import item_rng
+    from anomalygen.scene.graph import load_scene
+
+    t0 = time.perf_counter()
+    model, data, spec = load_scene(scene_dir)
+    timings = {"load_s": round(time.perf_counter() - t0, 3)}
+    rec = None
+    if video_path is not None:
+        from anomalygen.learn.video import VideoRecorder
+
+        rec = VideoRecorder(model)
+    drv = Driver(model, data, spec, rng=item_rng(seed, plan.task_id),
+                 on_step=(lambda d: rec.capture(d.data)) if rec else None)
+    results: list[SubTaskResult] = []
+    for st in plan.subtasks:
+        ts = time.perf_counter()
+        if st.method != SkillMethod.PRIMITIVE:
+            results.append(SubTaskResult(id=st.id, method=st.method, success=False, detail=(
+                f"not executed: {st.method.value} sub-tasks need a learned policy, which execute_plan does not train")))
+            continue
+        if time.perf_counter() - t0 > max_wall_s:
+            results.append(SubTaskResult(id=st.id, method=st.method, success=False, detail="not executed: time budget spent"))
+            continue
+        s0 = drv.steps
+        res = run_subtask(drv, st, plan)
+        drv.settle(10)
+        ok = res.success
+        detail = res.detail
+        if st.success.predicates:
+            preds = _evaluate(st.success.predicates, model, data, spec, plan.bindings)
+            ok = all(p.holds for p in preds)
+            detail += "; " + "; ".join(f"{p.call.name}: {'yes' if p.holds else 'no'}" for p in preds)
+        results.append(SubTaskResult(id=st.id, method=st.method, success=ok, steps=drv.steps - s0,
+                                     wall_s=round(time.perf_counter() - ts, 3), detail=detail))
+    drv.settle(25)
+    final = _evaluate(plan.success.predicates, model, data, spec, plan.bindings)
+    timings["execute_s"] = round(time.perf_counter() - t0 - timings["load_s"], 3)
+    timings["control_steps"] = float(drv.steps)
+    video = None
+    if rec is not None:
+        rec.capture(data, force=True)
+        tv = time.perf_counter()
+        saved = rec.save(Path(video_path))
+        rec.close()
+        video = str(saved) if saved else None
+        timings["video_s"] = round(time.perf_counter() - tv, 3)
+    success = bool(final) and all(p.holds for p in final)
+    return SkillResult(task_id=plan.task_id, seed=seed, success=success, subtasks=results,
+                       final_predicates=final, video=video, timings=timings)
