@@ -26,6 +26,55 @@ def _joint_for(spec, obj: str, part: str | None) -> tuple[str | None, float | No
     return None, None
 
 
+def _label_of(st: SubTask, prm: dict) -> str | None:
+    """The part label the step is about: its ``part`` param, else the label its success predicate names."""
+    if prm.get("part"):
+        return str(prm["part"])
+    for call in st.success.predicates:
+        if "label" in call.args:
+            return str(call.args["label"])
+    return None
+
+
+def _drive_joints(drv, st: SubTask, obj: str, prim: str, prm: dict):
+    """Close (or open) every part of ``obj`` with the step's label, most open first.
+
+    The planner names the object's first joint, but a fridge has a freezer and a main door and either
+    may be the open one; the scene state says which to push, so the joints are re-chosen here.
+    """
+    from anomalygen.learn import primitives as P
+
+    label = _label_of(st, prm)
+    opening = prim in ("pull", "open_joint")
+    cands = []
+    for o in drv.spec.objects:
+        if o.name != obj:
+            continue
+        for js in o.joint_states:
+            if label is not None and js.label != label and js.name != prm.get("joint"):
+                continue
+            lo, hi = js.range
+            closed = js.closed_value
+            far = hi if abs(hi - closed) > abs(lo - closed) else lo
+            goal = far if opening else closed
+            gap = abs(float(drv.data.joint(js.name).qpos[0]) - goal) / max(abs(hi - lo), 1e-6)
+            cands.append((gap, js.name, closed + 0.6 * (far - closed) if opening else goal))
+    if not cands and prm.get("joint") is not None:
+        cands = [(1.0, str(prm["joint"]), float(prm.get("target", 0.0)))]
+    if not cands:
+        return P.PrimitiveResult(False, 0, f"{obj} has no articulated part labelled {label!r} to {prim}")
+    cands.sort(key=lambda c: -c[0])
+    steps, ok, details = 0, True, []
+    for gap, joint, goal in cands:
+        if gap < 0.03:
+            continue
+        r = P.push_part(drv, joint, goal, tol=0.03)
+        steps += r.steps
+        ok &= r.success
+        details.append(r.detail)
+    return P.PrimitiveResult(ok, steps, "; ".join(details) or f"{label} parts of {obj} already there")
+
+
 def run_subtask(drv, st: SubTask, plan: Plan):
     """Execute one primitive sub-task on the driver; returns a PrimitiveResult."""
     from anomalygen.learn import primitives as P
@@ -51,14 +100,7 @@ def run_subtask(drv, st: SubTask, plan: Plan):
                 return g
         return P.move_to(drv, obj, region, release_after=bool(prm.get("release", True)))
     if prim in ("push", "pull", "close_joint", "open_joint", "switch_off"):
-        joint = prm.get("joint")
-        closed = prm.get("target")
-        if joint is None:
-            joint, closed = _joint_for(drv.spec, obj, prm.get("part"))
-        if joint is None:
-            return P.PrimitiveResult(False, 0, f"{obj} has no articulated joint to {prim}")
-        goal = float(closed if closed is not None else 0.0)
-        return P.push_part(drv, str(joint), goal)
+        return _drive_joints(drv, st, obj, prim, prm)
     return P.PrimitiveResult(False, 0, f"primitive {prim!r} is not implemented")
 
 
