@@ -124,7 +124,7 @@ def test_bring_your_own_tasks(run111, tmp_path):
 
 
 def test_texts_are_diverse_and_well_formed(run111):
-    """Self-BLEU (name + description, NLTK method 1) of the seeded 111 run stays far below the 0.80 the
+    """Self-BLEU (name + description, NLTK method 1) of the seeded 111 run stays well below the 0.80 the
     single-frame realiser had; names stay short and descriptions stay 1-3 sentences."""
     import re
 
@@ -136,7 +136,7 @@ def test_texts_are_diverse_and_well_formed(run111):
 
     out, _ = run111
     tasks = read_jsonl(out / "tasks.jsonl", TaskProposal)
-    assert self_bleu([f"{t.name} {t.description}" for t in tasks]) < 0.6
+    assert self_bleu([f"{t.name} {t.description}" for t in tasks]) < 0.55  # 0.493 at seed 0, 0.48-0.49 at seeds 1-3
     for t in tasks:
         assert 3 <= len(t.name.split()) <= 8, t.name
         sentences = [s for s in re.split(r"(?<=[.!?])\s+", t.description) if s]
