@@ -4,7 +4,10 @@ RoboGen keeps the checkpoint with the best return, which rewards shaping artefac
 handle scores well without ever closing the door). We evaluate deterministic episodes periodically
 and keep the policy whose success rate is highest (ties broken by return).
 Settings: 3x256 MLPs for actor and critics, learning rate 3e-4 for actor, critic and entropy
-coefficient (SB3 uses the same rate for all three), two torch threads.
+coefficient (SB3 uses the same rate for all three), one gradient step per env step after a short
+(500-step) random warm-up. Torch threads default to ONE: on the shared, loaded 2-core machine two
+OpenMP threads spin against each other and 40 SAC updates took > 100 s instead of 2.5 s with one
+thread (measured 2026-11-21); pass ``threads=2`` on a quiet machine.
 """
 
 from __future__ import annotations
@@ -44,8 +47,13 @@ def evaluate_policy(model, env, episodes: int, seed: int) -> tuple[float, float]
 
 
 def train_sac(make_env, steps: int, *, seed: int = 0, eval_every: int = 1000, eval_episodes: int = 5,
-              learning_starts: int = 200, threads: int = 2, log=None) -> tuple[object, SACResult]:
-    """Train SAC for ``steps`` env steps; return the model loaded with the best-success checkpoint."""
+              learning_starts: int = 500, threads: int = 1, stop_at: float | None = None,
+              log=None) -> tuple[object, SACResult]:
+    """Train SAC for ``steps`` env steps; return the model loaded with the best-success checkpoint.
+
+    With ``stop_at``, training ends at the first evaluation whose success rate reaches it
+    (``result.steps`` is then the steps actually taken).
+    """
     import torch
     from stable_baselines3 import SAC
     from stable_baselines3.common.callbacks import BaseCallback
@@ -53,7 +61,7 @@ def train_sac(make_env, steps: int, *, seed: int = 0, eval_every: int = 1000, ev
     torch.set_num_threads(threads)
     env, eval_env = make_env(), make_env()
     model = SAC("MlpPolicy", env, learning_rate=3e-4, policy_kwargs={"net_arch": [256, 256, 256]},
-                learning_starts=min(learning_starts, max(1, steps // 4)), batch_size=256, seed=seed, verbose=0,
+                learning_starts=min(learning_starts, max(1, steps // 4)), batch_size=256, train_freq=1, gradient_steps=1, seed=seed, verbose=0,
                 device="cpu")
     t0 = time.perf_counter()
     result = SACResult(best_success=-1.0, best_return=-np.inf, best_step=0, steps=steps, wall_s=0.0)
@@ -71,13 +79,16 @@ def train_sac(make_env, steps: int, *, seed: int = 0, eval_every: int = 1000, ev
         def _on_step(self) -> bool:
             if self.num_timesteps % eval_every == 0:
                 _evaluate(self.num_timesteps)
+                if stop_at is not None and result.curve[-1]["success"] >= stop_at:
+                    result.steps = self.num_timesteps
+                    return False
             return True
 
     _evaluate(0)
     if steps > 0:
         model.learn(total_timesteps=steps, callback=_Eval())
-    if result.curve[-1]["step"] != steps:
-        _evaluate(steps)
+    if result.curve[-1]["step"] != result.steps:
+        _evaluate(result.steps)
     if result.policy_state is not None:
         model.policy.load_state_dict(result.policy_state)
     result.wall_s = time.perf_counter() - t0
