@@ -207,10 +207,11 @@ class Driver:
         return robot.held_object(self.model, self.data)
 
     # ---------------------------------------------------------------- base
-    def place_base_near(self, point, *, reach=BASE_REACH) -> bool:
+    def place_base_near(self, point, *, reach=BASE_REACH, side=None) -> bool:
         """Put the base at a collision-free pose facing ``point`` at arm's reach (kinematic move).
 
-        Candidates: rings of 24 headings at each distance in ``reach``, tried nearest-to-current first.
+        Candidates: rings of 24 headings at each distance in ``reach``, tried nearest-to-current first;
+        with ``side`` (a horizontal direction from the point), only poses on that side (within 70 deg).
         A held object is carried rigidly with the base. Returns False (base unchanged) if none is free.
         """
         import mujoco
@@ -220,7 +221,10 @@ class Driver:
         m, d = self.model, self.data
         p = np.asarray(point, dtype=float)
         cur = np.array([d.joint(j).qpos[0] for j in robot.BASE_JOINTS])
-        if np.hypot(*(p[:2] - cur[:2])) < 0.62 and self._facing(cur, p):
+        sd = None if side is None else np.asarray(side, dtype=float)[:2] / (np.linalg.norm(np.asarray(side)[:2]) + 1e-9)
+        on_side = (lambda b: True) if sd is None else (
+            lambda b: float(np.dot(b - p[:2], sd)) > 0.34 * float(np.linalg.norm(b - p[:2])))
+        if np.hypot(*(p[:2] - cur[:2])) < 0.62 and self._facing(cur, p) and on_side(cur[:2]):
             return True
         saved = (d.qpos.copy(), d.qvel.copy(), d.mocap_pos.copy(), d.mocap_quat.copy())
         held = self.held
@@ -228,7 +232,7 @@ class Driver:
         hq = m.jnt_qposadr[m.body_jntadr[hb]] if held and m.body_jntadr[hb] >= 0 else -1
         for r in reach:
             angles = self.ring_offset + np.linspace(0, 2 * np.pi, 24, endpoint=False)
-            cands = [p[:2] + r * np.array([np.cos(a), np.sin(a)]) for a in angles]
+            cands = [b for b in (p[:2] + r * np.array([np.cos(a), np.sin(a)]) for a in angles) if on_side(b)]
             cands.sort(key=lambda b: float(np.hypot(*(b - cur[:2]))))
             for b in cands:
                 yaw = float(np.arctan2(p[1] - b[1], p[0] - b[0]))
@@ -405,9 +409,10 @@ def push_part(drv: Driver, joint: str, goal: float, *, tol: float = 0.08, max_st
     def q() -> float:
         return float(d.joint(joint).qpos[0])
 
-    if not drv.place_base_near(h()):
-        return PrimitiveResult(False, 0, f"no collision-free base pose near {joint}")
     sign = -1.0 if goal < q() else 1.0
+    behind = -sign * joint_motion_direction(drv.model, d, joint, h())
+    if not (drv.place_base_near(h(), side=behind) or drv.place_base_near(h())):
+        return PrimitiveResult(False, 0, f"no collision-free base pose near {joint}")
     for extra in (0.15, 0.0):
         v = sign * joint_motion_direction(drv.model, d, joint, h())
         drv.goto(h() - (standoff + extra) * v, max_steps=200, tol=0.02)
