@@ -68,7 +68,7 @@ def _drive_joints(drv, st: SubTask, obj: str, prim: str, prm: dict):
     for gap, joint, goal in cands:
         if gap < 0.03:
             continue
-        r = P.push_part(drv, joint, goal, tol=0.03)
+        r = P.push_part(drv, joint, goal, tol=0.015)
         steps += r.steps
         ok &= r.success
         details.append(r.detail)

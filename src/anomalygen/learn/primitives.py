@@ -419,6 +419,12 @@ def push_part(drv: Driver, joint: str, goal: float, *, tol: float = 0.08, max_st
     while drv.steps - s0 < max_steps and abs(q() - goal) > tol and sign * (goal - q()) > 0:
         v = sign * joint_motion_direction(drv.model, d, joint, h())
         drv.goto(h() + 0.06 * v, max_steps=1, tol=0.0)
+    for _ in range(15):  # keep pressing a moment so the part settles instead of bouncing back
+        v = sign * joint_motion_direction(drv.model, d, joint, h())
+        drv.goto(h() + 0.02 * v, max_steps=1, tol=0.0)
     ok = abs(q() - goal) <= tol or sign * (goal - q()) <= 0
-    drv.goto(drv.site - 0.1 * sign * joint_motion_direction(drv.model, d, joint, h()), max_steps=40)
+    back = drv.site - 0.12 * sign * joint_motion_direction(drv.model, d, joint, h())
+    drv.dp, dp = 0.004, drv.dp  # retreat slowly: a fast pull-back drags a light door with it
+    drv.goto(back, max_steps=60)
+    drv.dp = dp
     return PrimitiveResult(ok, drv.steps - s0, f"{joint} = {q():.3f} (goal {goal:.3f})")
