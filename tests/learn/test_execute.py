@@ -54,17 +54,17 @@ def test_fridge_door_gets_closed(built, tmp_path):
     from anomalygen.runfolder import read_model, write_model
 
     scene_dir, plan, spec = built["fridge"]
-    fridge = next(o for o in spec.objects if o.category_is("Refrigerator")) if hasattr(spec.objects[0], "category_is") \
-        else next(o for o in spec.objects if o.asset.category == "Refrigerator")
+    fridge = next(o for o in spec.objects if o.asset.category == "Refrigerator")
     before = {j.name: _joint(scene_dir, j.name) for j in fridge.joint_states if j.label == "door"}
     assert max(abs(v) for v in before.values()) > 0.3, "the test scene should start with a door open"
     res = execute_plan(scene_dir, plan, seed=0, video_path=tmp_path / "v.mp4")
     assert res.success and all(s.success for s in res.subtasks)
     assert all(p.holds for p in res.final_predicates) and res.final_predicates[0].call.name == "joint_closed"
-    # physics: every door joint ended near its closed value (5 % of its range)
-    for j in fridge.joint_states:
-        if j.label == "door":
-            assert f"{j.name} = " in res.subtasks[0].detail or abs(before[j.name] - j.closed_value) < 0.05
+    # physics: every door that started open was pushed and ended within 0.05 rad of closed
+    for name, q0 in before.items():
+        if abs(q0) > 0.05:
+            q1 = float(res.subtasks[0].detail.split(f"{name} = ")[1].split(" ")[0])
+            assert abs(q1) < 0.05
     assert (tmp_path / "v.mp4").stat().st_size > 10_000
     write_model(tmp_path / "result.json", res)
     assert read_model(tmp_path / "result.json", SkillResult).success
@@ -72,11 +72,13 @@ def test_fridge_door_gets_closed(built, tmp_path):
 
 @pytest.mark.slow
 def test_litter_is_picked_off_the_floor_into_the_bucket(built):
-    from anomalygen.knowledge.predicates import evaluate
     from anomalygen.learn.execute import execute_plan
-    from anomalygen.schema import PredicateCall
+    from anomalygen.scene.graph import load_scene
 
     scene_dir, plan, spec = built["litter"]
+    hazard = spec.bindings["$hazard"]
+    _, d0, _ = load_scene(scene_dir)
+    z0 = float(d0.body(hazard).xpos[2])
     assert [s.primitive for s in plan.subtasks] == ["grasp", "move_to"]
     res = execute_plan(scene_dir, plan, seed=0)
     assert res.subtasks[0].success, res.subtasks[0].detail  # suction caught the object and lifted it
@@ -84,7 +86,7 @@ def test_litter_is_picked_off_the_floor_into_the_bucket(built):
     names = {p.call.name: p.holds for p in res.final_predicates}
     assert names.get("inside") is True
     assert res.video is None and res.timings["control_steps"] > 50
-    del evaluate, PredicateCall
+    assert "lifted" in res.subtasks[0].detail and z0 < 0.1  # it started on the floor
 
 
 def test_non_primitive_subtasks_are_reported_not_executed(built):

@@ -75,6 +75,19 @@ def _drive_joints(drv, st: SubTask, obj: str, prim: str, prm: dict):
     return P.PrimitiveResult(ok, steps, "; ".join(details) or f"{label} parts of {obj} already there")
 
 
+def _closed_parts(drv, name: str) -> list[str]:
+    """Labels of the object's lids, doors, flaps and drawers that are (nearly) closed right now."""
+    out = []
+    for o in drv.spec.objects:
+        if o.name == name:
+            for js in o.joint_states:
+                if js.label in ("lid", "door", "flap", "drawer"):
+                    span = max(abs(js.range[1] - js.range[0]), 1e-6)
+                    if abs(float(drv.data.joint(js.name).qpos[0]) - js.closed_value) / span < 0.1:
+                        out.append(js.label)
+    return sorted(set(out))
+
+
 def run_subtask(drv, st: SubTask, plan: Plan):
     """Execute one primitive sub-task on the driver; returns a PrimitiveResult."""
     from anomalygen.learn import primitives as P
@@ -98,7 +111,11 @@ def run_subtask(drv, st: SubTask, plan: Plan):
             g = P.grasp(drv, obj)
             if not g.success:
                 return g
-        return P.move_to(drv, obj, region, release_after=bool(prm.get("release", True)))
+        res = P.move_to(drv, obj, region, release_after=bool(prm.get("release", True)))
+        shut = _closed_parts(drv, region)
+        if shut:  # say why an 'inside' will fail: suction cannot pull parts open (no pull primitive yet)
+            res.detail += f"; {region}'s {', '.join(shut)} closed (opening needs a pull primitive, not built)"
+        return res
     if prim in ("push", "pull", "close_joint", "open_joint", "switch_off"):
         return _drive_joints(drv, st, obj, prim, prm)
     return P.PrimitiveResult(False, 0, f"primitive {prim!r} is not implemented")
