@@ -87,6 +87,12 @@ def test_litter_is_picked_off_the_floor_into_the_bucket(built):
     assert names.get("inside") is True
     assert res.video is None and res.timings["control_steps"] > 50
     assert "lifted" in res.subtasks[0].detail and z0 < 0.1  # it started on the floor
+    again = execute_plan(scene_dir, plan, seed=0)  # same seed: the same steps and outcome
+
+    def key(r):
+        return r.success, [(s.steps, s.detail) for s in r.subtasks], [p.explanation for p in r.final_predicates]
+
+    assert key(again) == key(res)
 
 
 def test_non_primitive_subtasks_are_reported_not_executed(built):
