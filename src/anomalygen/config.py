@@ -114,9 +114,6 @@ class Settings(BaseSettings):
     learn: LearnConfig = Field(default_factory=LearnConfig)
     evaluate: EvaluateConfig = Field(default_factory=EvaluateConfig)
 
-    # Set per load by ``load_settings``; pydantic-settings reads it in ``settings_customise_sources``.
-    _toml_path: Path | None = None
-
     @classmethod
     def settings_customise_sources(
         cls,
@@ -147,6 +144,8 @@ class Settings(BaseSettings):
         return data
 
 
+# The TOML path of the load in progress: pydantic-settings builds sources in a classmethod with no
+# per-call arguments, so ``load_settings`` hands the path over here for the duration of one load.
 _CURRENT_TOML: dict[str, Path | None] = {"path": None}
 
 
