@@ -228,26 +228,18 @@ class Part:
     def hinge(
         self, name, axis, range, label, closed=None, pos=(0, 0, 0), *, spring=False, hold=False
     ) -> JointDef:
-        self.joint = JointDef(
-            name,
-            "hinge",
-            tuple(axis),
-            (float(range[0]), float(range[1])),
-            label,
-            float(range[0] if closed is None else closed),
-            tuple(pos),
-            spring,
-            hold,
-        )
-        self.label = self.label or label
-        return self.joint
+        return self._joint("hinge", name, axis, range, label, closed, pos, spring, hold)
 
     def slide(
         self, name, axis, range, label, closed=None, pos=(0, 0, 0), *, spring=False, hold=False
     ) -> JointDef:
+        return self._joint("slide", name, axis, range, label, closed, pos, spring, hold)
+
+    def _joint(self, kind, name, axis, range, label, closed, pos, spring, hold) -> JointDef:
+        """The one joint of this part; closed defaults to the range's lower end."""
         self.joint = JointDef(
             name,
-            "slide",
+            kind,
             tuple(axis),
             (float(range[0]), float(range[1])),
             label,
