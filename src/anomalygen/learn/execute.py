@@ -43,6 +43,7 @@ def _drive_joints(drv, st: SubTask, obj: str, prim: str, prm: dict):
     may be the open one; the scene state says which to push, so the joints are re-chosen here.
     """
     from anomalygen.learn import primitives as P
+    from anomalygen.learn.parts import actuate_part
 
     label = _label_of(st, prm)
     opening = prim in ("pull", "open_joint")
@@ -51,24 +52,25 @@ def _drive_joints(drv, st: SubTask, obj: str, prim: str, prm: dict):
         if o.name != obj:
             continue
         for js in o.joint_states:
-            if label is not None and js.label != label and js.name != prm.get("joint"):
+            if label is not None and js.label not in label.split("|") and js.name != prm.get("joint"):
                 continue
             lo, hi = js.range
             closed = js.closed_value
             far = hi if abs(hi - closed) > abs(lo - closed) else lo
             goal = far if opening else closed
             gap = abs(float(drv.data.joint(js.name).qpos[0]) - goal) / max(abs(hi - lo), 1e-6)
-            cands.append((gap, js.name, closed + 0.6 * (far - closed) if opening else goal))
+            cands.append((gap, js.name, closed + 0.6 * (far - closed) if opening else goal, closed,
+                          0.025 * abs(hi - lo)))
     if not cands and prm.get("joint") is not None:
-        cands = [(1.0, str(prm["joint"]), float(prm.get("target", 0.0)))]
+        cands = [(1.0, str(prm["joint"]), float(prm.get("target", 0.0)), 0.0, 0.02)]
     if not cands:
         return P.PrimitiveResult(False, 0, f"{obj} has no articulated part labelled {label!r} to {prim}")
     cands.sort(key=lambda c: -c[0])
     steps, ok, details = 0, True, []
-    for gap, joint, goal in cands:
-        if gap < 0.03:
+    for _, joint, goal, closed, tol in cands:
+        if abs(float(drv.data.joint(joint).qpos[0]) - goal) <= tol:  # done already (pushed along by another)
             continue
-        r = P.push_part(drv, joint, goal, tol=0.015)
+        r = actuate_part(drv, joint, goal, closed=closed, tol=tol)
         steps += r.steps
         ok &= r.success
         details.append(r.detail)

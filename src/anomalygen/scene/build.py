@@ -536,7 +536,7 @@ def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
     top_eye = np.array([focus[0], focus[1] - 0.01, 3.3])
     spec.worldbody.add_camera(name="top", pos=top_eye.tolist(), xyaxes=[0, -1, 0, 1, 0, 0], fovy=55)
 
-    loose = []
+    loose, parts = [], []
     for p in placed.values():
         body = spec.worldbody.add_body(name=p.name, pos=p.pos.tolist(), quat=p.quat)
         if p.support_geom is not None:
@@ -546,6 +546,7 @@ def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
             body.add_freejoint(name=f"{p.name}/free")
             loose.append(p.name)
         root = p.asset.attach(body, f"{p.name}/")
+        parts.extend(_articulated_bodies(root))
         if not p.fixed:
             # Rolling and torsional friction (condim 6): a needle or pencil must not roll for ever.
             # A 1 mm contact margin stops needles and coins tunnelling into a table top.
@@ -553,7 +554,8 @@ def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
                 geom.condim = 6
                 geom.friction = [max(geom.friction[0], 0.8), 0.01, 0.002]
                 geom.margin = max(geom.margin, 0.001)
-    robot.add_suction_welds(spec, loose)
+    # Suction can also hold a door, lid or drawer, so primitives can pull parts open or lift them shut.
+    robot.add_suction_welds(spec, loose + parts)
     task_objects = [p for p in placed.values() if p.role != ObjectRole.CLUTTER]
     add_observation_sensors(
         spec,
@@ -563,6 +565,18 @@ def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
     )
     spec.add_key(name="init")
     return spec
+
+
+def _articulated_bodies(body) -> list[str]:
+    """Names of the bodies under ``body`` that move on a hinge or slide joint (doors, lids, drawers)."""
+    import mujoco
+
+    out = []
+    if any(j.type in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE) for j in body.joints):
+        out.append(body.name)
+    for child in body.bodies:
+        out.extend(_articulated_bodies(child))
+    return out
 
 
 def _geoms_below(body) -> list:

@@ -322,11 +322,13 @@ def held_object(model: mujoco.MjModel, data: mujoco.MjData) -> str | None:
     return None
 
 
-def suction_on(model: mujoco.MjModel, data: mujoco.MjData, object_name: str | None = None) -> bool:
+def suction_on(model: mujoco.MjModel, data: mujoco.MjData, object_name: str | None = None, *,
+               torquescale: float = 1.0) -> bool:
     """Grab ``object_name`` (or the nearest candidate) if it is within SUCTION_RANGE of the cup.
 
     The weld's relative pose is set to the current one, so the object does not jump. Returns True
-    when an object is now held.
+    when an object is now held. ``torquescale`` 0 holds the position only: a door or lid held by
+    its face may then turn under the cup as it swings.
     """
     import mujoco
 
@@ -346,12 +348,15 @@ def suction_on(model: mujoco.MjModel, data: mujoco.MjData, object_name: str | No
     eq = _suction_eq(model, best)
     cup = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "suction")
     obj = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, best)
-    relpos, relquat = relative_pose(data.xpos[cup], data.xquat[cup], data.xpos[obj], data.xquat[obj])
-    # Weld data layout: anchor(3), relpos(3), relquat(4), torquescale(1): pose of body2 in body1.
-    model.eq_data[eq, 0:3] = 0.0
-    model.eq_data[eq, 3:6] = relpos
+    _, relquat = relative_pose(data.xpos[cup], data.xquat[cup], data.xpos[obj], data.xquat[obj])
+    # Weld data layout: anchor(3) in body2's frame, relpos(3) = where that anchor sits in body1's
+    # frame, relquat(4) = orientation of body2 in body1, torquescale(1). The anchor is the cup's centre:
+    # a door's frame sits on its hinge, where a position-only hold (torquescale 0) would hold nothing.
+    rot = data.xmat[obj].reshape(3, 3)
+    model.eq_data[eq, 0:3] = rot.T @ (data.xpos[cup] - data.xpos[obj])
+    model.eq_data[eq, 3:6] = 0.0
     model.eq_data[eq, 6:10] = relquat
-    model.eq_data[eq, 10] = 1.0
+    model.eq_data[eq, 10] = torquescale
     data.eq_active[eq] = 1
     return True
 

@@ -1,0 +1,274 @@
+"""Grasp-and-drive primitive for articulated parts: doors, lids, flaps and drawers.
+
+Pushing a part (``primitives.push_part``) cannot open anything, cannot lift a fold-down oven door and
+lets a light door bounce back open. Here the suction cup holds the part itself (the scene builder adds
+a suction weld for every hinged or sliding body) and drags the grasped point along the arc (hinge) or
+line (slide) the part allows, so the part goes exactly where it is led and stops there.
+
+The grasp point lies on a face of the part's own box: the face that points out of the cabinet when
+the part is closed (the front of a door or drawer, the top of a lid), 75 % of the way from the hinge
+to the far edge. When that face is out of reach (an oven door folded down shows its front to the
+floor, a toilet lid leaning on the tank shows it to the wall) the opposite face is used, and the drive
+stops short of closed so the cup is not trapped; the next attempt takes the outer face. The weld
+holds the position only (torque scale 0), so the part may turn under the cup while the arm keeps up.
+Each attempt picks a base pose facing the middle of the remaining arc; an attempt ends when the part
+stops following (out of reach, blocked), and the primitive re-grasps up to ``attempts`` times.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+HINGE, SLIDE = 3, 2  # mujoco.mjtJoint values
+INNER_FACE_STOP = 0.4  # rad: a grasp on the inner face lets go this far from closed
+LEAD_HINGE = 0.12
+
+
+@dataclass
+class PartGrasp:
+    body: int
+    point_local: np.ndarray  # grasp point, part body frame
+    normal_local: np.ndarray  # outward normal of the grasped face, part body frame
+    outer: bool  # the face that points out of the cabinet when closed
+
+
+def _rot(axis: np.ndarray, angle: float) -> np.ndarray:
+    a = axis / (np.linalg.norm(axis) + 1e-12)
+    k = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * (k @ k)
+
+
+def part_transform(drv, joint: str, dq: float):
+    """(R, t) moving a world point with the part when the joint value changes by ``dq``."""
+    m, d = drv.model, drv.data
+    j = m.joint(joint).id
+    axis = d.xaxis[j].copy()
+    if m.jnt_type[j] == SLIDE:
+        return np.eye(3), axis / np.linalg.norm(axis) * dq
+    r = _rot(axis, dq)
+    anchor = d.xanchor[j]
+    return r, anchor - r @ anchor
+
+
+def _body_box(drv, body: int) -> tuple[np.ndarray, np.ndarray]:
+    """Local AABB (body frame) of the body's own collision geoms (all geoms if none collide)."""
+    import mujoco
+
+    m = drv.model
+    geoms = [g for g in range(m.ngeom) if m.geom_bodyid[g] == body]
+    coll = [g for g in geoms if m.geom_contype[g] or m.geom_conaffinity[g]]
+    los, his = [], []
+    for g in coll or geoms:
+        rg = np.zeros(9)
+        mujoco.mju_quat2Mat(rg, m.geom_quat[g])
+        rg = rg.reshape(3, 3)
+        c, h = m.geom_aabb[g, :3], m.geom_aabb[g, 3:]
+        corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * h + c
+        pts = corners @ rg.T + m.geom_pos[g]
+        los.append(pts.min(axis=0))
+        his.append(pts.max(axis=0))
+    return np.min(los, axis=0), np.max(his, axis=0)
+
+
+def _static_centre(drv, obj_root: int, moving: set[int]) -> np.ndarray:
+    """Centre of the object's geoms that do not move with any part (the carcass)."""
+    from anomalygen.scene.graph import geom_world_aabbs
+
+    m = drv.model
+    sub = {obj_root}
+    for b in range(obj_root + 1, m.nbody):
+        if m.body_parentid[b] in sub:
+            sub.add(b)
+
+    def moves(b: int) -> bool:
+        while b != obj_root and b > 0:
+            if b in moving:
+                return True
+            b = int(m.body_parentid[b])
+        return False
+
+    lo, hi = geom_world_aabbs(m, drv.data)
+    sel = [g for g in range(m.ngeom) if m.geom_bodyid[g] in sub and not moves(int(m.geom_bodyid[g]))
+           and (m.geom_contype[g] or m.geom_conaffinity[g])]
+    if not sel:
+        return drv.data.xpos[obj_root].copy()
+    return (lo[sel].min(axis=0) + hi[sel].max(axis=0)) / 2
+
+
+def _object_root(m, body: int) -> int:
+    while m.body_parentid[body] != 0:
+        body = int(m.body_parentid[body])
+    return body
+
+
+def grasp_candidates(drv, joint: str, closed: float) -> list[PartGrasp]:
+    """The outer and the inner face of the part, with a grasp point each (outer first)."""
+    m, d = drv.model, drv.data
+    j = m.joint(joint).id
+    body = int(m.jnt_bodyid[j])
+    lo, hi = _body_box(drv, body)
+    rb = d.xmat[body].reshape(3, 3)
+    q = float(d.qpos[m.jnt_qposadr[j]])
+    rc, tc = part_transform(drv, joint, closed - q)  # current -> closed pose
+    root = _object_root(m, body)
+    moving = {int(m.jnt_bodyid[k]) for k in range(m.njnt) if m.jnt_type[k] in (HINGE, SLIDE)}
+    centre = _static_centre(drv, root, moving)
+    axis_w = d.xaxis[j] / np.linalg.norm(d.xaxis[j])
+    axis_l = rb.T @ axis_w
+    size = hi - lo
+    if m.jnt_type[j] == SLIDE:
+        k = int(np.argmax(np.abs(axis_l)))  # the face across the slide direction: the drawer front
+    else:
+        # thinnest box axis that is not the hinge axis: across the panel
+        cands = [i for i in range(3) if abs(axis_l[i]) < 0.7]
+        k = min(cands, key=lambda i: size[i])
+    out: list[PartGrasp] = []
+    for sgn in (1.0, -1.0):
+        n_l = np.zeros(3)
+        n_l[k] = sgn
+        p_l = (lo + hi) / 2
+        p_l[k] = hi[k] if sgn > 0 else lo[k]
+        if m.jnt_type[j] == HINGE:
+            # 75 % of the way from the axis to the far edge, along the panel's long in-plane direction
+            anchor_l = rb.T @ (d.xanchor[j] - d.xpos[body])
+            others = [i for i in range(3) if i != k]
+            i_far = max(others, key=lambda i: abs(abs(axis_l[i]) - 1.0) * size[i])
+            far = hi[i_far] if abs(hi[i_far] - anchor_l[i_far]) > abs(lo[i_far] - anchor_l[i_far]) else lo[i_far]
+            p_l[i_far] = anchor_l[i_far] + 0.75 * (far - anchor_l[i_far])
+        p_w = d.xpos[body] + rb @ p_l
+        n_w = rb @ n_l
+        p_c, n_c = rc @ p_w + tc, rc @ n_w
+        out.append(PartGrasp(body, p_l, n_l, outer=bool(np.dot(n_c, p_c - centre) > 0)))
+    out.sort(key=lambda g: not g.outer)
+    return out
+
+
+def _world(drv, g: PartGrasp) -> tuple[np.ndarray, np.ndarray]:
+    d = drv.data
+    rb = d.xmat[g.body].reshape(3, 3)
+    return d.xpos[g.body] + rb @ g.point_local, rb @ g.normal_local
+
+
+def _accessible(n_w: np.ndarray) -> bool:
+    """A face the cup can come at: not facing the floor."""
+    return bool(n_w[2] > -0.5)
+
+
+def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.02, attempts: int = 4,
+                 max_steps: int = 900):
+    """Hold the part by suction and lead it to ``goal``; re-grasp when it stops following."""
+    from anomalygen.learn.ik import quat_z_to
+    from anomalygen.learn.primitives import PRE_CONTACT, PrimitiveResult
+    from anomalygen.scene import robot
+
+    m, d = drv.model, drv.data
+    j = m.joint(joint).id
+    adr = m.jnt_qposadr[j]
+    hinge = m.jnt_type[j] == HINGE
+    s0 = drv.steps
+    name = m.body(int(m.jnt_bodyid[j])).name
+    notes = []
+
+    def q() -> float:
+        return float(d.qpos[adr])
+
+    for attempt in range(attempts):
+        if abs(q() - goal) <= tol or drv.steps - s0 > max_steps:
+            break
+        grasps = [g for g in grasp_candidates(drv, joint, closed) if _accessible(_world(drv, g)[1])]
+        if not grasps:
+            notes.append("no reachable face")
+            break
+        g = grasps[0]
+        stop = goal
+        if not g.outer and hinge and abs(goal - closed) < INNER_FACE_STOP:
+            stop = closed + np.sign(q() - closed) * INNER_FACE_STOP
+        p, n = _world(drv, g)
+        # base: facing the middle of the arc still to go, on the side the face looks to
+        r, t = part_transform(drv, joint, (stop - q()) / 2)
+        mid = r @ p + t
+        side = n if np.linalg.norm(n[:2]) > 0.3 else None
+        if not (drv.place_base_near(mid, side=side) or drv.place_base_near(p, side=side)
+                or drv.place_base_near(p)):
+            notes.append("no base pose")
+            break
+        quat = quat_z_to(-n)
+        hover = p + n * (PRE_CONTACT + 0.10)
+        if np.dot(drv.site - p, n) < 0.0:  # cup behind the face (left the inner face): go over the top
+            top = drv.aabb(name)[1][2] + 0.10
+            drv.goto(np.array([*drv.site[:2], max(top, drv.site[2])]), max_steps=80, tol=0.02)
+            drv.goto(np.array([*hover[:2], max(top, drv.site[2])]), quat, max_steps=120, tol=0.02)
+        drv.goto(hover, quat, max_steps=220, tol=0.02)
+        drv.goto(p + n * PRE_CONTACT, quat, max_steps=120)
+        grabbed = False
+        for k in range(24):
+            p, n = _world(drv, g)
+            drv.goto(p + n * (PRE_CONTACT - 0.0025 * k), quat, max_steps=10, tol=0.004)
+            if robot.object_distance_to_cup(m, d, name) < robot.SUCTION_RANGE * 0.8:
+                grabbed = robot.suction_on(m, d, name, torquescale=0.0)
+                if grabbed:
+                    break
+        if not grabbed:
+            notes.append(f"attempt {attempt + 1}: cup did not reach the {'outer' if g.outer else 'inner'} face")
+            drv.goto(drv.site + n * 0.08, max_steps=40)
+            continue
+        _drive(drv, joint, stop, tol=tol)
+        robot.suction_off(m, d, name)
+        p, n = _world(drv, g)
+        dp, drv.dp = drv.dp, 0.004  # back off gently: a fast pull drags a light part along
+        if g.outer:
+            drv.goto(drv.site + n * 0.10, max_steps=40)
+        else:  # the inner face looks into the cabinet: leave upwards, over the part's edge
+            drv.goto(drv.site + n * 0.03, max_steps=15)
+            drv.dp = dp
+            drv.goto(drv.site + np.array([0.0, 0.0, 0.25]), max_steps=40)
+        drv.dp = dp
+    drv.settle(10)
+    ok = abs(q() - goal) <= tol
+    detail = f"{joint} = {q():.3f} (goal {goal:.3f})" + (f"; {'; '.join(notes)}" if notes else "")
+    return PrimitiveResult(ok, drv.steps - s0, detail)
+
+
+def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400) -> None:
+    """Lead the held part towards ``goal``: the cup target rides the part's path just ahead of it."""
+    import mujoco
+
+    m, d = drv.model, drv.data
+    j = m.joint(joint).id
+    adr = m.jnt_qposadr[j]
+    hinge = m.jnt_type[j] == HINGE
+    step = 0.04 if hinge else 0.015  # rad or m the reference leads the part by, per control step
+    lead = LEAD_HINGE if hinge else 0.04
+    site0 = drv.site.copy()
+    cupq0 = d.mocap_quat[drv._mocap].copy()
+    q0 = float(d.qpos[adr])
+    ref = q0
+    best, stall = abs(q0 - goal), 0
+    for _ in range(max_steps):
+        q = float(d.qpos[adr])
+        if abs(q - goal) <= tol * 0.5:
+            break
+        if abs(ref - q) < lead:
+            ref = ref + np.clip(goal - ref, -step, step)
+        r, t = part_transform(drv, joint, ref - q)
+        # where the grasped point is now, moved with the part to the reference value
+        rq, tq = part_transform(drv, joint, q - q0)
+        here = rq @ site0 + tq
+        target = r @ here + t
+        rot = np.array([1.0, 0.0, 0.0, 0.0])
+        if hinge:
+            mujoco.mju_mat2Quat(rot, (r @ rq).reshape(9))
+        quat = np.zeros(4)
+        mujoco.mju_mulQuat(quat, rot, cupq0)
+        drv.goto(target, quat, max_steps=1, tol=0.0)
+        gap = abs(float(d.qpos[adr]) - goal)
+        if gap < best - 1e-3:
+            best, stall = gap, 0
+        else:
+            stall += 1
+            if stall > 40:
+                break
+    for _ in range(10):  # hold still a moment so the part settles where it was led
+        drv.step()
