@@ -1,0 +1,122 @@
+"""Run a SAC sub-task inside ``execute_plan``: train on a snapshot of the scene, replay on the Driver.
+
+1. Pre-position (``approach=True``): the 7-D action moves only the cup, never the mobile base, so a
+   part out of the arm's reach could never be learned. As RoboGen does before an RL sub-task, the
+   base is placed and the cup brought to the part with the same moves the push primitive makes
+   (6 cm behind the part point, against the direction the joint must move), or above the object
+   for object sub-tasks. These steps run on the Driver and show in the video.
+2. Snapshot the Driver's full physics state and train SAC (:func:`~anomalygen.learn.sac.train_sac`,
+   paper settings, evaluation every ``min(steps, 1000)`` steps, stop at 90 % success) on
+   :class:`~anomalygen.learn.subtask_env.SubTaskEnv`, which owns copies of model and data.
+3. Replay the best policy once, deterministically, on the Driver's own data from the snapshot,
+   through the env's own ``control_step`` with ``drv.step`` as the physics advance (frameskip set
+   to the env's 2 for the rollout), so the video hook records it and it behaves as in training.
+
+Same seed, same result: SB3 is seeded, torch runs on CPU, the env's noise comes from its seeded
+``np_random`` and MuJoCo is deterministic.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from anomalygen.learn.primitives import PrimitiveResult
+from anomalygen.schema import Plan, SubTask
+
+STANDOFF = 0.06  # m behind the part point, as push_part approaches
+
+
+def snapshot(model, data) -> np.ndarray:
+    """The full integration state (qpos, qvel, ctrl, mocap pose, active welds, warm start, ...)."""
+    import mujoco
+
+    spec = mujoco.mjtState.mjSTATE_INTEGRATION
+    out = np.empty(mujoco.mj_stateSize(model, spec))
+    mujoco.mj_getState(model, data, out, spec)
+    return out
+
+
+def restore(model, data, state: np.ndarray) -> None:
+    import mujoco
+
+    mujoco.mj_setState(model, data, state, mujoco.mjtState.mjSTATE_INTEGRATION)
+    mujoco.mj_forward(model, data)
+
+
+def _pre_position(drv, st: SubTask, plan: Plan, readout) -> str:
+    """Bring base and cup to where the sub-task's contact happens; returns a note for the detail."""
+    from anomalygen.learn import primitives as P
+
+    joint_terms = [t for t in (st.reward.terms if st.reward else []) if t.kind == "joint"]
+    if joint_terms:
+        t = joint_terms[0]
+        joint = readout._alias.get(t.joint or t.a, t.joint or t.a)
+        goal = float(t.target)
+        q = float(drv.data.joint(joint).qpos[0])
+        if abs(q - goal) <= readout._joint_tol[joint]:
+            return f"{joint} already at its goal"
+        body, local = P.part_point_local(drv, joint)
+
+        def h() -> np.ndarray:
+            return drv.data.xpos[body] + drv.data.xmat[body].reshape(3, 3) @ local
+
+        sign = -1.0 if goal < q else 1.0
+        behind = -sign * P.joint_motion_direction(drv.model, drv.data, joint, h())
+        if not (drv.place_base_near(h(), side=behind) or drv.place_base_near(h())):
+            return f"no collision-free base pose near {joint}"
+        for extra in (0.15, 0.0):
+            v = sign * P.joint_motion_direction(drv.model, drv.data, joint, h())
+            ok = drv.goto(h() - (STANDOFF + extra) * v, max_steps=200, tol=0.02)
+        return f"cup {'placed' if ok else 'not quite placed'} {STANDOFF * 100:.0f} cm behind the part of {joint}"
+    obj = st.params.get("object")
+    if isinstance(obj, str) and obj and drv.held != obj:
+        obj = plan.bindings.get(obj, obj) if obj.startswith("$") else obj
+        return P.approach(drv, obj).detail
+    return "no pre-positioning"
+
+
+def run_sac_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, threads: int = 1,
+                    eval_every: int | None = None, eval_episodes: int = 5, learning_starts: int = 500,
+                    approach: bool = True, log=None) -> PrimitiveResult:
+    """Train SAC for ``st`` from the Driver's current state and execute the best policy on the Driver.
+
+    ``result.steps`` counts the Driver's control steps (pre-positioning plus the rollout); the
+    detail says the training budget, best evaluation success and what the rollout did.
+    """
+    from anomalygen.learn.sac import train_sac
+    from anomalygen.learn.subtask_env import FRAMESKIP, HORIZON, SubTaskEnv, SubTaskReadout, control_step
+
+    if steps <= 0:
+        return PrimitiveResult(False, 0, "not executed: sac_steps is 0")
+    s0 = drv.steps
+    try:
+        readout = SubTaskReadout(drv.model, drv.spec, st, plan.bindings)
+    except ValueError as exc:
+        return PrimitiveResult(False, 0, f"not executed: {exc}")
+    pre = _pre_position(drv, st, plan, readout) if approach else "no pre-positioning"
+    snap = snapshot(drv.model, drv.data)
+
+    def make_env() -> SubTaskEnv:
+        return SubTaskEnv(drv.model, snap, drv.spec, st, plan.bindings)
+
+    policy, res = train_sac(make_env, steps, seed=seed, eval_every=eval_every or min(steps, 1000),
+                            eval_episodes=eval_episodes, learning_starts=learning_starts, threads=threads,
+                            stop_at=0.9, log=log)
+
+    restore(drv.model, drv.data, snap)
+    ee0 = drv.data.site_xpos[readout.ids.site].copy()
+    state = readout.state(drv.model, drv.data)
+    fs, drv.frameskip = drv.frameskip, FRAMESKIP
+    ok, why, t = False, "", 0
+    try:
+        while t < HORIZON and not ok:
+            act, _ = policy.predict(readout.observation(state, ee0, t, HORIZON), deterministic=True)
+            t += 1
+            state, _, ok, why = control_step(readout, drv.model, drv.data, act, t, drv.step)
+    finally:
+        drv.frameskip = fs
+    joints = readout.joint_summary(state)
+    detail = (f"{pre}; SAC {res.steps} steps: best eval success {res.best_success:.2f} at {res.best_step} steps; "
+              f"rollout {'succeeded' if ok else 'failed'} in {t} steps"
+              + (f" ({joints})" if joints else "") + (f"; {why}" if why else ""))
+    return PrimitiveResult(ok, drv.steps - s0, detail)
