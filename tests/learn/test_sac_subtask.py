@@ -44,7 +44,7 @@ def door_plan() -> tuple[SubTask, Plan]:
 def door_driver(q: float = 1.0, *, approach: bool = True):
     """The test scene (no table: the open door would swing into it) with the cup brought to the door."""
     from anomalygen.learn.primitives import Driver
-    from anomalygen.learn.sac_subtask import _pre_position
+    from anomalygen.learn.sac_subtask import pre_position
     from anomalygen.learn.subtask_env import SubTaskReadout
     from anomalygen.learn.testbed import build
 
@@ -52,7 +52,7 @@ def door_driver(q: float = 1.0, *, approach: bool = True):
     drv = Driver(tb.model, tb.data, door_spec(q), rng=np.random.default_rng(0))
     st, plan = door_plan()
     if approach:
-        note = _pre_position(drv, st, plan, SubTaskReadout(drv.model, drv.spec, st, plan.bindings))
+        note = pre_position(drv, st, plan, SubTaskReadout(drv.model, drv.spec, st, plan.bindings))
         assert note.startswith("cup placed")
     return drv, st, plan
 
@@ -177,6 +177,7 @@ def test_suction_action_grabs_and_releases():
     far = np.zeros(7)
     apply_action(drv.model, drv.data, ids, np.r_[far[:6], 1.0])
     assert drv.held == "box_0"
+    assert drv.model.eq_data[drv.model.equality("suction__box_0").id, 10] == 1.0  # free object: held rigidly
     apply_action(drv.model, drv.data, ids, np.r_[far[:6], -0.2])
     assert drv.held is None
 

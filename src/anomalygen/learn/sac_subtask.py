@@ -3,8 +3,8 @@
 1. Pre-position (``approach=True``): the 7-D action moves only the cup, never the mobile base, so a
    part out of the arm's reach could never be learned. As RoboGen does before an RL sub-task, the
    base is placed and the cup brought to the part with the same moves the push primitive makes
-   (6 cm behind the part point, against the direction the joint must move), or above the object
-   for object sub-tasks. These steps run on the Driver and show in the video.
+   (6 cm behind the part point, against the direction the joint must move; for a pull, 4 cm in
+   front of it, where suction can take hold), or above the object for object sub-tasks. These steps run on the Driver and show in the video.
 2. Snapshot the Driver's full physics state and train SAC (:func:`~anomalygen.learn.sac.train_sac`,
    paper settings, evaluation every ``min(steps, 1000)`` steps, stop at 90 % success) on
    :class:`~anomalygen.learn.subtask_env.SubTaskEnv`, which owns copies of model and data.
@@ -24,6 +24,7 @@ from anomalygen.learn.primitives import PrimitiveResult
 from anomalygen.schema import Plan, SubTask
 
 STANDOFF = 0.06  # m behind the part point, as push_part approaches
+PULL_STANDOFF = 0.04  # m in front of the part point (about 3 cm off a door face) for a pull
 
 
 def snapshot(model, data) -> np.ndarray:
@@ -43,17 +44,17 @@ def restore(model, data, state: np.ndarray) -> None:
     mujoco.mj_forward(model, data)
 
 
-def _pre_position(drv, st: SubTask, plan: Plan, readout) -> str:
+def pre_position(drv, st: SubTask, plan: Plan, readout) -> str:
     """Bring base and cup to where the sub-task's contact happens; returns a note for the detail."""
     from anomalygen.learn import primitives as P
 
     joint_terms = [t for t in (st.reward.terms if st.reward else []) if t.kind == "joint"]
     if joint_terms:
         t = joint_terms[0]
-        joint = readout._alias.get(t.joint or t.a, t.joint or t.a)
+        joint = readout.resolved(t.joint or t.a)
         goal = float(t.target)
         q = float(drv.data.joint(joint).qpos[0])
-        if abs(q - goal) <= readout._joint_tol[joint]:
+        if abs(q - goal) <= readout.joint_tol[joint]:
             return f"{joint} already at its goal"
         body, local = P.part_point_local(drv, joint)
 
@@ -61,13 +62,18 @@ def _pre_position(drv, st: SubTask, plan: Plan, readout) -> str:
             return drv.data.xpos[body] + drv.data.xmat[body].reshape(3, 3) @ local
 
         sign = -1.0 if goal < q else 1.0
-        behind = -sign * P.joint_motion_direction(drv.model, drv.data, joint, h())
-        if not (drv.place_base_near(h(), side=behind) or drv.place_base_near(h())):
+        # push from behind the motion; a pull (open) starts in front of the face, where suction can
+        # hold it: behind a closed door is inside the cabinet
+        pull = st.primitive in ("pull", "open_joint")
+        side = (1.0 if pull else -1.0) * sign * P.joint_motion_direction(drv.model, drv.data, joint, h())
+        if not (drv.place_base_near(h(), side=side) or drv.place_base_near(h())):
             return f"no collision-free base pose near {joint}"
+        off = PULL_STANDOFF if pull else STANDOFF
         for extra in (0.15, 0.0):
-            v = sign * P.joint_motion_direction(drv.model, drv.data, joint, h())
-            ok = drv.goto(h() - (STANDOFF + extra) * v, max_steps=200, tol=0.02)
-        return f"cup {'placed' if ok else 'not quite placed'} {STANDOFF * 100:.0f} cm behind the part of {joint}"
+            v = (1.0 if pull else -1.0) * sign * P.joint_motion_direction(drv.model, drv.data, joint, h())
+            ok = drv.goto(h() + (off + extra) * v, max_steps=200, tol=0.02)
+        where = "in front of" if pull else "behind"
+        return f"cup {'placed' if ok else 'not quite placed'} {off * 100:.0f} cm {where} the part of {joint}"
     obj = st.params.get("object")
     if isinstance(obj, str) and obj and drv.held != obj:
         obj = plan.bindings.get(obj, obj) if obj.startswith("$") else obj
@@ -93,7 +99,7 @@ def run_sac_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, thre
         readout = SubTaskReadout(drv.model, drv.spec, st, plan.bindings)
     except ValueError as exc:
         return PrimitiveResult(False, 0, f"not executed: {exc}")
-    pre = _pre_position(drv, st, plan, readout) if approach else "no pre-positioning"
+    pre = pre_position(drv, st, plan, readout) if approach else "no pre-positioning"
     snap = snapshot(drv.model, drv.data)
 
     def make_env() -> SubTaskEnv:

@@ -71,8 +71,8 @@ def apply_action(model, data, ids: ControlIds, action, *, dp: float = MAX_DELTA_
 
     Translation moves the target by ``dp * a[:3]``, kept within ``TARGET_LEASH`` of the cup so the
     weld never yanks the arm; ``a[3:6]`` is an axis-angle rotation (at most ``dr``) in the cup frame;
-    ``a[6] > 0`` grabs the nearest suction candidate within range, ``<= 0`` releases. Returns the
-    clipped action (the reward's action penalty reads it).
+    ``a[6] > 0`` grabs the nearest suction candidate within range (see :func:`_grab_nearest`),
+    ``<= 0`` releases. Returns the clipped action (the reward's action penalty reads it).
     """
     import mujoco
 
@@ -90,10 +90,31 @@ def apply_action(model, data, ids: ControlIds, action, *, dp: float = MAX_DELTA_
         data.mocap_quat[ids.mocap] = q / np.linalg.norm(q)
     held = robot.held_object(model, data)
     if a[6] > 0 and held is None:
-        robot.suction_on(model, data)
+        _grab_nearest(model, data)
     elif a[6] <= 0 and held is not None:
         robot.suction_off(model, data)
     return a
+
+
+def _grab_nearest(model, data) -> bool:
+    """Suction on the nearest candidate within range; a part (door, lid, drawer: a body on a hinge or
+    slide) is held by position only (torque scale 0), as the part primitives do, so it can turn under
+    the cup as it swings; a free object is held rigidly."""
+    import mujoco
+
+    from anomalygen.scene import robot
+
+    mujoco.mj_kinematics(model, data)
+    best, best_d = None, robot.SUCTION_RANGE
+    for name in robot.suction_candidates(model):
+        dist = robot.object_distance_to_cup(model, data, name)
+        if dist <= best_d:
+            best, best_d = name, dist
+    if best is None:
+        return False
+    j = int(model.body_jntadr[model.body(best).id])
+    part = j >= 0 and model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE
+    return robot.suction_on(model, data, best, torquescale=0.0 if part else 1.0)
 
 
 def _subtree_geoms(model, body: int) -> np.ndarray:
@@ -153,10 +174,14 @@ class SubTaskReadout:
         self._upright = list(dict.fromkeys(self._upright))
         self._regions = list(dict.fromkeys(self._regions))
         self.obs_dim = 3 + 4 + 3 * len(self.points) + len(self.joints) + 4 * len(self._upright) + 2
-        self._joint_tol = {}
+        self.joint_tol = {}
         for j in self.joints:
             lo, hi = model.joint(j).range
-            self._joint_tol[j] = JOINT_TOL_FRACTION * max(float(hi - lo), 1e-6) if hi > lo else 0.05
+            self.joint_tol[j] = JOINT_TOL_FRACTION * max(float(hi - lo), 1e-6) if hi > lo else 0.05
+
+    def resolved(self, ref: str) -> str:
+        """The scene name a reward reference stands for (role variables resolved)."""
+        return self._alias.get(ref, ref)
 
     def _resolve(self, model, ref: str | None, *, kind: str = "point") -> str:
         if ref is None:
@@ -247,8 +272,8 @@ class SubTaskReadout:
         checks, why = [], []
         for t in self.reward.terms:
             if t.kind == "joint":
-                j = self._alias.get(t.joint or t.a, t.joint or t.a)
-                checks.append(abs(state["joints"][j] - float(t.target)) <= self._joint_tol[j])
+                j = self.resolved(t.joint or t.a)
+                checks.append(abs(state["joints"][j] - float(t.target)) <= self.joint_tol[j])
             elif t.kind == "lifted":
                 checks.append(position_of(state, t.a)[2] >= float(t.target) - 0.01)
             elif t.kind == "inside":
