@@ -114,10 +114,16 @@ def run_subtask(drv, st: SubTask, plan: Plan):
             if not g.success:
                 return g
         res = P.move_to(drv, obj, region, release_after=bool(prm.get("release", True)))
-        shut = _closed_parts(drv, region)
-        if shut:  # say why an 'inside' will fail: suction cannot pull parts open (no pull primitive yet)
-            res.detail += f"; {region}'s {', '.join(shut)} closed (opening needs a pull primitive, not built)"
+        shut = [lab for lab in _closed_parts(drv, region) if lab != "door" or not drv.opened.get(region)]
+        if shut and not drv.opened.get(region):  # say why an 'inside' will fail
+            res.detail += f"; {region}'s {', '.join(shut)} closed and the plan did not open it"
         return res
+    if prim in ("push", "pull") and prm.get("access"):  # open a container to put something in / shut it again
+        from anomalygen.learn import parts
+
+        if prim == "pull":
+            return parts.open_for_access(drv, obj, str(prm.get("part", "lid")).split("|"))
+        return parts.close_opened(drv, obj)
     if prim in ("push", "pull", "close_joint", "open_joint", "switch_off"):
         return _drive_joints(drv, st, obj, prim, prm)
     return P.PrimitiveResult(False, 0, f"primitive {prim!r} is not implemented")

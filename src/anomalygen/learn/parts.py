@@ -23,7 +23,9 @@ import numpy as np
 
 HINGE, SLIDE = 3, 2  # mujoco.mjtJoint values
 INNER_FACE_STOP = 0.4  # rad: a grasp on the inner face lets go this far from closed
-LEAD_HINGE = 0.12
+LEAD_HINGE = 0.06
+MAX_DRAG = 0.04  # m the container may be dragged by its part before the drive gives up
+MAX_TILT = 0.2  # rad it may tip
 
 
 @dataclass
@@ -239,17 +241,22 @@ def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400) ->
     j = m.joint(joint).id
     adr = m.jnt_qposadr[j]
     hinge = m.jnt_type[j] == HINGE
-    step = 0.04 if hinge else 0.015  # rad or m the reference leads the part by, per control step
-    lead = LEAD_HINGE if hinge else 0.04
+    step = 0.03 if hinge else 0.012  # rad or m the reference advances per control step at most
+    # How far the reference may run ahead of the part: small first, so a light box is not dragged
+    # along by its lid; it grows while the part does not follow (a heavy oven door), up to 4x.
+    lead0 = LEAD_HINGE if hinge else 0.02
     site0 = drv.site.copy()
     cupq0 = d.mocap_quat[drv._mocap].copy()
     q0 = float(d.qpos[adr])
     ref = q0
+    root = _object_root(m, int(m.jnt_bodyid[j]))
+    root0 = d.xpos[root].copy()  # a lid at its stop drags or tips a light box: stop before it goes far
     best, stall = abs(q0 - goal), 0
     for _ in range(max_steps):
         q = float(d.qpos[adr])
         if abs(q - goal) <= tol * 0.5:
             break
+        lead = lead0 * min(4.0, 1.0 + stall / 8)
         if abs(ref - q) < lead:
             ref = ref + np.clip(goal - ref, -step, step)
         r, t = part_transform(drv, joint, ref - q)
@@ -263,6 +270,8 @@ def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400) ->
         quat = np.zeros(4)
         mujoco.mju_mulQuat(quat, rot, cupq0)
         drv.goto(target, quat, max_steps=1, tol=0.0)
+        if np.linalg.norm(d.xpos[root] - root0) > MAX_DRAG or d.xmat[root][8] < np.cos(MAX_TILT):
+            break
         gap = abs(float(d.qpos[adr]) - goal)
         if gap < best - 1e-3:
             best, stall = gap, 0
@@ -272,3 +281,108 @@ def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400) ->
                 break
     for _ in range(10):  # hold still a moment so the part settles where it was led
         drv.step()
+
+
+# --------------------------------------------------------------------------- containers
+LIDS = ("lid", "flap")
+OPEN_FRACTION = 0.85  # how far a lid, flap or drawer is opened to put something in
+
+
+def closure_joints(drv, obj: str, labels) -> list:
+    """The object's JointStates whose label is one of ``labels``."""
+    return [js for o in drv.spec.objects if o.name == obj for js in o.joint_states if js.label in labels]
+
+
+def _far(js) -> float:
+    lo, hi = js.range
+    return hi if abs(hi - js.closed_value) >= abs(lo - js.closed_value) else lo
+
+
+def static_box(drv, obj: str) -> tuple[np.ndarray, np.ndarray]:
+    """World AABB of the object's carcass: its collision geoms that no hinge or slide moves."""
+    from anomalygen.scene.graph import geom_world_aabbs
+
+    m = drv.model
+    root = drv.body_id(obj)
+    sub = {root}
+    for b in range(root + 1, m.nbody):
+        if m.body_parentid[b] in sub:
+            sub.add(b)
+    moving = {int(m.jnt_bodyid[k]) for k in range(m.njnt) if m.jnt_type[k] in (HINGE, SLIDE)}
+
+    def moves(b: int) -> bool:
+        while b != root and b > 0:
+            if b in moving:
+                return True
+            b = int(m.body_parentid[b])
+        return False
+
+    lo, hi = geom_world_aabbs(m, drv.data)
+    sel = [g for g in range(m.ngeom) if m.geom_bodyid[g] in sub and not moves(int(m.geom_bodyid[g]))
+           and (m.geom_contype[g] or m.geom_conaffinity[g])]
+    if not sel:
+        return drv.aabb(obj)
+    return lo[sel].min(axis=0), hi[sel].max(axis=0)
+
+
+def best_drawer(drv, obj: str, drawers: list):
+    """The drawer to put things in: the highest one whose top is within the arm's comfortable band."""
+    def top(js) -> float:
+        return float(drv.aabb(drv.model.body(int(drv.model.joint(js.name).bodyid[0])).name)[1][2])
+
+    ok = [js for js in drawers if 0.2 < top(js) < 1.15]
+    return max(ok or drawers, key=top) if (ok or drawers) else None
+
+
+def open_for_access(drv, obj: str, labels):
+    """Open the container so an object can go in: every lid and flap, or the best drawer.
+
+    Records what was opened in ``drv.opened[obj]`` (so the place step drops into an opened drawer
+    and the close step shuts exactly these) and returns a PrimitiveResult.
+    """
+    from anomalygen.learn.primitives import PrimitiveResult
+
+    s0 = drv.steps
+    lids = closure_joints(drv, obj, [lab for lab in labels if lab in LIDS])
+    chosen = lids
+    if not chosen:
+        drawer = best_drawer(drv, obj, closure_joints(drv, obj, ["drawer"]))
+        chosen = [drawer] if drawer is not None else []
+    if not chosen:
+        doors = closure_joints(drv, obj, ["door"])
+        return PrimitiveResult(False, 0, f"{obj} has {len(doors)} door(s) and no lid, flap or drawer: putting "
+                                         "things in through a door needs a side approach, which is not built")
+    drv.opened[obj] = [js.name for js in chosen]
+    ok, details = True, []
+    for js in chosen:
+        goal = js.closed_value + OPEN_FRACTION * (_far(js) - js.closed_value)
+        tol = 0.3 * abs(js.range[1] - js.range[0])  # over half open is open enough to put things in
+        q = float(drv.data.joint(js.name).qpos[0])
+        if abs(q - js.closed_value) >= abs(goal - js.closed_value) - tol:
+            continue
+        r = actuate_part(drv, js.name, goal, closed=js.closed_value, tol=tol)
+        ok &= r.success
+        details.append(r.detail)
+    return PrimitiveResult(ok, drv.steps - s0, "opened: " + "; ".join(details) if details else f"{obj} already open")
+
+
+def close_opened(drv, obj: str):
+    """Shut the parts ``open_for_access`` opened on ``obj`` (hinged lids last-opened first)."""
+    from anomalygen.learn.primitives import PrimitiveResult
+
+    s0 = drv.steps
+    names = list(reversed(drv.opened.get(obj, [])))
+    ok, details = True, []
+    for js in closure_joints(drv, obj, CLOSURES_ALL):
+        if js.name not in names:
+            continue
+        tol = 0.025 * abs(js.range[1] - js.range[0])
+        if abs(float(drv.data.joint(js.name).qpos[0]) - js.closed_value) <= tol:
+            continue
+        r = actuate_part(drv, js.name, js.closed_value, closed=js.closed_value, tol=tol)
+        ok &= r.success
+        details.append(r.detail)
+    return PrimitiveResult(ok, drv.steps - s0, "; ".join(details) or f"nothing of {obj} left open")
+
+
+CLOSURES_ALL = ("lid", "flap", "drawer", "door")

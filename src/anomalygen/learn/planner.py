@@ -23,6 +23,7 @@ from anomalygen.schema import (
 )
 
 LIFT_HEIGHT = 0.12  # metres above the start height for a pick
+CLOSURES = ("lid", "flap", "drawer", "door")  # part labels that can shut a container
 
 
 def _resolve(value: str, bindings: dict[str, str]) -> str:
@@ -95,6 +96,32 @@ def step_to_subtask(index: int, action: str, args: dict[str, str], bindings: dic
     raise ItemFailed(f"recipe action {action!r} has no sub-task mapping")
 
 
+def closed_closures(spec: SceneSpec | None, instance: str) -> list[str]:
+    """Labels of the container's lids, flaps, drawers and doors that are shut in the scene."""
+    if spec is None:
+        return []
+    labels = {js.label for obj in spec.objects if obj.name == instance for js in obj.joint_states
+              if js.label in CLOSURES and js.open_fraction < 0.1}
+    return [lab for lab in CLOSURES if lab in labels]
+
+
+def access_steps(container: str, labels: list[str]) -> tuple[SubTask, SubTask]:
+    """Open a shut container before the pick (suction cannot hold an object and a lid at once) and
+    shut it again after the place: a drawer left open is a hazard of its own."""
+    part = "|".join(labels)
+    opened = SubTask(id="s0_open_container", description=f"open {container} ({part}) to put something inside",
+                     method=SkillMethod.PRIMITIVE, primitive="pull",
+                     params={"object": container, "part": part, "access": True},
+                     reward=RewardSpec(terms=[RewardTerm(kind="distance", a="ee", b=container, weight=0.5),
+                                              RewardTerm(kind="action_penalty", weight=0.01)]))
+    shut = SubTask(id="s9_close_container", description=f"close {container} again", method=SkillMethod.PRIMITIVE,
+                   primitive="push", params={"object": container, "part": part, "access": True},
+                   reward=RewardSpec(terms=[RewardTerm(kind="action_penalty", weight=0.01)]),
+                   success=SuccessSpec(predicates=[PredicateCall(name="joint_closed", args={
+                       "object": container, "label": part, "max_fraction": 0.1})]))
+    return opened, shut
+
+
 def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, spec: SceneSpec | None = None,
                  source: str = "ground_truth") -> Plan:
     """A plan from the knowledge-base recipe of ``hazard_class``."""
@@ -106,5 +133,13 @@ def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, s
         raise ItemFailed(f"hazard class {hazard_class!r} is not in the knowledge base; no recipe to plan from")
     subtasks = [step_to_subtask(i, step.action, dict(step.args), bindings, spec, list(cls.success))
                 for i, step in enumerate(cls.recipe)]
+    for step in cls.recipe:
+        if step.action == "place_inside":
+            container = _resolve(step.args.get("container", "$container"), bindings)
+            labels = closed_closures(spec, container)
+            if labels:
+                opened, shut = access_steps(container, labels)
+                subtasks = [opened, *subtasks, shut]
+            break
     return Plan(task_id=task_id, source=source, engine=Engine.KNOWLEDGE, subtasks=subtasks,
                 success=SuccessSpec(predicates=list(cls.success)), bindings=dict(bindings))

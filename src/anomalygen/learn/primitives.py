@@ -113,6 +113,7 @@ class Driver:
         self.model, self.data, self.spec = model, data, spec
         self.frameskip, self.dp, self.on_step = int(frameskip), float(dp), on_step
         self.steps = 0
+        self.opened: dict[str, list[str]] = {}  # container -> joints opened to put something in
         # The seed only turns the ring of candidate base poses, so seeds try different approach sides.
         self.ring_offset = float(rng.uniform(0.0, 2 * np.pi / 24)) if rng is not None else 0.0
         self._mocap = robot.enable_ee_tracking(model, data)
@@ -340,9 +341,81 @@ def release(drv: Driver) -> PrimitiveResult:
 
 
 def _drop_point(drv: Driver, region: str, obj: str) -> np.ndarray:
-    """Where to hold the object's bottom before release: above the container opening / support centre."""
-    lo, hi = drv.aabb(region)
+    """Where to hold the object's bottom before release: above the opening of the container's carcass
+    (an open lid's own box does not count), inside an opened drawer's exposed part, or above the
+    centre of a support's top."""
+    from anomalygen.learn import parts
+
+    drawer = next((j for j in drv.opened.get(region, []) if drv.model.jnt_type[drv.model.joint(j).id] == parts.SLIDE),
+                  None)
+    if drawer is not None:
+        body = drv.model.body(int(drv.model.joint(drawer).bodyid[0])).name
+        dlo, dhi = drv.aabb(body)
+        clo, chi = parts.static_box(drv, region)
+        axis = np.abs(drv.data.xaxis[drv.model.joint(drawer).id])
+        k = int(np.argmax(axis[:2]))
+        centre = (dlo + dhi) / 2
+        # the stretch of the drawer that sticks out of the carcass, along the slide axis
+        if dhi[k] > chi[k]:
+            centre[k] = (max(dlo[k], chi[k]) + dhi[k]) / 2
+        elif dlo[k] < clo[k]:
+            centre[k] = (dlo[k] + min(dhi[k], clo[k])) / 2
+        return np.array([centre[0], centre[1], dhi[2] + 0.03])
+    lo, hi = opening(drv, region)
     return np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 0.04])
+
+
+def opening(drv: Driver, region: str) -> tuple[np.ndarray, np.ndarray]:
+    """The box above which a dropped object falls into ``region``: the carcass's top rectangle, minus
+    the strip that a half-open lid still hangs over (the lid swings about a horizontal axis, so it
+    covers the side of the opening next to its hinge)."""
+    from anomalygen.learn import parts
+
+    if not drv.opened.get(region):
+        return drv.aabb(region)
+    lo, hi = (v.copy() for v in parts.static_box(drv, region))
+    m = drv.model
+    for jn in drv.opened[region]:
+        j = m.joint(jn).id
+        if m.jnt_type[j] != parts.HINGE:
+            continue
+        axis = drv.data.xaxis[j]
+        k = 1 if abs(axis[0]) > abs(axis[1]) else 0  # horizontal direction the part swings along
+        plo, phi = drv.aabb(m.body(int(m.jnt_bodyid[j])).name)
+        if phi[k] <= lo[k] or plo[k] >= hi[k]:
+            continue  # swung clear of the opening
+        below, above = plo[k] - lo[k], hi[k] - phi[k]
+        if below >= above:
+            hi[k] = max(lo[k] + 1e-3, plo[k])
+        else:
+            lo[k] = min(hi[k] - 1e-3, phi[k])
+    return lo, hi
+
+
+def _long_axis_yaw(drv: Driver, obj: str) -> float:
+    """Yaw of the held object's longest horizontal extent (principal axis of its geoms' corners)."""
+    from anomalygen.scene import robot
+
+    m, d = drv.model, drv.data
+    mask = robot._subtree_geoms(m, drv.body_id(obj))
+    pts = []
+    for g in np.flatnonzero(mask):
+        c, h = m.geom_aabb[g, :3], m.geom_aabb[g, 3:]
+        corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * h + c
+        pts.append(corners @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g])
+    xy = np.concatenate(pts)[:, :2]
+    xy = xy - xy.mean(axis=0)
+    w, v = np.linalg.eigh(xy.T @ xy)
+    major = v[:, int(np.argmax(w))]
+    return float(np.arctan2(major[1], major[0]))
+
+
+def _yawed(quat: np.ndarray, yaw: float) -> np.ndarray:
+    import mujoco
+
+    out = np.zeros(4)
+    mujoco.mju_mulQuat(out, np.array([np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)]), quat)
+    return out
 
 
 def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True) -> PrimitiveResult:
@@ -361,6 +434,14 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True) -
     if not drv.place_base_near(goal):
         return PrimitiveResult(False, drv.steps - s0, f"no collision-free base pose near {region}")
     drv.goto(np.array([*goal[:2], carry_z]), quat, max_steps=250)
+    # turn the object so its long side runs along the long side of the opening
+    lo, hi = opening(drv, region)
+    want = 0.0 if hi[0] - lo[0] >= hi[1] - lo[1] else np.pi / 2
+    turn = (want - _long_axis_yaw(drv, obj) + np.pi / 2) % np.pi - np.pi / 2
+    cur = drv.data.mocap_quat[drv._mocap].copy()
+    for f in np.linspace(0.2, 1.0, 5):
+        drv.goto(np.array([*goal[:2], carry_z]), _yawed(cur, f * turn), max_steps=8)
+    quat = _yawed(cur, turn)
     ok = drv.goto(goal + np.array([0, 0, below]), quat, max_steps=200, tol=0.02)
     if release_after:
         release(drv)

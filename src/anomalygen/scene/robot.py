@@ -348,13 +348,17 @@ def suction_on(model: mujoco.MjModel, data: mujoco.MjData, object_name: str | No
     eq = _suction_eq(model, best)
     cup = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "suction")
     obj = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, best)
-    _, relquat = relative_pose(data.xpos[cup], data.xquat[cup], data.xpos[obj], data.xquat[obj])
+    relpos, relquat = relative_pose(data.xpos[cup], data.xquat[cup], data.xpos[obj], data.xquat[obj])
     # Weld data layout: anchor(3) in body2's frame, relpos(3) = where that anchor sits in body1's
-    # frame, relquat(4) = orientation of body2 in body1, torquescale(1). The anchor is the cup's centre:
-    # a door's frame sits on its hinge, where a position-only hold (torquescale 0) would hold nothing.
-    rot = data.xmat[obj].reshape(3, 3)
-    model.eq_data[eq, 0:3] = rot.T @ (data.xpos[cup] - data.xpos[obj])
-    model.eq_data[eq, 3:6] = 0.0
+    # frame, relquat(4) = orientation of body2 in body1, torquescale(1). A full weld anchors at body2's
+    # origin; a position-only hold (torquescale 0) anchors at the cup's centre instead, since a door's
+    # frame sits on its hinge, where holding the position would hold nothing.
+    anchor = np.zeros(3)
+    if torquescale < 1.0:
+        anchor = data.xmat[obj].reshape(3, 3).T @ (data.xpos[cup] - data.xpos[obj])
+        relpos = np.zeros(3)
+    model.eq_data[eq, 0:3] = anchor
+    model.eq_data[eq, 3:6] = relpos
     model.eq_data[eq, 6:10] = relquat
     model.eq_data[eq, 10] = torquescale
     data.eq_active[eq] = 1
