@@ -66,15 +66,16 @@ def _drive_joints(drv, st: SubTask, obj: str, prim: str, prm: dict):
     if not cands:
         return P.PrimitiveResult(False, 0, f"{obj} has no articulated part labelled {label!r} to {prim}")
     cands.sort(key=lambda c: -c[0])
-    steps, ok, details = 0, True, []
-    for _, joint, goal, closed, tol in cands:
-        if abs(float(drv.data.joint(joint).qpos[0]) - goal) <= tol:  # done already (pushed along by another)
-            continue
-        r = actuate_part(drv, joint, goal, closed=closed, tol=tol)
-        steps += r.steps
-        ok &= r.success
-        details.append(r.detail)
-    return P.PrimitiveResult(ok, steps, "; ".join(details) or f"{label} parts of {obj} already there")
+    steps, details = 0, {}
+    for _ in range(2):  # a second pass: closing one door can knock a neighbour open again
+        for _, joint, goal, closed, tol in cands:
+            if abs(float(drv.data.joint(joint).qpos[0]) - goal) <= tol:  # done already (pushed along by another)
+                continue
+            r = actuate_part(drv, joint, goal, closed=closed, tol=tol)
+            steps += r.steps
+            details[joint] = r.detail
+    ok = all(abs(float(drv.data.joint(j).qpos[0]) - g) <= t for _, j, g, _, t in cands)
+    return P.PrimitiveResult(ok, steps, "; ".join(details.values()) or f"{label} parts of {obj} already there")
 
 
 def _closed_parts(drv, name: str) -> list[str]:
@@ -113,7 +114,8 @@ def run_subtask(drv, st: SubTask, plan: Plan):
             g = P.grasp(drv, obj)
             if not g.success:
                 return g
-        res = P.move_to(drv, obj, region, release_after=bool(prm.get("release", True)))
+        into = any(c.name == "inside" for c in st.success.predicates) or prim == "place_inside"
+        res = P.move_to(drv, obj, region, release_after=bool(prm.get("release", True)), into=into)
         shut = [lab for lab in _closed_parts(drv, region) if lab != "door" or not drv.opened.get(region)]
         if shut and not drv.opened.get(region):  # say why an 'inside' will fail
             res.detail += f"; {region}'s {', '.join(shut)} closed and the plan did not open it"

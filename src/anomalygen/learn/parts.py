@@ -142,7 +142,13 @@ def grasp_candidates(drv, joint: str, closed: float) -> list[PartGrasp]:
         p_w = d.xpos[body] + rb @ p_l
         n_w = rb @ n_l
         p_c, n_c = rc @ p_w + tc, rc @ n_w
-        out.append(PartGrasp(body, p_l, n_l, outer=bool(np.dot(n_c, p_c - centre) > 0)))
+        if m.jnt_type[j] == SLIDE:  # a drawer's front faces the way it slides out
+            lo_r, hi_r = m.jnt_range[j]
+            far = hi_r if abs(hi_r - closed) >= abs(lo_r - closed) else lo_r
+            outer = bool(np.dot(n_w, axis_w) * np.sign(far - closed) > 0)
+        else:  # a door's or lid's outer face looks away from the carcass when shut
+            outer = bool(np.dot(n_c, p_c - centre) > 0)
+        out.append(PartGrasp(body, p_l, n_l, outer=outer))
     out.sort(key=lambda g: not g.outer)
     return out
 

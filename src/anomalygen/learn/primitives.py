@@ -105,7 +105,7 @@ class Driver:
     """Owns a loaded scene and moves the suction cup / base; counts control steps, calls ``on_step``."""
 
     def __init__(self, model, data, spec, *, frameskip: int = 5, dp: float = 0.012, on_step=None,
-                 rng: np.random.Generator | None = None):
+                 rng: np.random.Generator | None = None, planned_motion: bool = True):
         import mujoco
 
         from anomalygen.scene import robot
@@ -114,6 +114,8 @@ class Driver:
         self.frameskip, self.dp, self.on_step = int(frameskip), float(dp), on_step
         self.steps = 0
         self.opened: dict[str, list[str]] = {}  # container -> joints opened to put something in
+        self.planned_motion = planned_motion  # reach pre-contact poses by IK + OMPL paths
+        self.plan_seed = int(rng.integers(2**31)) if rng is not None else 0
         # The seed only turns the ring of candidate base poses, so seeds try different approach sides.
         self.ring_offset = float(rng.uniform(0.0, 2 * np.pi / 24)) if rng is not None else 0.0
         self._mocap = robot.enable_ee_tracking(model, data)
@@ -208,7 +210,7 @@ class Driver:
         return robot.held_object(self.model, self.data)
 
     # ---------------------------------------------------------------- base
-    def place_base_near(self, point, *, reach=BASE_REACH, side=None) -> bool:
+    def place_base_near(self, point, *, reach=BASE_REACH, side=None, tuck: bool = True) -> bool:
         """Put the base at a collision-free pose facing ``point`` at arm's reach (kinematic move).
 
         Candidates: rings of 24 headings at each distance in ``reach``, tried nearest-to-current first;
@@ -247,7 +249,20 @@ class Driver:
                     return True
         d.qpos[:], d.qvel[:], d.mocap_pos[:], d.mocap_quat[:] = saved
         mujoco.mj_forward(m, d)
+        if tuck and self.tuck():  # an outstretched arm collides everywhere: fold it in and try again
+            return self.place_base_near(point, reach=reach, side=side, tuck=False)
         return False
+
+    def tuck(self) -> bool:
+        """Bring the cup (and anything held) in close above the base, cup down, before a base move."""
+        from anomalygen.learn.ik import quat_z_to
+        from anomalygen.scene import robot
+
+        d = self.data
+        x, y, yaw = (float(d.joint(j).qpos[0]) for j in robot.BASE_JOINTS)
+        here = np.array([x + 0.35 * np.cos(yaw), y + 0.35 * np.sin(yaw), max(0.9, float(self.site[2]))])
+        self.goto(np.array([*self.site[:2], here[2]]), quat_z_to(np.array([0.0, 0.0, -1.0])), max_steps=60)
+        return self.goto(here, max_steps=120, tol=0.03)
 
     @staticmethod
     def _facing(base, p) -> bool:
@@ -284,45 +299,91 @@ class Driver:
 
 def _top_contact(drv: Driver, obj: str):
     """Grasp point and outward normal: the centre of the object's top face (AABB), normal +z."""
+    return grasp_points(drv, obj)[0], np.array([0.0, 0.0, 1.0])
+
+
+def grasp_points(drv: Driver, obj: str, n: int = 3) -> list[np.ndarray]:
+    """Up to ``n`` points to put the cup on, best first: the tops of the object's highest, widest
+    collision geoms, then the centre of its box's top. A pair of pliers or glasses has nothing
+    under the centre of its box, so the box alone sends the cup into a gap."""
+    from anomalygen.scene import robot
+    from anomalygen.scene.graph import geom_world_aabbs
+
+    m = drv.model
     lo, hi = drv.aabb(obj)
-    return np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2]]), np.array([0.0, 0.0, 1.0])
+    glo, ghi = geom_world_aabbs(m, drv.data)
+    mask = robot._subtree_geoms(m, drv.body_id(obj)) & (m.geom_contype | m.geom_conaffinity).astype(bool)
+    cands = []
+    for g in np.flatnonzero(mask):
+        area = float(np.prod(ghi[g, :2] - glo[g, :2]))
+        top = float(ghi[g, 2])
+        if top < hi[2] - 0.03:
+            continue  # well below the top: the cup would meet something else first
+        cands.append((top - hi[2] + 3.0 * np.sqrt(area), np.array([*(glo[g, :2] + ghi[g, :2]) / 2, top])))
+    cands.sort(key=lambda c: -c[0])
+    pts: list[np.ndarray] = []
+    for _, p in cands:
+        if all(np.linalg.norm(p[:2] - q[:2]) > 0.02 for q in pts):
+            pts.append(p)
+    centre = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2]])
+    if all(np.linalg.norm(centre[:2] - q[:2]) > 0.02 for q in pts):
+        pts.append(centre)
+    return pts[:n]
 
 
-def approach(drv: Driver, obj: str) -> PrimitiveResult:
-    """Base near ``obj``, cup to 0.03 m + a clearance above its top face, cup facing the surface."""
+def approach(drv: Driver, obj: str, point=None) -> PrimitiveResult:
+    """Base near ``obj``, cup to 0.03 m above its top face (grasp ``point``), cup facing the surface.
+
+    The pre-contact pose is reached by IK and a collision-free joint path (``arm_motion``), as the
+    paper does; when planning fails the cup rises and comes down straight instead."""
     from anomalygen.learn.ik import quat_z_to
 
     s0 = drv.steps
-    point, normal = _top_contact(drv, obj)
+    normal = np.array([0.0, 0.0, 1.0])
+    point = grasp_points(drv, obj)[0] if point is None else point
     if not drv.place_base_near(point):
         return PrimitiveResult(False, drv.steps - s0, f"no collision-free base pose near {obj}")
     quat = quat_z_to(-normal)
+    pre = point + normal * PRE_CONTACT
     hover = point + normal * (PRE_CONTACT + 0.12)
-    drv.goto(drv.site + np.array([0, 0, max(0.0, hover[2] - drv.site[2])]), quat, max_steps=120)
-    drv.goto(hover, quat, max_steps=200)
-    ok = drv.goto(point + normal * PRE_CONTACT, quat, max_steps=200)
+    ok = False
+    if drv.planned_motion:
+        from anomalygen.learn.arm_motion import move_arm_planned
+
+        r = move_arm_planned(drv, pre, quat, seed=drv.plan_seed, ik_attempts=3)
+        ok = r.ok
+    if not ok:
+        drv.goto(drv.site + np.array([0, 0, max(0.0, hover[2] - drv.site[2])]), quat, max_steps=120)
+        drv.goto(hover, quat, max_steps=200)
+        ok = drv.goto(pre, quat, max_steps=200)
     return PrimitiveResult(ok, drv.steps - s0, f"pre-contact {'reached' if ok else 'not reached'} above {obj}")
 
 
 def grasp(drv: Driver, obj: str, *, lift: float = 0.12) -> PrimitiveResult:
-    """Approach, move along the normal until the cup touches, switch suction on, lift by ``lift``."""
+    """Approach, move along the normal until the cup touches, switch suction on, lift by ``lift``.
+
+    Tries up to three grasp points (``grasp_points``) before giving up."""
     from anomalygen.learn.ik import quat_z_to
     from anomalygen.scene import robot
 
     s0 = drv.steps
-    res = approach(drv, obj)
-    if not res.success and "base" in res.detail:
-        return res
-    point, normal = _top_contact(drv, obj)
+    normal = np.array([0.0, 0.0, 1.0])
     quat = quat_z_to(-normal)
     grabbed = False
-    for k in range(40):  # descend 2.5 mm per waypoint until suction catches
-        target = point + normal * (PRE_CONTACT - 0.0025 * k)
-        drv.goto(target, quat, max_steps=12, tol=0.004)
-        if robot.object_distance_to_cup(drv.model, drv.data, obj) < robot.SUCTION_RANGE * 0.8:
-            grabbed = robot.suction_on(drv.model, drv.data, obj)
-            if grabbed:
-                break
+    for point in grasp_points(drv, obj):
+        res = approach(drv, obj, point)
+        if not res.success and "base" in res.detail:
+            return res
+        for k in range(40):  # descend 2.5 mm per waypoint until suction catches
+            target = point + normal * (PRE_CONTACT - 0.0025 * k)
+            drv.goto(target, quat, max_steps=12, tol=0.004)
+            if robot.object_distance_to_cup(drv.model, drv.data, obj) < robot.SUCTION_RANGE * 0.8:
+                grabbed = robot.suction_on(drv.model, drv.data, obj)
+                if grabbed:
+                    break
+        if grabbed:
+            break
+        drv.goto(drv.site + normal * 0.06, quat, max_steps=40)
     if not grabbed:
         return PrimitiveResult(False, drv.steps - s0, f"suction did not catch {obj} "
                                f"(cup-object distance {robot.object_distance_to_cup(drv.model, drv.data, obj):.3f} m)")
@@ -363,6 +424,42 @@ def _drop_point(drv: Driver, region: str, obj: str) -> np.ndarray:
         return np.array([centre[0], centre[1], dhi[2] + 0.03])
     lo, hi = opening(drv, region)
     return np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 0.04])
+
+
+def free_spot(drv: Driver, support: str, obj: str, *, edge_margin: float = 0.2) -> np.ndarray:
+    """A drop point on the support's top that keeps ``edge_margin`` from its edges and misses the
+    other things standing there (a book in the middle of the table would leave the object perched
+    half on it), nearest the centre; the centre when the top is too small for the margin."""
+    from anomalygen.scene.graph import geom_world_aabbs
+
+    m = drv.model
+    lo, hi = drv.aabb(support)
+    glo, ghi = geom_world_aabbs(m, drv.data)
+    top_geoms = [g for g in range(m.ngeom) if m.body(int(m.geom_bodyid[g])).name.startswith(support + "/")
+                 and ghi[g, 2] > hi[2] - 0.01]
+    if top_geoms:  # the top board itself, not the legs' footprint
+        lo = np.min(glo[top_geoms], axis=0)
+        hi = np.array([*np.max(ghi[top_geoms], axis=0)[:2], hi[2]])
+    olo, ohi = drv.aabb(obj)
+    half = float(np.max(ohi[:2] - olo[:2])) / 2
+    others = []
+    for o in drv.spec.objects:
+        if o.name in (obj, support):
+            continue
+        blo, bhi = drv.aabb(o.name)
+        if bhi[2] > hi[2] - 0.01 and blo[2] < hi[2] + 0.3:
+            others.append((blo[:2] - 0.03, bhi[:2] + 0.03))
+    centre = (lo[:2] + hi[:2]) / 2
+    inset = np.minimum(half + edge_margin, (hi[:2] - lo[:2]) / 2)
+    best, best_score = centre, np.inf
+    for x in np.linspace(lo[0] + inset[0], hi[0] - inset[0], 9):
+        for y in np.linspace(lo[1] + inset[1], hi[1] - inset[1], 9):
+            p = np.array([x, y])
+            hits = sum(bool(np.all(p + half > a) and np.all(p - half < b)) for a, b in others)
+            score = hits * 10.0 + float(np.linalg.norm(p - centre))
+            if score < best_score:
+                best, best_score = p, score
+    return np.array([best[0], best[1], hi[2] + 0.008])  # set down, not dropped: a globe would topple
 
 
 def opening(drv: Driver, region: str) -> tuple[np.ndarray, np.ndarray]:
@@ -418,14 +515,15 @@ def _yawed(quat: np.ndarray, yaw: float) -> np.ndarray:
     return out
 
 
-def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True) -> PrimitiveResult:
-    """Carry the held ``obj`` above ``region`` (container opening or support top centre), lower, release."""
+def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, into: bool = True) -> PrimitiveResult:
+    """Carry the held ``obj`` above ``region`` and lower it: into a container's opening (``into``) or
+    onto a free spot of a support's top; then release."""
     from anomalygen.learn.ik import quat_z_to
 
     s0 = drv.steps
     if drv.held != obj:
         return PrimitiveResult(False, 0, f"{obj} is not held")
-    goal = _drop_point(drv, region, obj)
+    goal = _drop_point(drv, region, obj) if into else free_spot(drv, region, obj)
     olo, ohi = drv.aabb(obj)
     below = drv.site[2] - olo[2]  # cup face to object bottom
     quat = quat_z_to(np.array([0.0, 0.0, -1.0]))
@@ -437,7 +535,7 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True) -
     # turn the object so its long side runs along the long side of the opening
     lo, hi = opening(drv, region)
     want = 0.0 if hi[0] - lo[0] >= hi[1] - lo[1] else np.pi / 2
-    turn = (want - _long_axis_yaw(drv, obj) + np.pi / 2) % np.pi - np.pi / 2
+    turn = (want - _long_axis_yaw(drv, obj) + np.pi / 2) % np.pi - np.pi / 2 if into else 0.0
     cur = drv.data.mocap_quat[drv._mocap].copy()
     for f in np.linspace(0.2, 1.0, 5):
         drv.goto(np.array([*goal[:2], carry_z]), _yawed(cur, f * turn), max_steps=8)

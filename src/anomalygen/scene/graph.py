@@ -185,14 +185,14 @@ def scene_graph(model: mujoco.MjModel, data: mujoco.MjData, spec: SceneSpec) -> 
         height = float(lo[i][2])
         on_floor = "floor" in supports[i] or height < ON_FLOOR_TOL
         edge = None
-        for sup, geom in supports[i].items():
-            if sup == "floor":
-                continue
-            # distance from the object's footprint to the edge of the supporting geom's top, in x/y;
-            # negative when the object overhangs.
+        # distance from the object's footprint to the edge of its main support's top (the widest
+        # supporting geom; a laptop also touching a mug in the middle of the table is not at an
+        # edge), in x/y; negative when the object overhangs.
+        under = [g for sup, g in supports[i].items() if sup != "floor"]
+        if under:
+            geom = max(under, key=lambda g: float(np.prod(geom_hi[g][:2] - geom_lo[g][:2])))
             d = np.minimum(lo[i][:2] - geom_lo[geom][:2], geom_hi[geom][:2] - hi[i][:2])
-            cand = float(np.min(d))
-            edge = cand if edge is None else min(edge, cand)
+            edge = float(np.min(d))
         container = inside_of[i]
         enclosed = container is not None and closed[container]
         objects.append(
