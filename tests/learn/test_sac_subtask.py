@@ -210,3 +210,31 @@ def test_run_sac_subtask_trains_and_replays_on_the_driver_deterministically():
         assert rollout == 100 or res.success
         outs.append((res.success, res.steps, res.detail, drv.data.qpos.copy()))
     assert outs[0][:3] == outs[1][:3] and np.array_equal(outs[0][3], outs[1][3])
+
+
+@pytest.mark.slow
+def test_a_closing_reward_about_an_already_closed_part_moves_to_the_open_one(tmp_path):
+    """The planner names a fridge's first joint (the freezer); the open one is the door."""
+    from test_execute import TASKS
+
+    from anomalygen.config import Settings
+    from anomalygen.learn.planner import plan_from_kb
+    from anomalygen.learn.primitives import Driver
+    from anomalygen.learn.sac_subtask import retarget_joints
+    from anomalygen.scene.build import build_scene
+    from anomalygen.scene.graph import load_scene
+
+    task = TASKS["fridge"]
+    spec = build_scene(task, seed=0, settings=Settings(build={"clutter": 1}), out_dir=tmp_path)
+    st = plan_from_kb(task.id, task.hazard_class, dict(spec.bindings), spec=spec).subtasks[0]
+    model, data, spec = load_scene(tmp_path)
+    drv = Driver(model, data, spec)
+    fridge = next(o for o in spec.objects if o.asset.category == "Refrigerator")
+    named = next(t.joint for t in st.reward.terms if t.kind == "joint")
+    door = max((j for j in fridge.joint_states if j.label == "door"), key=lambda j: abs(data.joint(j.name).qpos[0]))
+    assert abs(data.joint(named).qpos[0]) < 0.01 < abs(data.joint(door.name).qpos[0])  # the scene this guards
+    moved, note = retarget_joints(drv, st)
+    term = next(t for t in moved.reward.terms if t.kind == "joint")
+    assert (term.joint, term.target) == (door.name, door.closed_value) and named in note
+    assert [t.kind for t in moved.reward.terms] == [t.kind for t in st.reward.terms]
+    assert retarget_joints(drv, moved) == (moved, "")  # nothing left to move

@@ -44,6 +44,48 @@ def restore(model, data, state: np.ndarray) -> None:
     mujoco.mj_forward(model, data)
 
 
+def retarget_joints(drv, st: SubTask) -> tuple[SubTask, str]:
+    """Point a closing joint term at the part that is open now, as ``execute._drive_joints`` does.
+
+    The planner names an object's first joint, but a fridge has a freezer and a main door and either
+    may be the open one; a reward about the closed freezer can never be improved on. A term whose
+    target is its joint's closed value and whose joint is already closed moves to the most open joint
+    of the same object whose label the step's predicates (or ``part`` param) name.
+    """
+    from anomalygen.learn.subtask_env import JOINT_TOL_FRACTION
+
+    if st.reward is None:
+        return st, ""
+    labels = {str(st.params["part"])} if st.params.get("part") else set()
+    for call in st.success.predicates:
+        if "label" in call.args:
+            labels |= {v.strip() for v in str(call.args["label"]).split("|")}
+
+    def gap(js) -> float:
+        q = float(drv.data.joint(js.name).qpos[0])
+        return abs(q - js.closed_value) / max(abs(js.range[1] - js.range[0]), 1e-6)
+
+    terms, notes = [], []
+    for t in st.reward.terms:
+        name = t.joint or t.a
+        owner = next((o for o in drv.spec.objects if any(j.name == name for j in o.joint_states)), None) \
+            if t.kind == "joint" else None
+        js = next((j for j in owner.joint_states if j.name == name), None) if owner else None
+        if js is None or float(t.target) != js.closed_value or gap(js) > JOINT_TOL_FRACTION:
+            terms.append(t)
+            continue
+        cands = [j for j in owner.joint_states if not labels or "*" in labels or j.label in labels]
+        best = max(cands, key=gap, default=None)
+        if best is None or best.name == name or gap(best) <= JOINT_TOL_FRACTION:
+            terms.append(t)
+            continue
+        terms.append(t.model_copy(update={"joint": best.name, "a": None, "target": best.closed_value}))
+        notes.append(f"reward moved from {name} (already closed) to {best.name}")
+    if not notes:
+        return st, ""
+    return st.model_copy(update={"reward": st.reward.model_copy(update={"terms": terms})}), "; ".join(notes)
+
+
 def pre_position(drv, st: SubTask, plan: Plan, readout) -> str:
     """Bring base and cup to where the sub-task's contact happens; returns a note for the detail."""
     from anomalygen.learn import primitives as P
@@ -95,6 +137,7 @@ def run_sac_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, thre
     if steps <= 0:
         return PrimitiveResult(False, 0, "not executed: sac_steps is 0")
     s0 = drv.steps
+    st, moved = retarget_joints(drv, st)
     try:
         readout = SubTaskReadout(drv.model, drv.spec, st, plan.bindings)
     except ValueError as exc:
@@ -122,7 +165,7 @@ def run_sac_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, thre
     finally:
         drv.frameskip = fs
     joints = readout.joint_summary(state)
-    detail = (f"{pre}; SAC {res.steps} steps: best eval success {res.best_success:.2f} at {res.best_step} steps; "
+    detail = (("" if not moved else moved + "; ") + f"{pre}; SAC {res.steps} steps: best eval success {res.best_success:.2f} at {res.best_step} steps; "
               f"rollout {'succeeded' if ok else 'failed'} in {t} steps"
               + (f" ({joints})" if joints else "") + (f"; {why}" if why else ""))
     return PrimitiveResult(ok, drv.steps - s0, detail)
