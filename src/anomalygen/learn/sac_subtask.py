@@ -4,7 +4,9 @@
    part out of the arm's reach could never be learned. As RoboGen does before an RL sub-task, the
    base is placed and the cup brought to the part with the same moves the push primitive makes
    (6 cm behind the part point, against the direction the joint must move; for a pull, 4 cm in
-   front of it, where suction can take hold), or above the object for object sub-tasks. These steps run on the Driver and show in the video.
+   front of it, where suction can take hold), or above the object for object sub-tasks. These
+   steps run on the Driver and show in the video. Before that, a closing reward about a part that
+   is already closed is moved to the open part of the same object (:func:`retarget_joints`).
 2. Snapshot the Driver's full physics state and train SAC (:func:`~anomalygen.learn.sac.train_sac`,
    paper settings, evaluation every ``min(steps, 1000)`` steps, stop at 90 % success) on
    :class:`~anomalygen.learn.subtask_env.SubTaskEnv`, which owns copies of model and data.
