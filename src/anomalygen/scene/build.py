@@ -542,10 +542,10 @@ def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
         if p.support_geom is not None:
             furniture.emit(p.support_geom, body, rng)
             continue
+        root = p.asset.attach(body, f"{p.name}/")
         if not p.fixed:
             body.add_freejoint(name=f"{p.name}/free")
-            loose.append(p.name)
-        root = p.asset.attach(body, f"{p.name}/")
+            loose.append((p.name, root.name))
         parts.extend(_articulated_bodies(root))
         if not p.fixed:
             # Rolling and torsional friction (condim 6): a needle or pencil must not roll for ever.
@@ -555,7 +555,7 @@ def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
                 geom.friction = [max(geom.friction[0], 0.8), 0.01, 0.002]
                 geom.margin = max(geom.margin, 0.001)
     # Suction can also hold a door, lid or drawer, so primitives can pull parts open or lift them shut.
-    robot.add_suction_welds(spec, loose + parts)
+    robot.add_suction_welds(spec, [n for n, _ in loose] + parts, [r for _, r in loose] + parts)
     task_objects = [p for p in placed.values() if p.role != ObjectRole.CLUTTER]
     add_observation_sensors(
         spec,

@@ -206,13 +206,19 @@ def _wrist_xyaxes(tilt: float = 0.3) -> list[float]:
     return [*right.tolist(), *up.tolist()]
 
 
-def add_suction_welds(spec: mujoco.MjSpec, object_bodies: list[str]) -> None:
-    """One inactive weld per free object body, so suction is a toggle at run time (no recompiles)."""
+def add_suction_welds(spec: mujoco.MjSpec, object_bodies: list[str], held_bodies: list[str] | None = None) -> None:
+    """One inactive weld per free object body, so suction is a toggle at run time (no recompiles).
+
+    The weld is named after the object (``suction__<object>``) but may hold another body of it
+    (``held_bodies``): the body that carries the mass. MuJoCo softens a weld by the inverse weight of
+    the bodies it joins, and an object's massless wrapper body has an enormous one, which left a
+    paper ball trailing 30 cm under the cup.
+    """
     import mujoco
 
-    for body in object_bodies:
+    for body, held in zip(object_bodies, held_bodies or object_bodies, strict=True):
         eq = spec.add_equality(
-            name=SUCTION_PREFIX + body, type=mujoco.mjtEq.mjEQ_WELD, name1="suction", name2=body
+            name=SUCTION_PREFIX + body, type=mujoco.mjtEq.mjEQ_WELD, name1="suction", name2=held
         )
         eq.objtype = mujoco.mjtObj.mjOBJ_BODY
         eq.active = False
@@ -347,7 +353,7 @@ def suction_on(model: mujoco.MjModel, data: mujoco.MjData, object_name: str | No
         return False
     eq = _suction_eq(model, best)
     cup = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "suction")
-    obj = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, best)
+    obj = int(model.eq_obj2id[eq])  # the body the weld holds (the object's massive body)
     relpos, relquat = relative_pose(data.xpos[cup], data.xquat[cup], data.xpos[obj], data.xquat[obj])
     # Weld data layout: anchor(3) in body2's frame, relpos(3) = where that anchor sits in body1's
     # frame, relquat(4) = orientation of body2 in body1, torquescale(1). A full weld anchors at body2's
