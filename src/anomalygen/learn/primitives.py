@@ -423,10 +423,38 @@ def _drop_point(drv: Driver, region: str, obj: str) -> np.ndarray:
             centre[k] = (dlo[k] + min(dhi[k], clo[k])) / 2
         return np.array([centre[0], centre[1], dhi[2] + 0.03])
     lo, hi = opening(drv, region)
-    # Into a deep box, reach down a little before letting go: a needle dropped 45 cm passes through a
-    # cardboard bottom in one physics step.
-    deeper = float(np.clip(hi[2] - lo[2] - 0.2, 0.0, 0.15))
-    return np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 0.04 - deeper])
+    centre = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 0.04])
+    # Reach down into the container before letting go: a needle or a flat wrapper dropped from the
+    # rim passes through a thin bottom in one physics step. The floor inside is found by a ray.
+    floor = _floor_below(drv, centre, obj)
+    if floor is not None:
+        centre[2] = max(floor + 0.02, hi[2] - MAX_REACH_IN, lo[2] + 0.02)
+        centre[2] = min(centre[2], hi[2] + 0.04)
+    return centre
+
+
+MAX_REACH_IN = 0.5  # m the held object's bottom may go below a container's rim
+
+
+def _floor_below(drv: Driver, point: np.ndarray, obj: str) -> float | None:
+    """Height of the first surface under ``point`` (the held object and the robot ignored)."""
+    import mujoco
+
+    from anomalygen.scene import robot
+
+    m, d = drv.model, drv.data
+    skip = robot._subtree_geoms(m, drv.body_id(obj)) | np.isin(np.arange(m.ngeom), list(drv._robot_geoms))
+    start = np.asarray(point, dtype=float).copy()
+    geomid = np.zeros(1, dtype=np.int32)
+    for _ in range(8):  # step past ignored geoms
+        dist = mujoco.mj_ray(m, d, start, np.array([0.0, 0.0, -1.0]), None, 1, -1, geomid)
+        if dist < 0:
+            return None
+        hit = start[2] - dist
+        if not skip[int(geomid[0])]:
+            return float(hit)
+        start[2] = hit - 1e-4
+    return None
 
 
 def free_spot(drv: Driver, support: str, obj: str, *, edge_margin: float = 0.2) -> np.ndarray:
