@@ -4,9 +4,10 @@ Primitive sub-tasks are executed by :mod:`anomalygen.learn.primitives` on one sh
 :class:`~anomalygen.learn.primitives.Driver`, so the state flows from one step to the next (a grasp
 is followed by a move with the object still held). A sub-task succeeds when its SuccessSpec holds on
 ``scene_graph`` right after it (or, with an empty spec, when the primitive reports success); the task
-succeeds when the plan's SuccessSpec holds on the final, settled state. Sub-tasks whose method is SAC
-or CEM are not trained here (that needs a per-sub-task environment the SAC helper owns); they are
-reported as not executed, with that reason, and the plan continues.
+succeeds when the plan's SuccessSpec holds on the final, settled state. SAC sub-tasks are learned on
+the spot (``sac_subtask.run_sac_subtask``: ``sac_steps`` environment steps from the state the plan has
+reached, then the best policy is replayed on the Driver); CEM sub-tasks need a legged robot, which
+household scenes do not carry, and are reported as not executed with that reason.
 """
 
 from __future__ import annotations
@@ -139,7 +140,7 @@ def _evaluate(calls, model, data, spec, bindings) -> list[PredicateResult]:
 
 
 def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: str | Path | None = None,
-                 max_wall_s: float = 600.0) -> SkillResult:
+                 max_wall_s: float = 600.0, sac_steps: int = 0) -> SkillResult:
     """Load the scene, run the plan's sub-tasks in order, check success, optionally record a video."""
     from anomalygen.learn.primitives import Driver
     from anomalygen.rng import item_rng
@@ -158,15 +159,21 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
     results: list[SubTaskResult] = []
     for st in plan.subtasks:
         ts = time.perf_counter()
-        if st.method != SkillMethod.PRIMITIVE:
+        if st.method == SkillMethod.CEM:
             results.append(SubTaskResult(id=st.id, method=st.method, success=False, detail=(
-                f"not executed: {st.method.value} sub-tasks need a learned policy, which execute_plan does not train")))
+                "not executed: CEM plans the motion of a legged robot (learn/cem.py, the Gymnasium Ant); "
+                "household scenes carry the wheeled arm")))
             continue
         if time.perf_counter() - t0 > max_wall_s:
             results.append(SubTaskResult(id=st.id, method=st.method, success=False, detail="not executed: time budget spent"))
             continue
         s0 = drv.steps
-        res = run_subtask(drv, st, plan)
+        if st.method == SkillMethod.SAC:
+            from anomalygen.learn.sac_subtask import run_sac_subtask
+
+            res = run_sac_subtask(drv, st, plan, steps=sac_steps, seed=seed)
+        else:
+            res = run_subtask(drv, st, plan)
         drv.settle(10)
         ok = res.success
         detail = res.detail

@@ -26,6 +26,7 @@ INNER_FACE_STOP = 0.4  # rad: a grasp on the inner face lets go this far from cl
 LEAD_HINGE = 0.06
 MAX_DRAG = 0.04  # m the container may be dragged by its part before the drive gives up
 MAX_TILT = 0.2  # rad it may tip
+COMFORT_Z = 0.95  # m: height at which the arm holds a tall door
 
 
 @dataclass
@@ -34,6 +35,7 @@ class PartGrasp:
     point_local: np.ndarray  # grasp point, part body frame
     normal_local: np.ndarray  # outward normal of the grasped face, part body frame
     outer: bool  # the face that points out of the cabinet when closed
+    beyond_local: np.ndarray | None = None  # just past the free edge (hinged parts), part body frame
 
 
 def _rot(axis: np.ndarray, angle: float) -> np.ndarray:
@@ -139,6 +141,18 @@ def grasp_candidates(drv, joint: str, closed: float) -> list[PartGrasp]:
             i_far = max(others, key=lambda i: abs(abs(axis_l[i]) - 1.0) * size[i])
             far = hi[i_far] if abs(hi[i_far] - anchor_l[i_far]) > abs(lo[i_far] - anchor_l[i_far]) else lo[i_far]
             p_l[i_far] = anchor_l[i_far] + 0.75 * (far - anchor_l[i_far])
+            # along a vertical hinge, hold the door at a comfortable height (a freezer door's middle
+            # is out of the arm's reach)
+            i_ax = int(np.argmax(np.abs(axis_l)))
+            if abs(axis_w[2]) > 0.7 and i_ax != k:
+                z0 = float((d.xpos[body] + rb @ p_l)[2])
+                want = float(np.clip(COMFORT_Z, z0 - (p_l[i_ax] - lo[i_ax]) * abs(axis_w[2]) + 0.06,
+                                     z0 + (hi[i_ax] - p_l[i_ax]) * abs(axis_w[2]) - 0.06))
+                p_l[i_ax] += (want - z0) / (rb[2, i_ax] if abs(rb[2, i_ax]) > 1e-6 else 1.0)
+        beyond = None
+        if m.jnt_type[j] == HINGE:  # 12 cm past the free edge, level with the grasp point
+            beyond = p_l.copy()
+            beyond[i_far] = far + 0.12 * np.sign(far - anchor_l[i_far])
         p_w = d.xpos[body] + rb @ p_l
         n_w = rb @ n_l
         p_c, n_c = rc @ p_w + tc, rc @ n_w
@@ -148,7 +162,7 @@ def grasp_candidates(drv, joint: str, closed: float) -> list[PartGrasp]:
             outer = bool(np.dot(n_w, axis_w) * np.sign(far - closed) > 0)
         else:  # a door's or lid's outer face looks away from the carcass when shut
             outer = bool(np.dot(n_c, p_c - centre) > 0)
-        out.append(PartGrasp(body, p_l, n_l, outer=outer))
+        out.append(PartGrasp(body, p_l, n_l, outer=outer, beyond_local=beyond))
     out.sort(key=lambda g: not g.outer)
     return out
 
@@ -204,10 +218,12 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
             break
         quat = quat_z_to(-n)
         hover = p + n * (PRE_CONTACT + 0.10)
-        if np.dot(drv.site - p, n) < 0.0:  # cup behind the face (left the inner face): go over the top
-            top = drv.aabb(name)[1][2] + 0.10
-            drv.goto(np.array([*drv.site[:2], max(top, drv.site[2])]), max_steps=80, tol=0.02)
-            drv.goto(np.array([*hover[:2], max(top, drv.site[2])]), quat, max_steps=120, tol=0.02)
+        if np.dot(drv.site - p, n) < 0.0 and g.beyond_local is not None:
+            # the cup is behind the face: round the part's free edge instead of sweeping through it
+            rb = d.xmat[g.body].reshape(3, 3)
+            edge = d.xpos[g.body] + rb @ g.beyond_local
+            drv.goto(edge - n * 0.08, max_steps=120, tol=0.03)
+            drv.goto(edge + n * (PRE_CONTACT + 0.10), quat, max_steps=120, tol=0.03)
         drv.goto(hover, quat, max_steps=220, tol=0.02)
         drv.goto(p + n * PRE_CONTACT, quat, max_steps=120)
         grabbed = False

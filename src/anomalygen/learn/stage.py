@@ -37,7 +37,8 @@ def learn_item(item_id: str, payload: dict, ctx: StageContext) -> dict:
         raise ItemFailed(f"no valid plan for {task_id}")
     out = run.skill_dir(task_id, seed)
     video = out / "video.mp4" if settings.learn.video else None
-    result = execute_plan(run.scene_dir(task_id), plan, seed=seed, video_path=video)
+    result = execute_plan(run.scene_dir(task_id), plan, seed=seed, video_path=video,
+                          sac_steps=settings.learn.sac_steps)
     if result.video:
         result = result.model_copy(update={"video": "video.mp4"})
     write_model(out / "result.json", result)
