@@ -249,7 +249,44 @@ def move_arm_planned(drv, target_pos, quat, *, time_limit: float = 1.0, seed: in
     if path is None:
         return fail(f"no path in {time_limit:g} s")
     plan_s = round(time.perf_counter() - t0, 4)
+    settled, n_way, steps = follow_joint_path(drv, path, max_steps=max_steps, joint_speed=joint_speed, tol=tol)
+    err = float(np.linalg.norm(drv.site - np.asarray(target_pos, dtype=float)))
+    return ArmMotionResult(settled, "reached" if settled else "did not settle", n_way, plan_s, steps,
+                           round(err, 5), margin)
 
+
+def rehome(drv, *, time_limit: float = 1.0, seed: int = 0, max_steps: int = 300) -> bool:
+    """Bring the arm back to its home configuration (cup down, folded in), planned when possible.
+
+    Pulling a drawer or a door leaves the wrist turned sideways; a straight mocap move from there to a
+    cup-down pose can wind the wrist into the furniture. From home every approach starts clean. When
+    no collision-free path is found (the arm starts touching something) the joints are interpolated
+    straight to home.
+    """
+    from anomalygen.learn.motion import plan_path
+    from anomalygen.scene import robot
+
+    m, d = drv.model, drv.data
+    held = robot.held_object(m, d)
+    rel = _held_relative_pose(m, d, held) if held is not None else None
+    ref = _reference_state(m, d)
+    checker = _checker(m, ref, held, rel, 0.005, ())
+    q0 = d.qpos[checker.qadr].copy()
+    home = np.asarray(robot.HOME_ARM, dtype=float)
+    path = plan_path(m, ref, robot.ARM_JOINTS, home, time_limit=time_limit, seed=seed, checker=checker) \
+        if checker.valid(q0) and checker.valid(home) else None
+    settled, _, _ = follow_joint_path(drv, path or [q0, home], max_steps=max_steps)
+    return settled
+
+
+def follow_joint_path(drv, path, *, max_steps: int = 400, joint_speed: float = 1.0, tol: float = 0.01):
+    """Execute an arm joint path under position control; returns (settled, waypoints, steps)."""
+    from anomalygen.scene import robot
+
+    m, d = drv.model, drv.data
+    goal = np.asarray(path[-1], dtype=float)
+    qadr = [m.jnt_qposadr[m.joint(n).id] for n in robot.ARM_JOINTS]
+    q0 = d.qpos[qadr].copy()
     # ---- execute: joint position control along the path
     dt = drv.frameskip * m.opt.timestep
     way = retime(path, joint_speed * dt)
@@ -268,7 +305,7 @@ def move_arm_planned(drv, target_pos, quat, *, time_limit: float = 1.0, seed: in
             d.ctrl[acts] = q
             drv.step()
         while drv.steps - s0 < max_steps:
-            err = np.max(np.abs(d.qpos[checker.qadr] - goal))
+            err = np.max(np.abs(d.qpos[qadr] - goal))
             if (err < tol and np.max(np.abs(d.qvel[dadr])) < 0.05
                     and np.max(np.abs(d.qpos[bq] - base_set)) < 0.003):
                 settled = True
@@ -278,6 +315,4 @@ def move_arm_planned(drv, target_pos, quat, *, time_limit: float = 1.0, seed: in
         robot.enable_ee_tracking(m, d)  # mocap on the cup, arm limp again, weld on
         for name, v in zip(robot.BASE_JOINTS, base_set, strict=True):
             d.actuator(name).ctrl[0] = v  # enable_ee_tracking re-aims the base where it is; keep the set point
-    err = float(np.linalg.norm(drv.site - np.asarray(target_pos, dtype=float)))
-    return ArmMotionResult(settled, "reached" if settled else "did not settle", len(way), plan_s,
-                           drv.steps - s0, round(err, 5), margin)
+    return settled, len(way), drv.steps - s0

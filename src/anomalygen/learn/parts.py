@@ -250,6 +250,10 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
             drv.goto(drv.site + np.array([0.0, 0.0, 0.25]), max_steps=40)
         drv.dp = dp
     drv.settle(10)
+    if drv.planned_motion and not drv.cup_down():
+        from anomalygen.learn.arm_motion import rehome
+
+        rehome(drv, seed=drv.plan_seed)  # the wrist is turned sideways: start the next move clean
     ok = abs(q() - goal) <= tol
     detail = f"{joint} = {q():.3f} (goal {goal:.3f})" + (f"; {'; '.join(notes)}" if notes else "")
     return PrimitiveResult(ok, drv.steps - s0, detail)

@@ -141,6 +141,10 @@ class Driver:
         for _ in range(n):
             self.step()
 
+    def cup_down(self, cos_tol: float = 0.7) -> bool:
+        """True when the cup face points roughly down (within ~45 degrees)."""
+        return bool(-self.data.xmat[self._cup].reshape(3, 3)[2, 2] > cos_tol)
+
     @property
     def site(self) -> np.ndarray:
         return self.data.site_xpos[self._site_ee].copy()
@@ -346,16 +350,24 @@ def approach(drv: Driver, obj: str, point=None) -> PrimitiveResult:
     quat = quat_z_to(-normal)
     pre = point + normal * PRE_CONTACT
     hover = point + normal * (PRE_CONTACT + 0.12)
-    ok = False
+    planned = False
     if drv.planned_motion:
         from anomalygen.learn.arm_motion import move_arm_planned
 
-        r = move_arm_planned(drv, pre, quat, seed=drv.plan_seed, ik_attempts=3)
-        ok = r.ok
-    if not ok:
-        drv.goto(drv.site + np.array([0, 0, max(0.0, hover[2] - drv.site[2])]), quat, max_steps=120)
+        for goal in (pre, hover):  # the hover pose is freer when the pre-contact one is cramped
+            if move_arm_planned(drv, goal, quat, seed=drv.plan_seed, ik_attempts=3).ok:
+                planned = True
+                break
+    if not planned and drv.planned_motion and not drv.cup_down():
+        from anomalygen.learn.arm_motion import rehome
+
+        rehome(drv, seed=drv.plan_seed)
+    if not planned:  # rise, turn the cup face-down while clear of everything, then come over and down
+        up = drv.site + np.array([0, 0, max(0.0, hover[2] - drv.site[2])])
+        drv.goto(up, max_steps=120)
+        drv.goto(up, quat, max_steps=60)
         drv.goto(hover, quat, max_steps=200)
-        ok = drv.goto(pre, quat, max_steps=200)
+    ok = drv.goto(pre, quat, max_steps=200)
     return PrimitiveResult(ok, drv.steps - s0, f"pre-contact {'reached' if ok else 'not reached'} above {obj}")
 
 
