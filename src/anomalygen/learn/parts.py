@@ -24,8 +24,8 @@ import numpy as np
 HINGE, SLIDE = 3, 2  # mujoco.mjtJoint values
 INNER_FACE_STOP = 0.4  # rad: a grasp on the inner face lets go this far from closed
 LEAD_HINGE = 0.06
-MAX_DRAG = 0.04  # m the container may be dragged by its part before the drive gives up
-MAX_TILT = 0.2  # rad it may tip
+MAX_DRAG = 0.10  # m the container may be dragged by its part before the drive gives up
+MAX_TILT = 0.35  # rad it may tip
 COMFORT_Z = 0.95  # m: height at which the arm holds a tall door
 
 
@@ -238,7 +238,9 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
             notes.append(f"attempt {attempt + 1}: cup did not reach the {'outer' if g.outer else 'inner'} face")
             drv.goto(drv.site + n * 0.08, max_steps=40)
             continue
-        _drive(drv, joint, stop, tol=tol)
+        why = _drive(drv, joint, stop, tol=tol)
+        if why:
+            notes.append(f"attempt {attempt + 1}: {why}")
         robot.suction_off(m, d, name)
         p, n = _world(drv, g)
         dp, drv.dp = drv.dp, 0.004  # back off gently: a fast pull drags a light part along
@@ -259,7 +261,7 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
     return PrimitiveResult(ok, drv.steps - s0, detail)
 
 
-def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400) -> None:
+def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400) -> str:
     """Lead the held part towards ``goal``: the cup target rides the part's path just ahead of it."""
     import mujoco
 
@@ -278,6 +280,7 @@ def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400) ->
     root = _object_root(m, int(m.jnt_bodyid[j]))
     root0 = d.xpos[root].copy()  # a lid at its stop drags or tips a light box: stop before it goes far
     best, stall = abs(q0 - goal), 0
+    why = ""
     for _ in range(max_steps):
         q = float(d.qpos[adr])
         if abs(q - goal) <= tol * 0.5:
@@ -297,6 +300,7 @@ def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400) ->
         mujoco.mju_mulQuat(quat, rot, cupq0)
         drv.goto(target, quat, max_steps=1, tol=0.0)
         if np.linalg.norm(d.xpos[root] - root0) > MAX_DRAG or d.xmat[root][8] < np.cos(MAX_TILT):
+            why = f"stopped: {m.body(root).name} was being dragged or tipped"
             break
         gap = abs(float(d.qpos[adr]) - goal)
         if gap < best - 1e-3:
@@ -304,9 +308,11 @@ def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400) ->
         else:
             stall += 1
             if stall > 40:
+                why = "stopped: the part no longer followed"
                 break
     for _ in range(10):  # hold still a moment so the part settles where it was led
         drv.step()
+    return why
 
 
 # --------------------------------------------------------------------------- containers
@@ -390,6 +396,19 @@ def open_for_access(drv, obj: str, labels):
         ok &= r.success
         details.append(r.detail)
     return PrimitiveResult(ok, drv.steps - s0, "opened: " + "; ".join(details) if details else f"{obj} already open")
+
+
+def _falls_shut(drv, joint: str, closed: float) -> bool:
+    """Would gravity swing this hinged part back towards closed? (its centre of mass is on the
+    closed side of the vertical plane through the hinge axis)"""
+    m, d = drv.model, drv.data
+    j = m.joint(joint).id
+    body = int(m.jnt_bodyid[j])
+    axis = d.xaxis[j]
+    q = float(d.qpos[m.jnt_qposadr[j]])
+    torque = float(np.dot(np.cross(d.xipos[body] - d.xanchor[j], np.array([0.0, 0.0, -1.0])), axis))
+    # gravity torque along the axis pushes q towards closed when its sign opposes the opening direction
+    return bool(torque * np.sign(q - closed) < 0)
 
 
 def close_opened(drv, obj: str):

@@ -190,15 +190,17 @@ class Driver:
         return lo[use].min(axis=0), hi[use].max(axis=0)
 
     def _robot_in_collision(self) -> bool:
+        """Robot or the object it holds penetrating the world (the floor under the base excepted)."""
+        from anomalygen.scene import robot
+
         d = self.data
+        held = self.held
+        carried = robot._subtree_geoms(self.model, self.body_id(held)) if held is not None else None
         for i in range(d.ncon):
             g1, g2 = int(d.contact.geom1[i]), int(d.contact.geom2[i])
-            r1, r2 = g1 in self._robot_geoms, g2 in self._robot_geoms
+            r1 = g1 in self._robot_geoms or (carried is not None and carried[g1])
+            r2 = g2 in self._robot_geoms or (carried is not None and carried[g2])
             if r1 != r2 and self._floor not in (g1, g2) and d.contact.dist[i] < -0.002:
-                other = g2 if r1 else g1
-                held = self.held
-                if held is not None and self._in_body(other, held):
-                    continue
                 return True
         return False
 
@@ -433,15 +435,17 @@ def _drop_point(drv: Driver, region: str, obj: str) -> np.ndarray:
             centre[k] = (max(dlo[k], chi[k]) + dhi[k]) / 2
         elif dlo[k] < clo[k]:
             centre[k] = (dlo[k] + min(dhi[k], clo[k])) / 2
-        return np.array([centre[0], centre[1], dhi[2] + 0.03])
+        top = np.array([centre[0], centre[1], dhi[2] + 0.03])
+        floor = _floor_below(drv, top, obj)
+        return top if floor is None else np.array([centre[0], centre[1], floor - 0.01])
     lo, hi = opening(drv, region)
     centre = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 0.04])
-    # Reach down into the container before letting go: a needle or a flat wrapper dropped from the
-    # rim passes through a thin bottom in one physics step. The floor inside is found by a ray.
+    # Set the object down inside rather than drop it from the rim: the contacts are soft (20 ms), so
+    # a needle or a flat wrapper falling even 2 cm sinks past the middle of an 8 mm bottom and is
+    # pushed out underneath. The floor inside is found by a ray; the lowering stops at first touch.
     floor = _floor_below(drv, centre, obj)
     if floor is not None:
-        centre[2] = max(floor + 0.02, hi[2] - MAX_REACH_IN, lo[2] + 0.02)
-        centre[2] = min(centre[2], hi[2] + 0.04)
+        centre[2] = min(max(floor - 0.01, hi[2] - MAX_REACH_IN), hi[2] + 0.04)
     return centre
 
 
@@ -502,7 +506,7 @@ def free_spot(drv: Driver, support: str, obj: str, *, edge_margin: float = 0.2) 
             score = hits * 10.0 + float(np.linalg.norm(p - centre))
             if score < best_score:
                 best, best_score = p, score
-    return np.array([best[0], best[1], hi[2] + 0.008])  # set down, not dropped: a globe would topple
+    return np.array([best[0], best[1], hi[2] - 0.01])  # set down until it touches: a dropped globe topples
 
 
 def opening(drv: Driver, region: str) -> tuple[np.ndarray, np.ndarray]:
@@ -583,11 +587,46 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     for f in np.linspace(0.2, 1.0, 5):
         drv.goto(np.array([*goal[:2], carry_z]), _yawed(cur, f * turn), max_steps=8)
     quat = _yawed(cur, turn)
-    ok = drv.goto(goal + np.array([0, 0, below]), quat, max_steps=200, tol=0.02)
+    ok = lower_until_contact(drv, obj, goal + np.array([0, 0, below]), quat)
     if release_after:
         release(drv)
         drv.goto(drv.site + np.array([0, 0, 0.1]), quat, max_steps=60)
     return PrimitiveResult(ok, drv.steps - s0, f"{obj} {'lowered' if ok else 'not fully lowered'} over {region}")
+
+
+def lower_until_contact(drv: Driver, obj: str, target, quat, *, max_steps: int = 200, tol: float = 0.02) -> bool:
+    """Lower the held object towards ``target`` (cup face) and stop the moment it touches anything.
+
+    A guarded move: the weld is stiff, so pressing on would push a needle through a thin bottom. It
+    also stops where the arm can reach no lower with the cup upright (deep in a box on the floor the
+    wrist tilts and the swinging object knocks the lid shut). True when the target was reached or
+    the object came to rest on something."""
+    target = np.asarray(target, dtype=float)
+    for _ in range(max_steps):
+        if held_touches(drv, obj):
+            return True
+        if not drv.cup_down(0.9):  # reached as low as the arm can with the cup upright: let go here
+            return True
+        drv.goto(target, quat, max_steps=1, tol=0.0)
+        if np.linalg.norm(drv.site - target) < tol:
+            return True
+    return False
+
+
+def held_touches(drv: Driver, obj: str) -> bool:
+    """Does the held object touch something other than the robot?"""
+    from anomalygen.scene import robot
+
+    d = drv.data
+    mask = robot._subtree_geoms(drv.model, drv.body_id(obj))
+    for i in range(d.ncon):
+        g1, g2 = int(d.contact.geom1[i]), int(d.contact.geom2[i])
+        if mask[g1] == mask[g2]:
+            continue
+        other = g2 if mask[g1] else g1
+        if other not in drv._robot_geoms and d.contact.dist[i] < 0.0:
+            return True
+    return False
 
 
 def surface_centre_of(drv: Driver, obj: str) -> str | None:

@@ -52,6 +52,9 @@ MAX_AUX = 3
 CLUTTER_MAX_SIZE = 0.3
 
 
+LOOSE_SOLREF = 0.005  # s: contact time constant of loose objects (2.5 physics steps)
+
+
 @lru_cache(maxsize=1)
 def _kb():
     from anomalygen.knowledge import load_kb
@@ -178,6 +181,12 @@ def _cavity_world(holder: Placed):
     return wc - wh, wc + wh, cav
 
 
+def _container_room(asset) -> float:
+    """Longest thing that lies flat in the container's biggest cavity (along its long side)."""
+    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+    return 0.95 * 2 * float(max(cav.half_extents[0], cav.half_extents[1]))
+
+
 def _cavity_cap(asset) -> float:
     cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
     return 0.8 * 2 * float(min(cav.half_extents))
@@ -244,6 +253,20 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
     )
     if container_name:
         container = choose(container_name, ObjectRole.CONTAINER)
+        if container is not hazard and container.asset.cavities:
+            # The hazard must be able to go in: a 0.5 m plastic bag does not fit a 0.3 m bucket.
+            # Draw the container again (other sizes), then a smaller hazard, before giving up.
+            for _ in range(4):
+                if hazard.size <= _container_room(container.asset):
+                    break
+                by_catalogue.pop(container.catalogue, None)
+                used.discard(container.name)
+                container = choose(container_name, ObjectRole.CONTAINER)
+            room = _container_room(container.asset)
+            if hazard.size > room and hazard is not target:
+                by_catalogue.pop(hazard.catalogue, None)
+                used.discard(hazard.name)
+                hazard = choose(sc.hazard_object, ObjectRole.HAZARD, cap=min(cap or room, room))
     support_var = None
     if "$support" in variables:
         sname = _first_known(hc.default_supports)
@@ -549,11 +572,16 @@ def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
         parts.extend(_articulated_bodies(root))
         if not p.fixed:
             # Rolling and torsional friction (condim 6): a needle or pencil must not roll for ever.
-            # A 1 mm contact margin stops needles and coins tunnelling into a table top.
+            # A 1 mm contact margin stops needles and coins tunnelling into a table top. Their
+            # contacts are stiffer than the 20 ms default (priority makes theirs win): with it a
+            # needle set down in a box sank past the middle of the 8 mm bottom and was pushed out
+            # underneath.
             for geom in _geoms_below(root):
                 geom.condim = 6
                 geom.friction = [max(geom.friction[0], 0.8), 0.01, 0.002]
                 geom.margin = max(geom.margin, 0.001)
+                geom.priority = 1
+                geom.solref = [LOOSE_SOLREF, 1.0]
     # Suction can also hold a door, lid or drawer, so primitives can pull parts open or lift them shut.
     robot.add_suction_welds(spec, [n for n, _ in loose] + parts, [r for _, r in loose] + parts)
     task_objects = [p for p in placed.values() if p.role != ObjectRole.CLUTTER]

@@ -790,7 +790,10 @@ def _handle_tool(rng, name):
         r.box((0.0008, 0.0035, 0.0035), (-L / 2, 0, 0.0035), METAL[1], D_METAL)
         return _d(r, ["steel", "sharp point"], length=L)
     L = u(rng, 0.03, 0.05)  # needle
-    r.capsule(0.0005, L / 2, (0, 0, 0.0005), METAL[0], D_METAL, axis="x")
+    # Seen 1 mm thick, but it collides as a 3 mm capsule: a 0.5 mm radius slipped through an 8 mm
+    # box bottom in simulation.
+    r.capsule(0.0005, L / 2, (0, 0, 0.0015), METAL[0], D_METAL, axis="x", collide=False)
+    r.capsule(0.0015, L / 2, (0, 0, 0.0015), (0.75, 0.75, 0.78, 0.0), D_METAL, axis="x")
     return _d(r, ["thin steel", "very sharp point"], length=L)
 
 
@@ -862,7 +865,8 @@ def storage_box(rng):
     open_box(r, hx, hy, hz, t, c, 900)
     lid = r.child("lid", (0, hy, 2 * hz + 0.002))
     lid.hinge("lid_hinge", (1, 0, 0), (-1.9, 0), "lid", 0.0)
-    lid.box((hx + 0.004, hy + 0.002, 0.006), (0, -hy, 0.006), c, 900)
+    # a 6 mm plastic lid: the 12 mm one weighed 1.5 kg and its holding friction tipped the box
+    lid.box((hx + 0.004, hy + 0.002, 0.003), (0, -hy, 0.003), c, 900)
     return Draft(
         r,
         {"size_x": hx},
