@@ -216,12 +216,14 @@ class Driver:
         return robot.held_object(self.model, self.data)
 
     # ---------------------------------------------------------------- base
-    def place_base_near(self, point, *, reach=BASE_REACH, side=None, tuck: bool = True) -> bool:
+    def place_base_near(self, point, *, reach=BASE_REACH, side=None, tuck: bool = True, reach_poses=()) -> bool:
         """Put the base at a collision-free pose facing ``point`` at arm's reach (kinematic move).
 
         Candidates: rings of 24 headings at each distance in ``reach``, tried nearest-to-current first;
         with ``side`` (a horizontal direction from the point), only poses on that side (within 70 deg).
-        A held object is carried rigidly with the base. Returns False (base unchanged) if none is free.
+        With ``reach_poses`` ((pos, quat) pairs) a pose must also let the arm reach each of them by IK
+        (else the first free pose is taken). A held object is carried rigidly with the base. Returns
+        False (base unchanged) if none is free.
         """
         import mujoco
 
@@ -247,7 +249,7 @@ class Driver:
                 yaw = float(np.arctan2(p[1] - b[1], p[0] - b[0]))
                 self._move_base_rigid(cur, np.array([b[0], b[1], yaw]), saved, hq)
                 mujoco.mj_forward(m, d)
-                if not self._robot_in_collision():
+                if not self._robot_in_collision() and self._reaches(reach_poses):
                     for j, v in zip(robot.BASE_JOINTS, (b[0], b[1], yaw), strict=True):
                         d.actuator(j).ctrl[0] = v
                     d.qvel[:] = 0.0
@@ -256,8 +258,25 @@ class Driver:
         d.qpos[:], d.qvel[:], d.mocap_pos[:], d.mocap_quat[:] = saved
         mujoco.mj_forward(m, d)
         if tuck and self.tuck():  # an outstretched arm collides everywhere: fold it in and try again
+            return self.place_base_near(point, reach=reach, side=side, tuck=False, reach_poses=reach_poses)
+        if reach_poses:  # nowhere reaches every pose with the cup upright: settle for a free pose
             return self.place_base_near(point, reach=reach, side=side, tuck=False)
         return False
+
+    def _reaches(self, poses) -> bool:
+        """Can the arm (base where it is now) put the cup face at each (pos, quat)? IK on a copy."""
+        if not poses:
+            return True
+        from anomalygen.learn.ik import solve_ik
+        from anomalygen.scene import robot
+
+        home = np.asarray(robot.HOME_ARM, dtype=float)
+        for pos, quat in poses:
+            r = solve_ik(self.model, self.data, "suction_site", robot.ARM_JOINTS, pos, quat, q_init=home,
+                         iterations=150)
+            if not r.success:
+                return False
+        return True
 
     def tuck(self) -> bool:
         """Bring the cup (and anything held) in close above the base, cup down, before a base move."""
@@ -576,25 +595,32 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     quat = quat_z_to(np.array([0.0, 0.0, -1.0]))
     carry_z = max(drv.site[2], goal[2] + below + 0.1)
     drv.goto(np.array([*drv.site[:2], carry_z]), quat, max_steps=150)
-    if not drv.place_base_near(goal):
-        return PrimitiveResult(False, drv.steps - s0, f"no collision-free base pose near {region}")
-    drv.goto(np.array([*goal[:2], carry_z]), quat, max_steps=250)
     # turn the object so its long side runs along the long side of the opening
     lo, hi = opening(drv, region)
     want = 0.0 if hi[0] - lo[0] >= hi[1] - lo[1] else np.pi / 2
     turn = (want - _long_axis_yaw(drv, obj) + np.pi / 2) % np.pi - np.pi / 2 if into else 0.0
-    cur = drv.data.mocap_quat[drv._mocap].copy()
-    for f in np.linspace(0.2, 1.0, 5):
-        drv.goto(np.array([*goal[:2], carry_z]), _yawed(cur, f * turn), max_steps=8)
-    quat = _yawed(cur, turn)
-    ok = lower_until_contact(drv, obj, goal + np.array([0, 0, below]), quat)
+    final = _yawed(quat, turn)
+    above, low = np.array([*goal[:2], carry_z]), goal + np.array([0, 0, below])
+    if not drv.place_base_near(goal, reach_poses=[(above, final), (low, final)]):
+        return PrimitiveResult(False, drv.steps - s0, f"no collision-free base pose near {region}")
+    planned = False
+    if drv.planned_motion:
+        from anomalygen.learn.arm_motion import move_arm_planned
+
+        planned = move_arm_planned(drv, above, final, seed=drv.plan_seed, ik_attempts=3).ok
+    if not planned:
+        drv.goto(above, quat, max_steps=250)
+        for f in np.linspace(0.2, 1.0, 5):
+            drv.goto(above, _yawed(quat, f * turn), max_steps=8)
+    quat = final
+    ok = lower_until_contact(drv, obj, low, quat)
     if release_after:
         release(drv)
         drv.goto(drv.site + np.array([0, 0, 0.1]), quat, max_steps=60)
     return PrimitiveResult(ok, drv.steps - s0, f"{obj} {'lowered' if ok else 'not fully lowered'} over {region}")
 
 
-def lower_until_contact(drv: Driver, obj: str, target, quat, *, max_steps: int = 200, tol: float = 0.02) -> bool:
+def lower_until_contact(drv: Driver, obj: str, target, quat, *, max_steps: int = 300, tol: float = 0.02) -> bool:
     """Lower the held object towards ``target`` (cup face) and stop the moment it touches anything.
 
     A guarded move: the weld is stiff, so pressing on would push a needle through a thin bottom. It
@@ -602,15 +628,25 @@ def lower_until_contact(drv: Driver, obj: str, target, quat, *, max_steps: int =
     wrist tilts and the swinging object knocks the lid shut). True when the target was reached or
     the object came to rest on something."""
     target = np.asarray(target, dtype=float)
-    for _ in range(max_steps):
-        if held_touches(drv, obj):
-            return True
-        if not drv.cup_down(0.9):  # reached as low as the arm can with the cup upright: let go here
-            return True
-        drv.goto(target, quat, max_steps=1, tol=0.0)
-        if np.linalg.norm(drv.site - target) < tol:
-            return True
-    return False
+    upright = drv.cup_down(0.9)
+    dp = drv.dp
+    try:
+        for _ in range(max_steps):
+            if held_touches(drv, obj):
+                return True
+            if upright and not drv.cup_down(0.9):  # as low as the arm goes with the cup upright: let go
+                return True
+            # the last 8 cm slowly (3 mm a step): at full speed a 4 mm bottom is crossed between checks
+            drv.dp = SLOW_DP if drv.site[2] - target[2] < 0.08 else dp
+            drv.goto(target, quat, max_steps=1, tol=0.0)
+            if np.linalg.norm(drv.site - target) < tol:
+                return True
+        return False
+    finally:
+        drv.dp = dp
+
+
+SLOW_DP = 0.003  # m per control step for the final part of a set-down
 
 
 def held_touches(drv: Driver, obj: str) -> bool:
@@ -624,7 +660,7 @@ def held_touches(drv: Driver, obj: str) -> bool:
         if mask[g1] == mask[g2]:
             continue
         other = g2 if mask[g1] else g1
-        if other not in drv._robot_geoms and d.contact.dist[i] < 0.0:
+        if other not in drv._robot_geoms and d.contact.dist[i] < 0.0005:
             return True
     return False
 
