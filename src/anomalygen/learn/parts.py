@@ -366,6 +366,38 @@ def best_drawer(drv, obj: str, drawers: list):
     return max(ok or drawers, key=top) if (ok or drawers) else None
 
 
+def compartment_behind(drv, obj: str, js) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(lo, hi, outward normal) of the space behind a shut door: the door's face extent, as deep as
+    the carcass reaches behind it."""
+    m = drv.model
+    body = m.body(int(m.joint(js.name).bodyid[0])).name
+    dlo, dhi = drv.aabb(body)
+    clo, chi = static_box(drv, obj)
+    g = grasp_candidates(drv, js.name, js.closed_value)[0]
+    n = _world(drv, g)[1]
+    k = int(np.argmax(np.abs(n[:2])))
+    lo, hi = dlo.copy(), dhi.copy()
+    if n[k] < 0:  # the door faces -k: the compartment runs towards +k
+        lo[k], hi[k] = dhi[k], chi[k]
+    else:
+        lo[k], hi[k] = clo[k], dlo[k]
+    out = np.zeros(3)
+    out[k] = np.sign(n[k])
+    return lo, hi, out
+
+
+def best_door(drv, obj: str, doors: list):
+    """The door whose compartment is tall enough for the hand (0.18 m) and the highest within reach."""
+    ok = []
+    for js in doors:
+        if abs(float(drv.data.joint(js.name).qpos[0]) - js.closed_value) > 0.1:
+            continue  # only shut doors have a known compartment behind them
+        lo, hi, _ = compartment_behind(drv, obj, js)
+        if hi[2] - lo[2] >= 0.18 and 0.15 < lo[2] < 1.0:
+            ok.append((float(lo[2]), js))
+    return max(ok, key=lambda t: t[0])[1] if ok else None
+
+
 def open_for_access(drv, obj: str, labels):
     """Open the container so an object can go in: every lid and flap, or the best drawer.
 
@@ -381,9 +413,12 @@ def open_for_access(drv, obj: str, labels):
         drawer = best_drawer(drv, obj, closure_joints(drv, obj, ["drawer"]))
         chosen = [drawer] if drawer is not None else []
     if not chosen:
-        doors = closure_joints(drv, obj, ["door"])
-        return PrimitiveResult(False, 0, f"{obj} has {len(doors)} door(s) and no lid, flap or drawer: putting "
-                                         "things in through a door needs a side approach, which is not built")
+        door = best_door(drv, obj, closure_joints(drv, obj, ["door"]))
+        if door is None:
+            return PrimitiveResult(False, 0, f"{obj} has no lid, flap, drawer or door with a reachable "
+                                             "compartment behind it")
+        drv.compartments[obj] = compartment_behind(drv, obj, door)
+        chosen = [door]
     drv.opened[obj] = [js.name for js in chosen]
     ok, details = True, []
     for js in chosen:

@@ -114,6 +114,7 @@ class Driver:
         self.frameskip, self.dp, self.on_step = int(frameskip), float(dp), on_step
         self.steps = 0
         self.opened: dict[str, list[str]] = {}  # container -> joints opened to put something in
+        self.compartments: dict[str, tuple] = {}  # container -> (lo, hi, outward normal) behind its opened door
         self.planned_motion = planned_motion  # reach pre-contact poses by IK + OMPL paths
         self.plan_seed = int(rng.integers(2**31)) if rng is not None else 0
         # The seed only turns the ring of candidate base poses, so seeds try different approach sides.
@@ -589,6 +590,8 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     s0 = drv.steps
     if drv.held != obj:
         return PrimitiveResult(False, 0, f"{obj} is not held")
+    if into and region in drv.compartments:
+        return place_through_door(drv, obj, region, release_after=release_after)
     goal = _drop_point(drv, region, obj) if into else free_spot(drv, region, obj)
     olo, ohi = drv.aabb(obj)
     below = drv.site[2] - olo[2]  # cup face to object bottom
@@ -618,6 +621,43 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
         release(drv)
         drv.goto(drv.site + np.array([0, 0, 0.1]), quat, max_steps=60)
     return PrimitiveResult(ok, drv.steps - s0, f"{obj} {'lowered' if ok else 'not fully lowered'} over {region}")
+
+
+def place_through_door(drv: Driver, obj: str, region: str, *, release_after: bool = True) -> PrimitiveResult:
+    """Slide the held object into the compartment behind an opened door and set it on its floor.
+
+    The cup stays face-down, so the object is carried level at a height just clearing the
+    compartment's floor, turned to lie across the opening, pushed in horizontally, lowered until it
+    touches, released; the cup then backs out the way it came."""
+    from anomalygen.learn.ik import quat_z_to
+
+    s0 = drv.steps
+    lo, hi, out = drv.compartments[region]
+    centre = (lo + hi) / 2
+    floor = _floor_below(drv, np.array([centre[0], centre[1], hi[2] - 0.01]), obj)
+    floor = float(lo[2]) if floor is None else floor
+    olo, ohi = drv.aabb(obj)
+    below = drv.site[2] - olo[2]
+    quat = quat_z_to(np.array([0.0, 0.0, -1.0]))
+    across = 0.0 if abs(out[0]) > abs(out[1]) else np.pi / 2  # long side along the opening's width
+    turn = (across + np.pi / 2 - _long_axis_yaw(drv, obj) + np.pi / 2) % np.pi - np.pi / 2
+    final = _yawed(quat, turn)
+    depth = float(np.dot(hi - lo, np.abs(out)))
+    z = floor + below + 0.015
+    inside = np.array([centre[0], centre[1], z])
+    front = inside + out * (depth / 2 + 0.2)
+    drv.goto(np.array([*drv.site[:2], max(drv.site[2], z + 0.1)]), quat, max_steps=150)
+    if not drv.place_base_near(front, side=out, reach_poses=[(front, final), (inside, final)]):
+        return PrimitiveResult(False, drv.steps - s0, f"no base pose in front of {region}'s open door")
+    drv.goto(np.array([*front[:2], max(drv.site[2], z)]), final, max_steps=250)
+    drv.goto(front, final, max_steps=150)
+    ok = drv.goto(inside, final, max_steps=200, tol=0.02)
+    lower_until_contact(drv, obj, inside - np.array([0, 0, 0.05]), final)
+    if release_after:
+        release(drv)
+        drv.goto(drv.site + np.array([0, 0, 0.01]), final, max_steps=20)
+        drv.goto(np.array([*front[:2], drv.site[2]]), final, max_steps=150)
+    return PrimitiveResult(ok, drv.steps - s0, f"{obj} {'slid into' if ok else 'not fully into'} {region} through its door")
 
 
 def lower_until_contact(drv: Driver, obj: str, target, quat, *, max_steps: int = 300, tol: float = 0.02) -> bool:
