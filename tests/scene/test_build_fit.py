@@ -1,0 +1,127 @@
+"""The builder binds only a container the hazard can lie in, or fails the item saying it does not fit.
+
+``build._plan`` is the selection-and-placement half of one build attempt (no MuJoCo compile), so each
+attempt's choice is checked directly; ``item_rng(seed, task.id, attempt)`` is the generator
+``build._attempt`` hands it, so attempts 0..repair_attempts are exactly the ones a build makes.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from anomalygen.config import Settings
+from anomalygen.errors import ItemFailed
+from anomalygen.rng import item_rng
+from anomalygen.scene import build, select
+from anomalygen.schema import TaskProposal
+
+ATTEMPTS = 4  # a build makes repair_attempts + 1 = 4 by default
+
+
+def _litter(hazard: str, container: str, target: str) -> TaskProposal:
+    return TaskProposal(
+        id=f"t-fit-{hazard}-{container}-{target}", name="litter", explanation="test",
+        description=f"A {hazard} lies in the walkway.", category="household_hazard",
+        hazard_class="pick_up_floor_litter", target_asset=target,
+        scenario=dict(hazard_object=hazard, room="office", placement="walkway", container=container, co_objects=[]),
+        provenance=dict(engine="knowledge", mode="brainstorm"))
+
+
+SETTINGS = Settings(build={"clutter": 0, "repair_attempts": ATTEMPTS - 1})
+
+
+def _outcomes(task: TaskProposal, attempts: int = ATTEMPTS):
+    """Per attempt: ('fit', hazard size, room of the placed container) or ('failed', message)."""
+    out = []
+    for attempt in range(attempts):
+        try:
+            _, bindings, placed = build._plan(task, SETTINGS, item_rng(0, task.id, attempt))
+        except ItemFailed as exc:
+            out.append(("failed", str(exc)))
+            continue
+        hazard, container = placed[bindings["$hazard"]], placed[bindings["$container"]]
+        out.append(("fit", float(hazard.asset.size), build._container_room(container.asset)))
+    return out
+
+
+def _assert_fits_or_says_so(outcomes):
+    for k, o in enumerate(outcomes):
+        if o[0] == "fit":
+            assert o[1] <= o[2] + 1e-9, f"attempt {k}: a {o[1]:.3f} m hazard bound to a container with {o[2]:.3f} m room"
+        else:
+            assert "does not fit" in o[1], f"attempt {k}: {o[1]}"
+
+
+def test_container_room_is_the_long_side_of_the_biggest_cavity():
+    from anomalygen.assets.core import generate
+
+    for name in ("Bucket", "storage_box", "StorageFurniture"):
+        asset = generate(name, 0)
+        cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+        room = build._container_room(asset)
+        assert room == pytest.approx(0.95 * 2 * max(cav.half_extents[0], cav.half_extents[1]))
+        # it lies inside the object's own footprint
+        ext = np.asarray(asset.aabb[1]) - np.asarray(asset.aabb[0])
+        assert 0.05 < room < max(ext[0], ext[1])
+    # a bigger bucket has more room; the generator scales the cavity with the asset
+    small, big = generate("Bucket", 3, size=0.25), generate("Bucket", 3, size=0.4)
+    assert build._container_room(small) < build._container_room(big)
+    assert build._container_room(big) / build._container_room(small) == pytest.approx(0.4 / 0.25, rel=0.15)
+
+
+def test_bag_and_bucket_fail_with_does_not_fit_after_redrawing_the_bucket(monkeypatch, tmp_path):
+    """No bucket (at most ~0.24 m of room) takes a plastic bag (at least 0.30 m): every attempt redraws
+    the bucket, then the bag smaller, and the item fails saying so instead of binding a bucket."""
+    task = _litter("plastic_bag", "Bucket", "Bucket")
+    drawn: list = []
+    real = select.pick_asset
+
+    def counting(catalogue, **kw):
+        asset = real(catalogue, **kw)
+        drawn.append((catalogue, asset))
+        return asset
+
+    monkeypatch.setattr(select, "pick_asset", counting)
+    outcomes = _outcomes(task)
+    _assert_fits_or_says_so(outcomes)
+    assert all(o[0] == "failed" for o in outcomes)
+    # one attempt: the bucket drawn as target, redrawn 4 times, then the bag with the last bucket's room as cap
+    drawn.clear()
+    with pytest.raises(ItemFailed) as exc:
+        build._plan(task, SETTINGS, item_rng(0, task.id, 0))
+    buckets = [a for c, a in drawn if c == "Bucket"]
+    assert len(buckets) == 5
+    cap = float(re.search(r"does not fit a ([0-9.]+) m space", str(exc.value)).group(1))
+    assert cap == pytest.approx(build._container_room(buckets[-1]), abs=0.006)
+    # the whole build fails with the same reason (selection fails before anything is compiled)
+    once = Settings(build={"clutter": 0, "repair_attempts": 0})
+    with pytest.raises(ItemFailed, match="does not fit"):
+        build.build_scene(task, seed=0, settings=once, out_dir=tmp_path / "scene")
+    assert not (tmp_path / "scene" / "scene.json").exists()
+
+
+def test_container_redrawn_until_the_hazard_fits():
+    """Target elsewhere (a table): buckets are redrawn or the wrapper drawn smaller until it fits."""
+    outcomes = _outcomes(_litter("wrapper", "Bucket", "Table"))
+    _assert_fits_or_says_so(outcomes)
+    assert any(o[0] == "fit" for o in outcomes)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "build._plan: when the container is also the task's target, the redraw replaces the container in "
+    "by_catalogue but the placement loop places the stale `target` Chosen under the same instance name, "
+    "so the too-small first draw is what the scene gets (attempt 2: wrapper 0.199 m in a bucket with "
+    "0.174 m room)"))
+def test_container_that_is_also_the_target_fits_the_hazard():
+    _assert_fits_or_says_so(_outcomes(_litter("wrapper", "Bucket", "Bucket")))
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "build._plan: when the hazard is the task's target it is never redrawn smaller (`hazard is not "
+    "target`), and after 4 container redraws the plan goes on with a container it does not fit "
+    "instead of failing with 'does not fit' (attempt 0: plastic bag 0.450 m, trash can 0.217 m room)"))
+def test_hazard_that_is_the_target_fits_or_fails():
+    _assert_fits_or_says_so(_outcomes(_litter("plastic_bag", "TrashCan", "plastic_bag")))
