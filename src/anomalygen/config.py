@@ -79,7 +79,11 @@ class LearnConfig(Section):
     engine: Engine | None = None
     plan_source: Literal["ground_truth", "detected"] = "ground_truth"
     seeds: int = Field(1, ge=1)
-    sac_steps: int = Field(2000, ge=0)
+    sac_steps: int = Field(2000, ge=0, description="SAC environment steps per SAC sub-task (paper: 1M)")
+    sac_actions: list[str] = Field(
+        default_factory=list,
+        description="recipe actions the knowledge planner hands to SAC instead of a primitive, e.g. close_joint",
+    )
     cem_iterations: int = Field(5, ge=1)
     video: bool = True
     reward_mode: Literal["spec", "code"] = "spec"

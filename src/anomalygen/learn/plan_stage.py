@@ -41,7 +41,8 @@ def plan_item(task_id: str, payload: dict, ctx: StageContext) -> str:
     if settings.engine_for("learn").value == "llm":
         plan = _plan_with_llm(task_id, payload, ctx, hazard_class, bindings, spec, hypothesis)
     else:
-        plan = plan_from_kb(task_id, hazard_class, bindings, spec=spec, source=source)
+        plan = plan_from_kb(task_id, hazard_class, bindings, spec=spec, source=source,
+                            sac_actions=settings.learn.sac_actions)
     write_model(run.plan_path(task_id), plan)
     return str(run.plan_path(task_id))
 

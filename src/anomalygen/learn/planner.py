@@ -123,7 +123,7 @@ def access_steps(container: str, labels: list[str]) -> tuple[SubTask, SubTask]:
 
 
 def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, spec: SceneSpec | None = None,
-                 source: str = "ground_truth") -> Plan:
+                 source: str = "ground_truth", sac_actions: tuple[str, ...] | list[str] = ()) -> Plan:
     """A plan from the knowledge-base recipe of ``hazard_class``."""
     from anomalygen.knowledge.base import load_kb
 
@@ -133,6 +133,9 @@ def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, s
         raise ItemFailed(f"hazard class {hazard_class!r} is not in the knowledge base; no recipe to plan from")
     subtasks = [step_to_subtask(i, step.action, dict(step.args), bindings, spec, list(cls.success))
                 for i, step in enumerate(cls.recipe)]
+    # Steps the user wants learned rather than scripted keep their reward spec and go to SAC.
+    subtasks = [st.model_copy(update={"method": SkillMethod.SAC}) if step.action in sac_actions else st
+                for st, step in zip(subtasks, cls.recipe, strict=True)]
     for step in cls.recipe:
         if step.action == "place_inside":
             container = _resolve(step.args.get("container", "$container"), bindings)
