@@ -140,8 +140,25 @@ def _evaluate(calls, model, data, spec, bindings) -> list[PredicateResult]:
 
 
 def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: str | Path | None = None,
-                 max_wall_s: float = 600.0, sac_steps: int = 0) -> SkillResult:
-    """Load the scene, run the plan's sub-tasks in order, check success, optionally record a video."""
+                 max_wall_s: float = 600.0, sac_steps: int = 0, isolate: bool = True) -> SkillResult:
+    """Load the scene, run the plan's sub-tasks in order, check success, optionally record a video.
+
+    With ``isolate`` (default) the execution runs in a fresh process: OMPL's random generator is
+    process-global and seeded once, so a path planned in a process that has planned before depends on
+    that history. In a fresh process the first seed is the item's, and the result is a function of
+    (scene, plan, seed) alone, whichever worker or test runs it. Costs about a second.
+    """
+    if isolate:
+        from concurrent.futures import ProcessPoolExecutor
+        from multiprocessing import get_context
+
+        with ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn")) as pool:
+            return pool.submit(_execute_here, str(scene_dir), plan, seed, None if video_path is None else
+                               str(video_path), max_wall_s, sac_steps).result()
+    return _execute_here(scene_dir, plan, seed, video_path, max_wall_s, sac_steps)
+
+
+def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float, sac_steps: int) -> SkillResult:
     from anomalygen.learn.primitives import Driver
     from anomalygen.rng import item_rng
     from anomalygen.scene.graph import load_scene

@@ -173,6 +173,32 @@ def _world(drv, g: PartGrasp) -> tuple[np.ndarray, np.ndarray]:
     return d.xpos[g.body] + rb @ g.point_local, rb @ g.normal_local
 
 
+def _on_surface(drv, g: PartGrasp) -> PartGrasp:
+    """Move the grasp point onto the part's real surface along the face normal (a ray): the box of a
+    door with a handle has its front face at the handle's tip, centimetres in front of the panel."""
+    import mujoco
+
+    from anomalygen.scene import robot
+
+    m, d = drv.model, drv.data
+    p, n = _world(drv, g)
+    part = robot._subtree_geoms(m, g.body)
+    start = p + n * 0.05
+    geomid = np.zeros(1, dtype=np.int32)
+    travelled = 0.0
+    for _ in range(6):
+        dist = mujoco.mj_ray(m, d, start, -n, None, 1, -1, geomid)
+        if dist < 0 or travelled + dist > 0.25:
+            return g
+        hit = start - n * dist
+        if part[int(geomid[0])]:
+            rb = d.xmat[g.body].reshape(3, 3)
+            return PartGrasp(g.body, rb.T @ (hit - d.xpos[g.body]), g.normal_local, g.outer, g.beyond_local)
+        travelled += dist + 1e-4
+        start = hit - n * 1e-4
+    return g
+
+
 def _accessible(n_w: np.ndarray) -> bool:
     """A face the cup can come at: not facing the floor."""
     return bool(n_w[2] > -0.5)
@@ -203,7 +229,7 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
         if not grasps:
             notes.append("no reachable face")
             break
-        g = grasps[0]
+        g = _on_surface(drv, grasps[0])
         stop = goal
         if not g.outer and hinge and abs(goal - closed) < INNER_FACE_STOP:
             stop = closed + np.sign(q() - closed) * INNER_FACE_STOP
@@ -212,19 +238,29 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
         r, t = part_transform(drv, joint, (stop - q()) / 2)
         mid = r @ p + t
         side = n if np.linalg.norm(n[:2]) > 0.3 else None
-        if not (drv.place_base_near(mid, side=side) or drv.place_base_near(p, side=side)
+        reach = [(p + n * PRE_CONTACT, quat_z_to(-n))]
+        if not (drv.place_base_near(mid, side=side, reach_poses=reach) or drv.place_base_near(p, side=side)
                 or drv.place_base_near(p)):
             notes.append("no base pose")
             break
         quat = quat_z_to(-n)
         hover = p + n * (PRE_CONTACT + 0.10)
-        if np.dot(drv.site - p, n) < 0.0 and g.beyond_local is not None:
+        reached = False
+        if drv.planned_motion:  # IK + a collision-free joint path to the pre-contact pose, as for grasps
+            from anomalygen.learn.arm_motion import move_arm_planned
+
+            for goal_pose in (p + n * PRE_CONTACT, hover):
+                if move_arm_planned(drv, goal_pose, quat, seed=drv.plan_seed, ik_attempts=3).ok:
+                    reached = True
+                    break
+        if not reached and np.dot(drv.site - p, n) < 0.0 and g.beyond_local is not None:
             # the cup is behind the face: round the part's free edge instead of sweeping through it
             rb = d.xmat[g.body].reshape(3, 3)
             edge = d.xpos[g.body] + rb @ g.beyond_local
             drv.goto(edge - n * 0.08, max_steps=120, tol=0.03)
             drv.goto(edge + n * (PRE_CONTACT + 0.10), quat, max_steps=120, tol=0.03)
-        drv.goto(hover, quat, max_steps=220, tol=0.02)
+        if not reached:
+            drv.goto(hover, quat, max_steps=220, tol=0.02)
         drv.goto(p + n * PRE_CONTACT, quat, max_steps=120)
         grabbed = False
         for k in range(24):
@@ -255,7 +291,10 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
     if drv.planned_motion and not drv.cup_down():
         from anomalygen.learn.arm_motion import rehome
 
-        rehome(drv, seed=drv.plan_seed)  # the wrist is turned sideways: start the next move clean
+        # the wrist is turned sideways: start the next move clean, from above the part so the arm
+        # does not sweep through what it just opened
+        drv.goto(drv.site + np.array([0.0, 0.0, 0.25]), max_steps=60, tol=0.03)
+        rehome(drv, seed=drv.plan_seed)
     ok = abs(q() - goal) <= tol
     detail = f"{joint} = {q():.3f} (goal {goal:.3f})" + (f"; {'; '.join(notes)}" if notes else "")
     return PrimitiveResult(ok, drv.steps - s0, detail)
@@ -312,6 +351,12 @@ def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400) ->
                 break
     for _ in range(10):  # hold still a moment so the part settles where it was led
         drv.step()
+    # Pulling pushes the soft base servo back a little; make where it stands the new set point, or the
+    # base would roll forward again afterwards and shove the drawer shut with the arm.
+    from anomalygen.scene import robot
+
+    for name in robot.BASE_JOINTS:
+        d.actuator(name).ctrl[0] = float(d.joint(name).qpos[0])
     return why
 
 

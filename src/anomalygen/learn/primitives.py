@@ -493,10 +493,8 @@ def _floor_below(drv: Driver, point: np.ndarray, obj: str) -> float | None:
     return None
 
 
-def free_spot(drv: Driver, support: str, obj: str, *, edge_margin: float = 0.2) -> np.ndarray:
-    """A drop point on the support's top that keeps ``edge_margin`` from its edges and misses the
-    other things standing there (a book in the middle of the table would leave the object perched
-    half on it), nearest the centre; the centre when the top is too small for the margin."""
+def top_rect(drv: Driver, support: str) -> tuple[np.ndarray, np.ndarray]:
+    """World box of a support's top board (not the legs' footprint), its height the top's."""
     from anomalygen.scene.graph import geom_world_aabbs
 
     m = drv.model
@@ -504,11 +502,22 @@ def free_spot(drv: Driver, support: str, obj: str, *, edge_margin: float = 0.2) 
     glo, ghi = geom_world_aabbs(m, drv.data)
     top_geoms = [g for g in range(m.ngeom) if m.body(int(m.geom_bodyid[g])).name.startswith(support + "/")
                  and ghi[g, 2] > hi[2] - 0.01]
-    if top_geoms:  # the top board itself, not the legs' footprint
+    if top_geoms:
         lo = np.min(glo[top_geoms], axis=0)
         hi = np.array([*np.max(ghi[top_geoms], axis=0)[:2], hi[2]])
-    olo, ohi = drv.aabb(obj)
-    half = float(np.max(ohi[:2] - olo[:2])) / 2
+    return lo, hi
+
+
+def free_spot(drv: Driver, support: str, obj: str, *, edge_margin: float = 0.2) -> np.ndarray:
+    """A drop point on the support's top that keeps ``edge_margin`` from its edges and misses the
+    other things standing there (a book in the middle of the table would leave the object perched
+    half on it), nearest the centre; the centre when the top is too small for the margin."""
+    from anomalygen.scene.graph import geom_world_aabbs
+
+    lo, hi = top_rect(drv, support)
+    # the object will be turned to lie along the top's long side (move_to does that)
+    _, a, b = footprint(drv, obj)
+    half = np.array([a, b]) if hi[0] - lo[0] >= hi[1] - lo[1] else np.array([b, a])
     others = []
     for o in drv.spec.objects:
         if o.name in (obj, support):
@@ -517,13 +526,17 @@ def free_spot(drv: Driver, support: str, obj: str, *, edge_margin: float = 0.2) 
         if bhi[2] > hi[2] - 0.01 and blo[2] < hi[2] + 0.3:
             others.append((blo[:2] - 0.03, bhi[:2] + 0.03))
     centre = (lo[:2] + hi[:2]) / 2
-    inset = np.minimum(half + edge_margin, (hi[:2] - lo[:2]) / 2)
+    inset = np.minimum(half + 0.02, (hi[:2] - lo[:2]) / 2)
     best, best_score = centre, np.inf
-    for x in np.linspace(lo[0] + inset[0], hi[0] - inset[0], 9):
-        for y in np.linspace(lo[1] + inset[1], hi[1] - inset[1], 9):
+    # Score a 15 x 15 grid: landing on something else costs most, then ending within NEAR_EDGE of an
+    # edge (the hazard itself), then falling short of the wider margin, then distance from the centre.
+    for x in np.linspace(lo[0] + inset[0], hi[0] - inset[0], 15):
+        for y in np.linspace(lo[1] + inset[1], hi[1] - inset[1], 15):
             p = np.array([x, y])
             hits = sum(bool(np.all(p + half > a) and np.all(p - half < b)) for a, b in others)
-            score = hits * 10.0 + float(np.linalg.norm(p - centre))
+            edge = float(np.min(np.minimum(p - half - lo[:2], hi[:2] - p - half)))
+            score = (hits * 10.0 + 20.0 * max(0.0, NEAR_EDGE + 0.02 - edge) + 5.0 * max(0.0, edge_margin - edge)
+                     + 0.1 * float(np.linalg.norm(p - centre)))
             if score < best_score:
                 best, best_score = p, score
     return np.array([best[0], best[1], hi[2] - 0.01])  # set down until it touches: a dropped globe topples
@@ -558,6 +571,11 @@ def opening(drv: Driver, region: str) -> tuple[np.ndarray, np.ndarray]:
 
 def _long_axis_yaw(drv: Driver, obj: str) -> float:
     """Yaw of the held object's longest horizontal extent (principal axis of its geoms' corners)."""
+    return footprint(drv, obj)[0]
+
+
+def footprint(drv: Driver, obj: str) -> tuple[float, float, float]:
+    """(yaw of the long side, half length, half width) of the object seen from above."""
     from anomalygen.scene import robot
 
     m, d = drv.model, drv.data
@@ -571,7 +589,9 @@ def _long_axis_yaw(drv: Driver, obj: str) -> float:
     xy = xy - xy.mean(axis=0)
     w, v = np.linalg.eigh(xy.T @ xy)
     major = v[:, int(np.argmax(w))]
-    return float(np.arctan2(major[1], major[0]))
+    minor = np.array([-major[1], major[0]])
+    along, across = xy @ major, xy @ minor
+    return (float(np.arctan2(major[1], major[0])), float(np.ptp(along)) / 2, float(np.ptp(across)) / 2)
 
 
 def _yawed(quat: np.ndarray, yaw: float) -> np.ndarray:
@@ -598,10 +618,10 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     quat = quat_z_to(np.array([0.0, 0.0, -1.0]))
     carry_z = max(drv.site[2], goal[2] + below + 0.1)
     drv.goto(np.array([*drv.site[:2], carry_z]), quat, max_steps=150)
-    # turn the object so its long side runs along the long side of the opening
-    lo, hi = opening(drv, region)
+    # turn the object so its long side runs along the long side of the opening (or of the table top)
+    lo, hi = opening(drv, region) if into else top_rect(drv, region)
     want = 0.0 if hi[0] - lo[0] >= hi[1] - lo[1] else np.pi / 2
-    turn = (want - _long_axis_yaw(drv, obj) + np.pi / 2) % np.pi - np.pi / 2 if into else 0.0
+    turn = (want - _long_axis_yaw(drv, obj) + np.pi / 2) % np.pi - np.pi / 2
     final = _yawed(quat, turn)
     above, low = np.array([*goal[:2], carry_z]), goal + np.array([0, 0, below])
     if not drv.place_base_near(goal, reach_poses=[(above, final), (low, final)]):
@@ -686,6 +706,7 @@ def lower_until_contact(drv: Driver, obj: str, target, quat, *, max_steps: int =
         drv.dp = dp
 
 
+NEAR_EDGE = 0.15  # m: the knowledge base's near_edge distance for fragile things (move_fragile_from_edge)
 SLOW_DP = 0.003  # m per control step for the final part of a set-down
 
 

@@ -1,0 +1,89 @@
+"""Primitive skill success on the knowledge run: the issue's acceptance figure, with a table by class.
+
+Runs the real pipeline through the CLI in a scratch run folder: ``brainstorm --engine knowledge --n N``,
+``build``, ``plan`` and ``learn --seeds K`` (videos off) on the tasks of the classes that motion
+primitives solve (store / move an object, close a door, drawer or lid, pick up from the floor). Prints
+the table and one JSON line: per-class and overall success over all (task, seed) runs.
+
+    .venv/bin/python benchmarks/bench_primitives.py [--n 111] [--seeds 3] [--workers 2] [--out DIR]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+PRIMITIVE_CLASSES = (
+    "close_open_furniture",
+    "close_open_refrigerator",
+    "close_oven_or_microwave",
+    "close_toilet_lid",
+    "move_fragile_from_edge",
+    "pick_up_floor_litter",
+    "store_sharp_objects",
+)
+
+
+def _cli(*args: str, env=None) -> None:
+    exe = Path(sys.executable).with_name("anomalygen")
+    subprocess.run([str(exe), *args, "--quiet"], check=True, env=env)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--n", type=int, default=111)
+    ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--out", default=None, help="run folder (default: a temporary one)")
+    a = ap.parse_args()
+    run = Path(a.out or tempfile.mkdtemp(prefix="bench_primitives_")) / "run"
+    env = {**os.environ, "ANOMALYGEN_LEARN__VIDEO": "false"}
+    t0 = time.perf_counter()
+    _cli("brainstorm", "--run", str(run), "--engine", "knowledge", "--n", str(a.n), "--seed", str(a.seed))
+    tasks = [json.loads(line) for line in (run / "tasks.jsonl").read_text().splitlines() if line.strip()]
+    chosen = [t["id"] for t in tasks if t["hazard_class"] in PRIMITIVE_CLASSES]
+    only = [x for tid in chosen for x in ("--only", tid)]
+    t_build = time.perf_counter()
+    _cli("build", "--run", str(run), "--workers", str(a.workers), "--seed", str(a.seed), *only)
+    built = [tid for tid in chosen if (run / "scenes" / tid / "scene.json").is_file()]
+    only = [x for tid in built for x in ("--only", tid)]
+    _cli("plan", "--run", str(run), *only)
+    t_learn = time.perf_counter()
+    _cli("learn", "--run", str(run), "--seeds", str(a.seeds), "--workers", str(a.workers), *only, env=env)
+    t_end = time.perf_counter()
+
+    by_class: dict[str, list[int]] = {}
+    cls_of = {t["id"]: t["hazard_class"] for t in tasks}
+    for tid in built:
+        for seed in range(a.seeds):
+            res = run / "skills" / tid / f"seed{seed}" / "result.json"
+            ok = res.is_file() and json.loads(res.read_text()).get("success", False)
+            row = by_class.setdefault(cls_of[tid], [0, 0])
+            row[0] += 1
+            row[1] += int(bool(ok))
+    n = sum(r[0] for r in by_class.values())
+    s = sum(r[1] for r in by_class.values())
+    print("| hazard class | runs | success | rate |\n|---|---|---|---|")
+    for hc, (k, ok) in sorted(by_class.items()):
+        print(f"| {hc} | {k} | {ok} | {ok / k:.0%} |")
+    print(f"| all | {n} | {s} | {s / max(n, 1):.0%} |")
+    print(json.dumps({
+        "name": "primitives",
+        "tasks_in_classes": len(chosen), "tasks_built": len(built), "seeds": a.seeds,
+        "runs": n, "successes": s, "rate": round(s / max(n, 1), 3),
+        "by_class": {hc: {"n": k, "success": ok} for hc, (k, ok) in sorted(by_class.items())},
+        "build_s": round(t_learn - t_build, 1), "learn_s": round(t_end - t_learn, 1),
+        "total_s": round(t_end - t0, 1), "run": str(run),
+    }))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
