@@ -367,11 +367,13 @@ def approach(drv: Driver, obj: str, point=None) -> PrimitiveResult:
     s0 = drv.steps
     normal = np.array([0.0, 0.0, 1.0])
     point = grasp_points(drv, obj)[0] if point is None else point
-    if not drv.place_base_near(point):
-        return PrimitiveResult(False, drv.steps - s0, f"no collision-free base pose near {obj}")
     quat = quat_z_to(-normal)
     pre = point + normal * PRE_CONTACT
     hover = point + normal * (PRE_CONTACT + 0.12)
+    # a base pose from which the cup reaches the object face-down (a globe's top is 1.2 m up: from
+    # the wrong spot the cup meets it tilted and the globe hangs crooked)
+    if not drv.place_base_near(point, reach_poses=[(pre, quat), (hover, quat)]):
+        return PrimitiveResult(False, drv.steps - s0, f"no collision-free base pose near {obj}")
     planned = False
     if drv.planned_motion:
         from anomalygen.learn.arm_motion import move_arm_planned
@@ -512,7 +514,6 @@ def free_spot(drv: Driver, support: str, obj: str, *, edge_margin: float = 0.2) 
     """A drop point on the support's top that keeps ``edge_margin`` from its edges and misses the
     other things standing there (a book in the middle of the table would leave the object perched
     half on it), nearest the centre; the centre when the top is too small for the margin."""
-    from anomalygen.scene.graph import geom_world_aabbs
 
     lo, hi = top_rect(drv, support)
     # the object will be turned to lie along the top's long side (move_to does that)

@@ -256,7 +256,8 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
         if container is not hazard and container.asset.cavities:
             # The hazard must be able to go in: a 0.5 m plastic bag does not fit a 0.3 m bucket.
             # Draw the container again (other sizes), then a smaller hazard, before giving up.
-            for _ in range(4):
+            # A container that is also the scene's target keeps its draw (other steps refer to it).
+            for _ in range(4 if container is not target else 0):
                 if hazard.size <= _container_room(container.asset):
                     break
                 by_catalogue.pop(container.catalogue, None)
@@ -267,6 +268,9 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
                 by_catalogue.pop(hazard.catalogue, None)
                 used.discard(hazard.name)
                 hazard = choose(sc.hazard_object, ObjectRole.HAZARD, cap=min(cap or room, room))
+            if hazard.size > room:
+                raise ItemFailed(f"{hazard.catalogue} ({hazard.size:.2f} m) does not fit {container.catalogue} "
+                                 f"(room for {room:.2f} m)")
     support_var = None
     if "$support" in variables:
         sname = _first_known(hc.default_supports)
