@@ -116,6 +116,7 @@ class Driver:
         self.opened: dict[str, list[str]] = {}  # container -> joints opened to put something in
         self.compartments: dict[str, tuple] = {}  # container -> (lo, hi, outward normal) behind its opened door
         self.planned_motion = planned_motion  # reach pre-contact poses by IK + OMPL paths
+        self.reaches = True  # did the last base placement satisfy its reach poses?
         self.plan_seed = int(rng.integers(2**31)) if rng is not None else 0
         # The seed only turns the ring of candidate base poses, so seeds try different approach sides.
         self.ring_offset = float(rng.uniform(0.0, 2 * np.pi / 24)) if rng is not None else 0.0
@@ -255,13 +256,16 @@ class Driver:
                         d.actuator(j).ctrl[0] = v
                     d.qvel[:] = 0.0
                     self.settle(10)
+                    self.reaches = True
                     return True
         d.qpos[:], d.qvel[:], d.mocap_pos[:], d.mocap_quat[:] = saved
         mujoco.mj_forward(m, d)
         if tuck and self.tuck():  # an outstretched arm collides everywhere: fold it in and try again
             return self.place_base_near(point, reach=reach, side=side, tuck=False, reach_poses=reach_poses)
-        if reach_poses:  # nowhere reaches every pose with the cup upright: settle for a free pose
-            return self.place_base_near(point, reach=reach, side=side, tuck=False)
+        if reach_poses:  # nowhere reaches every pose: settle for a free pose (and say so in .reaches)
+            ok = self.place_base_near(point, reach=reach, side=side, tuck=False)
+            self.reaches = False
+            return ok
         return False
 
     def _reaches(self, poses) -> bool:
@@ -410,6 +414,8 @@ def grasp(drv: Driver, obj: str, *, lift: float = 0.12) -> PrimitiveResult:
         res = approach(drv, obj, point)
         if not res.success and "base" in res.detail:
             return res
+        if not drv.reaches and drv.aabb(obj)[1][2] - drv.aabb(obj)[0][2] > 0.2:
+            break  # a tall object whose top the cup cannot reach face-down: hold it by the side
         for k in range(40):  # descend 2.5 mm per waypoint until suction catches
             target = point + normal * (PRE_CONTACT - 0.0025 * k)
             drv.goto(target, quat, max_steps=12, tol=0.004)
@@ -421,10 +427,63 @@ def grasp(drv: Driver, obj: str, *, lift: float = 0.12) -> PrimitiveResult:
             break
         drv.goto(drv.site + normal * 0.06, quat, max_steps=40)
     if not grabbed:
+        side = side_grasp(drv, obj, lift=lift)
+        if side.success:
+            return PrimitiveResult(True, drv.steps - s0, side.detail)
         return PrimitiveResult(False, drv.steps - s0, f"suction did not catch {obj} "
                                f"(cup-object distance {robot.object_distance_to_cup(drv.model, drv.data, obj):.3f} m)")
     drv.goto(drv.site + np.array([0, 0, lift]), quat, max_steps=150)
     return PrimitiveResult(True, drv.steps - s0, f"holding {obj}, lifted {lift:.2f} m")
+
+
+def side_grasp(drv: Driver, obj: str, *, lift: float = 0.12) -> PrimitiveResult:
+    """Hold a tall object by the side of its widest part, cup horizontal (a globe's top is beyond
+    the arm's reach with the cup face-down). The cup comes from the robot's side along a ray to the
+    surface; the weld then holds the object's body, so it is carried upright."""
+    import mujoco
+
+    from anomalygen.learn.ik import quat_z_to
+    from anomalygen.scene import robot
+    from anomalygen.scene.graph import geom_world_aabbs
+
+    s0 = drv.steps
+    m, d = drv.model, drv.data
+    glo, ghi = geom_world_aabbs(m, d)
+    mask = robot._subtree_geoms(m, drv.body_id(obj)) & (m.geom_contype | m.geom_conaffinity).astype(bool)
+    g = max(np.flatnonzero(mask), key=lambda k: float(np.prod(ghi[k, :2] - glo[k, :2])))
+    centre = (glo[g] + ghi[g]) / 2
+    base = np.array([float(d.joint(j).qpos[0]) for j in robot.BASE_JOINTS[:2]])
+    a0 = float(np.arctan2(*(base - centre[:2])[::-1]))
+    geomid = np.zeros(1, dtype=np.int32)
+    for a in a0 + np.array([0, 1, -1, 2, -2, 3, -3, 4]) * np.pi / 4:  # from the robot's side first
+        n = np.array([np.cos(a), np.sin(a), 0.0])
+        quat = quat_z_to(-n)
+        dist = mujoco.mj_ray(m, d, centre + n * 0.5, -n, None, 1, -1, geomid)
+        if dist < 0 or not mask[int(geomid[0])]:
+            continue  # something else stands in front of the object on this side
+        point = centre + n * (0.5 - dist)
+        pre = point + n * PRE_CONTACT
+        if drv.place_base_near(point, side=n, reach_poses=[(pre, quat), (pre + n * 0.1, quat)]) and drv.reaches:
+            break
+    else:
+        return PrimitiveResult(False, drv.steps - s0, f"no base pose reaches the side of {obj}")
+    planned = False
+    if drv.planned_motion:
+        from anomalygen.learn.arm_motion import move_arm_planned
+
+        planned = any(move_arm_planned(drv, goal, quat, seed=drv.plan_seed, ik_attempts=3).ok
+                      for goal in (pre, pre + n * 0.1))
+    if not planned:
+        drv.goto(drv.site + np.array([0, 0, max(0.0, pre[2] + 0.1 - drv.site[2])]), max_steps=100)
+        drv.goto(pre + n * 0.1, quat, max_steps=250, tol=0.02)
+    drv.goto(pre, quat, max_steps=150)
+    for k in range(40):
+        drv.goto(point + n * (PRE_CONTACT - 0.0025 * k), quat, max_steps=10, tol=0.004)
+        if robot.object_distance_to_cup(m, d, obj) < robot.SUCTION_RANGE * 0.8 and robot.suction_on(m, d, obj):
+            drv.goto(drv.site + np.array([0, 0, lift]), quat, max_steps=150)
+            return PrimitiveResult(True, drv.steps - s0, f"holding {obj} by its side, lifted {lift:.2f} m")
+    drv.goto(drv.site + n * 0.08, quat, max_steps=40)
+    return PrimitiveResult(False, drv.steps - s0, f"suction did not catch the side of {obj}")
 
 
 def release(drv: Driver) -> PrimitiveResult:
@@ -616,7 +675,8 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     goal = _drop_point(drv, region, obj) if into else free_spot(drv, region, obj)
     olo, ohi = drv.aabb(obj)
     below = drv.site[2] - olo[2]  # cup face to object bottom
-    quat = quat_z_to(np.array([0.0, 0.0, -1.0]))
+    # carry face-down, or as held for a side grasp (turning the cup would turn the object over)
+    quat = quat_z_to(np.array([0.0, 0.0, -1.0])) if drv.cup_down(0.7) else drv.data.mocap_quat[drv._mocap].copy()
     carry_z = max(drv.site[2], goal[2] + below + 0.1)
     drv.goto(np.array([*drv.site[:2], carry_z]), quat, max_steps=150)
     # turn the object so its long side runs along the long side of the opening (or of the table top)
@@ -637,6 +697,15 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
         for f in np.linspace(0.2, 1.0, 5):
             drv.goto(above, _yawed(quat, f * turn), max_steps=8)
     quat = final
+    # aim the object, not the cup: held by its side, a globe's centre is a radius away from the cup
+    for _ in range(2):
+        olo, ohi = drv.aabb(obj)
+        err = goal[:2] - (olo[:2] + ohi[:2]) / 2
+        if np.linalg.norm(err) < 0.01:
+            break
+        above = np.array([above[0] + err[0], above[1] + err[1], above[2]])
+        low = np.array([low[0] + err[0], low[1] + err[1], low[2]])
+        drv.goto(above, quat, max_steps=120, tol=0.01)
     ok = lower_until_contact(drv, obj, low, quat)
     if release_after:
         release(drv)
