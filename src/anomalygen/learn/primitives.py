@@ -409,13 +409,18 @@ def grasp(drv: Driver, obj: str, *, lift: float = 0.12) -> PrimitiveResult:
     s0 = drv.steps
     normal = np.array([0.0, 0.0, 1.0])
     quat = quat_z_to(-normal)
-    grabbed = False
+    grabbed, tried_side = False, False
     for point in grasp_points(drv, obj):
         res = approach(drv, obj, point)
         if not res.success and "base" in res.detail:
             return res
-        if not drv.reaches and drv.aabb(obj)[1][2] - drv.aabb(obj)[0][2] > 0.2:
-            break  # a tall object whose top the cup cannot reach face-down: hold it by the side
+        if not drv.reaches and not tried_side and drv.aabb(obj)[1][2] - drv.aabb(obj)[0][2] > 0.2:
+            # a tall object whose top the cup cannot reach face-down: hold it by the side if possible
+            tried_side = True
+            side = side_grasp(drv, obj, lift=lift)
+            if side.success:
+                return PrimitiveResult(True, drv.steps - s0, side.detail)
+            res = approach(drv, obj, point)
         for k in range(40):  # descend 2.5 mm per waypoint until suction catches
             target = point + normal * (PRE_CONTACT - 0.0025 * k)
             drv.goto(target, quat, max_steps=12, tol=0.004)
@@ -427,9 +432,6 @@ def grasp(drv: Driver, obj: str, *, lift: float = 0.12) -> PrimitiveResult:
             break
         drv.goto(drv.site + normal * 0.06, quat, max_steps=40)
     if not grabbed:
-        side = side_grasp(drv, obj, lift=lift)
-        if side.success:
-            return PrimitiveResult(True, drv.steps - s0, side.detail)
         return PrimitiveResult(False, drv.steps - s0, f"suction did not catch {obj} "
                                f"(cup-object distance {robot.object_distance_to_cup(drv.model, drv.data, obj):.3f} m)")
     drv.goto(drv.site + np.array([0, 0, lift]), quat, max_steps=150)
