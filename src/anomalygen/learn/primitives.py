@@ -414,12 +414,18 @@ def grasp(drv: Driver, obj: str, *, lift: float = 0.12) -> PrimitiveResult:
         res = approach(drv, obj, point)
         if not res.success and "base" in res.detail:
             return res
-        if not drv.reaches and not tried_side and drv.aabb(obj)[1][2] - drv.aabb(obj)[0][2] > 0.2:
+        if (not drv.reaches and not tried_side and drv.aabb(obj)[1][2] - drv.aabb(obj)[0][2] > 0.2
+                and footprint(drv, obj)[2] > 0.09):  # bulky, not a thin screen that a side push would topple
             # a tall object whose top the cup cannot reach face-down: hold it by the side if possible
             tried_side = True
             side = side_grasp(drv, obj, lift=lift)
             if side.success:
                 return PrimitiveResult(True, drv.steps - s0, side.detail)
+            if drv.planned_motion and not drv.cup_down():
+                from anomalygen.learn.arm_motion import rehome
+
+                drv.goto(drv.site + np.array([0.0, 0.0, 0.1]), max_steps=40, tol=0.03)
+                rehome(drv, seed=drv.plan_seed)  # back from the side pose before trying the top
             res = approach(drv, obj, point)
         for k in range(40):  # descend 2.5 mm per waypoint until suction catches
             target = point + normal * (PRE_CONTACT - 0.0025 * k)
