@@ -260,8 +260,8 @@ def rehome(drv, *, time_limit: float = 1.0, seed: int = 0, max_steps: int = 300)
 
     Pulling a drawer or a door leaves the wrist turned sideways; a straight mocap move from there to a
     cup-down pose can wind the wrist into the furniture. From home every approach starts clean. When
-    no collision-free path is found (the arm starts touching something) the joints are interpolated
-    straight to home.
+    the arm starts touching something the joints are interpolated straight to home; when home itself
+    collides (a drawer just pulled open in front of the robot) nothing moves and False is returned.
     """
     from anomalygen.learn.motion import plan_path
     from anomalygen.scene import robot
@@ -273,8 +273,10 @@ def rehome(drv, *, time_limit: float = 1.0, seed: int = 0, max_steps: int = 300)
     checker = _checker(m, ref, held, rel, 0.005, ())
     q0 = d.qpos[checker.qadr].copy()
     home = np.asarray(robot.HOME_ARM, dtype=float)
+    if not checker.valid(home):
+        return False  # home itself collides (an opened drawer right in front): stay put
     path = plan_path(m, ref, robot.ARM_JOINTS, home, time_limit=time_limit, seed=seed, checker=checker) \
-        if checker.valid(q0) and checker.valid(home) else None
+        if checker.valid(q0) else None
     settled, _, _ = follow_joint_path(drv, path or [q0, home], max_steps=max_steps)
     return settled
 

@@ -281,6 +281,8 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
         p, n = _world(drv, g)
         dp, drv.dp = drv.dp, 0.004  # back off gently: a fast pull drags a light part along
         if g.outer:
+            if not hinge:  # a cup resting on a drawer front's top edge would hook it and pull it out
+                drv.goto(drv.site + np.array([0.0, 0.0, 0.02]), max_steps=10)
             drv.goto(drv.site + n * 0.10, max_steps=40)
         else:  # the inner face looks into the cabinet: leave upwards, over the part's edge
             drv.goto(drv.site + n * 0.03, max_steps=15)
