@@ -596,10 +596,10 @@ def free_spot(drv: Driver, support: str, obj: str, *, edge_margin: float = 0.2) 
     centre = (lo[:2] + hi[:2]) / 2
     inset = np.minimum(half + 0.02, (hi[:2] - lo[:2]) / 2)
     best, best_score = centre, np.inf
-    # Score a 15 x 15 grid: landing on something else costs most, then ending within NEAR_EDGE of an
+    # Score a 31 x 31 grid (a 4 cm step can miss the one clear spot on a crowded table): landing on something else costs most, then ending within NEAR_EDGE of an
     # edge (the hazard itself), then falling short of the wider margin, then distance from the centre.
-    for x in np.linspace(lo[0] + inset[0], hi[0] - inset[0], 15):
-        for y in np.linspace(lo[1] + inset[1], hi[1] - inset[1], 15):
+    for x in np.linspace(lo[0] + inset[0], hi[0] - inset[0], 31):
+        for y in np.linspace(lo[1] + inset[1], hi[1] - inset[1], 31):
             p = np.array([x, y])
             hits = sum(bool(np.all(p + half > a) and np.all(p - half < b)) for a, b in others)
             edge = float(np.min(np.minimum(p - half - lo[:2], hi[:2] - p - half)))
