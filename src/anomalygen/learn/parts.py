@@ -76,31 +76,6 @@ def _body_box(drv, body: int) -> tuple[np.ndarray, np.ndarray]:
     return np.min(los, axis=0), np.max(his, axis=0)
 
 
-def _static_centre(drv, obj_root: int, moving: set[int]) -> np.ndarray:
-    """Centre of the object's geoms that do not move with any part (the carcass)."""
-    from anomalygen.scene.graph import geom_world_aabbs
-
-    m = drv.model
-    sub = {obj_root}
-    for b in range(obj_root + 1, m.nbody):
-        if m.body_parentid[b] in sub:
-            sub.add(b)
-
-    def moves(b: int) -> bool:
-        while b != obj_root and b > 0:
-            if b in moving:
-                return True
-            b = int(m.body_parentid[b])
-        return False
-
-    lo, hi = geom_world_aabbs(m, drv.data)
-    sel = [g for g in range(m.ngeom) if m.geom_bodyid[g] in sub and not moves(int(m.geom_bodyid[g]))
-           and (m.geom_contype[g] or m.geom_conaffinity[g])]
-    if not sel:
-        return drv.data.xpos[obj_root].copy()
-    return (lo[sel].min(axis=0) + hi[sel].max(axis=0)) / 2
-
-
 def _object_root(m, body: int) -> int:
     while m.body_parentid[body] != 0:
         body = int(m.body_parentid[body])
@@ -116,9 +91,8 @@ def grasp_candidates(drv, joint: str, closed: float) -> list[PartGrasp]:
     rb = d.xmat[body].reshape(3, 3)
     q = float(d.qpos[m.jnt_qposadr[j]])
     rc, tc = part_transform(drv, joint, closed - q)  # current -> closed pose
-    root = _object_root(m, body)
-    moving = {int(m.jnt_bodyid[k]) for k in range(m.njnt) if m.jnt_type[k] in (HINGE, SLIDE)}
-    centre = _static_centre(drv, root, moving)
+    clo, chi = static_box(drv, m.body(_object_root(m, body)).name)
+    centre = (clo + chi) / 2  # the carcass: what no hinge or slide moves
     axis_w = d.xaxis[j] / np.linalg.norm(d.xaxis[j])
     axis_l = rb.T @ axis_w
     size = hi - lo
@@ -245,14 +219,7 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
             break
         quat = quat_z_to(-n)
         hover = p + n * (PRE_CONTACT + 0.10)
-        reached = False
-        if drv.planned_motion:  # IK + a collision-free joint path to the pre-contact pose, as for grasps
-            from anomalygen.learn.arm_motion import move_arm_planned
-
-            for goal_pose in (p + n * PRE_CONTACT, hover):
-                if move_arm_planned(drv, goal_pose, quat, seed=drv.plan_seed, ik_attempts=3).ok:
-                    reached = True
-                    break
+        reached = drv.reach_planned((p + n * PRE_CONTACT, hover), quat)  # as for grasps
         if not reached and np.dot(drv.site - p, n) < 0.0 and g.beyond_local is not None:
             # the cup is behind the face: round the part's free edge instead of sweeping through it
             rb = d.xmat[g.body].reshape(3, 3)
@@ -290,13 +257,8 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
             drv.goto(drv.site + np.array([0.0, 0.0, 0.25]), max_steps=40)
         drv.dp = dp
     drv.settle(10)
-    if drv.planned_motion and not drv.cup_down():
-        from anomalygen.learn.arm_motion import rehome
-
-        # the wrist is turned sideways: start the next move clean, from above the part so the arm
-        # does not sweep through what it just opened
-        drv.goto(drv.site + np.array([0.0, 0.0, 0.25]), max_steps=60, tol=0.03)
-        rehome(drv, seed=drv.plan_seed)
+    # lift well clear first, so the arm does not sweep through what it just opened
+    drv.straighten_wrist(lift=0.25, lift_steps=60)
     ok = abs(q() - goal) <= tol
     detail = f"{joint} = {q():.3f} (goal {goal:.3f})" + (f"; {'; '.join(notes)}" if notes else "")
     return PrimitiveResult(ok, drv.steps - s0, detail)
@@ -379,14 +341,11 @@ def _far(js) -> float:
 
 def static_box(drv, obj: str) -> tuple[np.ndarray, np.ndarray]:
     """World AABB of the object's carcass: its collision geoms that no hinge or slide moves."""
+    from anomalygen.scene import robot
     from anomalygen.scene.graph import geom_world_aabbs
 
     m = drv.model
     root = drv.body_id(obj)
-    sub = {root}
-    for b in range(root + 1, m.nbody):
-        if m.body_parentid[b] in sub:
-            sub.add(b)
     moving = {int(m.jnt_bodyid[k]) for k in range(m.njnt) if m.jnt_type[k] in (HINGE, SLIDE)}
 
     def moves(b: int) -> bool:
@@ -397,7 +356,8 @@ def static_box(drv, obj: str) -> tuple[np.ndarray, np.ndarray]:
         return False
 
     lo, hi = geom_world_aabbs(m, drv.data)
-    sel = [g for g in range(m.ngeom) if m.geom_bodyid[g] in sub and not moves(int(m.geom_bodyid[g]))
+    sub = robot._subtree_geoms(m, root)
+    sel = [g for g in np.flatnonzero(sub) if not moves(int(m.geom_bodyid[g]))
            and (m.geom_contype[g] or m.geom_conaffinity[g])]
     if not sel:
         return drv.aabb(obj)

@@ -143,6 +143,26 @@ class Driver:
         for _ in range(n):
             self.step()
 
+    def reach_planned(self, goals, quat) -> bool:
+        """Cup to the first of ``goals`` reachable by IK and a collision-free OMPL path (``arm_motion``);
+        False, with nothing moved, when none is (or planned motion is off): the caller moves straight."""
+        if not self.planned_motion:
+            return False
+        from anomalygen.learn.arm_motion import move_arm_planned
+
+        return any(move_arm_planned(self, g, quat, seed=self.plan_seed, ik_attempts=3).ok for g in goals)
+
+    def straighten_wrist(self, lift: float = 0.0, lift_steps: int = 40) -> None:
+        """If a pull or side grasp left the cup sideways, rise by ``lift`` and plan back to the home
+        configuration: a straight cup-down move from there winds the wrist into the furniture."""
+        if not self.planned_motion or self.cup_down():
+            return
+        from anomalygen.learn.arm_motion import rehome
+
+        if lift > 0:
+            self.goto(self.site + np.array([0.0, 0.0, lift]), max_steps=lift_steps, tol=0.03)
+        rehome(self, seed=self.plan_seed)
+
     def cup_down(self, cos_tol: float = 0.7) -> bool:
         """True when the cup face points roughly down (within ~45 degrees)."""
         return bool(-self.data.xmat[self._cup].reshape(3, 3)[2, 2] > cos_tol)
@@ -378,19 +398,9 @@ def approach(drv: Driver, obj: str, point=None) -> PrimitiveResult:
     # the wrong spot the cup meets it tilted and the globe hangs crooked)
     if not drv.place_base_near(point, reach_poses=[(pre, quat), (hover, quat)]):
         return PrimitiveResult(False, drv.steps - s0, f"no collision-free base pose near {obj}")
-    planned = False
-    if drv.planned_motion:
-        from anomalygen.learn.arm_motion import move_arm_planned
-
-        for goal in (pre, hover):  # the hover pose is freer when the pre-contact one is cramped
-            if move_arm_planned(drv, goal, quat, seed=drv.plan_seed, ik_attempts=3).ok:
-                planned = True
-                break
-    if not planned and drv.planned_motion and not drv.cup_down():
-        from anomalygen.learn.arm_motion import rehome
-
-        rehome(drv, seed=drv.plan_seed)
+    planned = drv.reach_planned((pre, hover), quat)  # the hover pose is freer when pre-contact is cramped
     if not planned:  # rise, turn the cup face-down while clear of everything, then come over and down
+        drv.straighten_wrist()
         up = drv.site + np.array([0, 0, max(0.0, hover[2] - drv.site[2])])
         drv.goto(up, max_steps=120)
         drv.goto(up, quat, max_steps=60)
@@ -421,11 +431,7 @@ def grasp(drv: Driver, obj: str, *, lift: float = 0.12) -> PrimitiveResult:
             side = side_grasp(drv, obj, lift=lift)
             if side.success:
                 return PrimitiveResult(True, drv.steps - s0, side.detail)
-            if drv.planned_motion and not drv.cup_down():
-                from anomalygen.learn.arm_motion import rehome
-
-                drv.goto(drv.site + np.array([0.0, 0.0, 0.1]), max_steps=40, tol=0.03)
-                rehome(drv, seed=drv.plan_seed)  # back from the side pose before trying the top
+            drv.straighten_wrist(lift=0.1)  # back from the side pose before trying the top
             res = approach(drv, obj, point)
         for k in range(40):  # descend 2.5 mm per waypoint until suction catches
             target = point + normal * (PRE_CONTACT - 0.0025 * k)
@@ -475,13 +481,7 @@ def side_grasp(drv: Driver, obj: str, *, lift: float = 0.12) -> PrimitiveResult:
             break
     else:
         return PrimitiveResult(False, drv.steps - s0, f"no base pose reaches the side of {obj}")
-    planned = False
-    if drv.planned_motion:
-        from anomalygen.learn.arm_motion import move_arm_planned
-
-        planned = any(move_arm_planned(drv, goal, quat, seed=drv.plan_seed, ik_attempts=3).ok
-                      for goal in (pre, pre + n * 0.1))
-    if not planned:
+    if not drv.reach_planned((pre, pre + n * 0.1), quat):
         drv.goto(drv.site + np.array([0, 0, max(0.0, pre[2] + 0.1 - drv.site[2])]), max_steps=100)
         drv.goto(pre + n * 0.1, quat, max_steps=250, tol=0.02)
     drv.goto(pre, quat, max_steps=150)
@@ -695,12 +695,7 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     above, low = np.array([*goal[:2], carry_z]), goal + np.array([0, 0, below])
     if not drv.place_base_near(goal, reach_poses=[(above, final), (low, final)]):
         return PrimitiveResult(False, drv.steps - s0, f"no collision-free base pose near {region}")
-    planned = False
-    if drv.planned_motion:
-        from anomalygen.learn.arm_motion import move_arm_planned
-
-        planned = move_arm_planned(drv, above, final, seed=drv.plan_seed, ik_attempts=3).ok
-    if not planned:
+    if not drv.reach_planned((above,), final):
         drv.goto(above, quat, max_steps=250)
         for f in np.linspace(0.2, 1.0, 5):
             drv.goto(above, _yawed(quat, f * turn), max_steps=8)
