@@ -6,24 +6,9 @@ import numpy as np
 import pytest
 
 from anomalygen.scene.robot import ARM_JOINTS
+from support.testbed_scene import scene_with_obstacle
 
-
-def _scene(obstacle_at=None, half=0.03):
-    import mujoco
-
-    from anomalygen.learn.testbed import build_spec
-    from anomalygen.scene.robot import set_home
-
-    spec, _ = build_spec()
-    if obstacle_at is not None:
-        spec.worldbody.add_geom(name="obstacle", type=mujoco.mjtGeom.mjGEOM_BOX, size=[half] * 3,
-                                pos=list(obstacle_at), rgba=[1, 0, 0, 1])
-    m = spec.compile()
-    d = mujoco.MjData(m)
-    set_home(m, d, (0.0, 0.0, 0.0))
-    d.joint("cabinet_0:door_hinge").qpos[0] = 1.2
-    mujoco.mj_forward(m, d)
-    return m, d
+_scene = scene_with_obstacle
 
 
 @pytest.fixture(scope="module")
