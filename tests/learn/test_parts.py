@@ -274,16 +274,20 @@ def _move_onto(drv, obj: str, support: str, xy) -> None:
     mujoco.mj_forward(drv.model, drv.data)
 
 
-def _footprint_clear(drv, spot, obj, support):
+def _footprint_clear(drv, spot, obj, support, *, turned=True):
     """(margin to the top's edges, names of other objects on the top the object's footprint overlaps).
 
-    The footprint is the object's, turned to lie along the top's long side, as ``move_to`` sets it down."""
+    The footprint is the object's, turned to lie along the top's long side, as ``move_to`` sets down
+    an elongated object; not ``turned``, the object's box as it lies now."""
     from anomalygen.learn.parts import static_box
     from anomalygen.learn.primitives import footprint, top_rect
 
     _, a, b = footprint(drv, obj)
     rlo, rhi = top_rect(drv, support)
     half = np.array([a, b]) if rhi[0] - rlo[0] >= rhi[1] - rlo[1] else np.array([b, a])
+    if not turned:
+        olo, ohi = drv.aabb(obj)
+        half = (ohi[:2] - olo[:2]) / 2
     tlo, thi = static_box(drv, support)
     margin = float(min(np.min(spot[:2] - half - tlo[:2]), np.min(thi[:2] - (spot[:2] + half))))
     hits = []
@@ -311,6 +315,31 @@ def test_free_spot_misses_what_stands_on_the_table_and_keeps_off_the_edges(scene
     assert hits == [], f"{spot} puts the pliers on {hits}"
     assert margin >= 0.15
     assert top - 0.02 < spot[2] < top  # at the top, to be lowered until it touches
+
+
+def test_free_spot_for_an_object_that_keeps_its_orientation(scenes):
+    """A square object is set down as it hangs (turning it only swings it): the spot is chosen for
+    its present box, which here lies across the table's long side."""
+    import mujoco
+
+    from anomalygen.learn.primitives import free_spot
+
+    drv = _driver(scenes, "box")
+    support = scenes["box"][1].bindings["$support"]
+    tlo, thi = drv.aabb(support)
+    clutter = next(o.name for o in drv.spec.objects if o.role == "clutter")
+    _move_onto(drv, clutter, support, (tlo[:2] + thi[:2]) / 2)
+    jnt = drv.model.body_jntadr[drv.body_id("pliers_0")]
+    adr = drv.model.jnt_qposadr[jnt]
+    long_x = thi[0] - tlo[0] >= thi[1] - tlo[1]
+    yaw = np.pi / 2 if long_x else 0.0  # lay the pliers across the long side, against what move_to would do
+    quat = np.zeros(4)
+    mujoco.mju_mulQuat(quat, np.array([np.cos(yaw / 2), 0, 0, np.sin(yaw / 2)]), drv.data.qpos[adr + 3:adr + 7].copy())
+    drv.data.qpos[adr + 3:adr + 7] = quat
+    mujoco.mj_forward(drv.model, drv.data)
+    spot = free_spot(drv, support, "pliers_0", turned=False)
+    margin, hits, _ = _footprint_clear(drv, spot, "pliers_0", support, turned=False)
+    assert hits == [] and margin >= 0.15, (spot, margin, hits)
 
 
 def test_free_spot_prefers_a_clear_spot_over_the_edge_margin(scenes):

@@ -577,15 +577,21 @@ def top_rect(drv: Driver, support: str) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
-def free_spot(drv: Driver, support: str, obj: str, *, edge_margin: float = 0.2) -> np.ndarray:
+def free_spot(drv: Driver, support: str, obj: str, *, edge_margin: float = 0.2, turned: bool = True) -> np.ndarray:
     """A drop point on the support's top that keeps ``edge_margin`` from its edges and misses the
     other things standing there (a book in the middle of the table would leave the object perched
-    half on it), nearest the centre; the centre when the top is too small for the margin."""
+    half on it), nearest the centre; the centre when the top is too small for the margin.
+
+    ``turned``: the object will be turned to lie along the top's long side (``move_to`` does that
+    for objects with a long side); otherwise it keeps its present orientation."""
 
     lo, hi = top_rect(drv, support)
-    # the object will be turned to lie along the top's long side (move_to does that)
-    _, a, b = footprint(drv, obj)
-    half = np.array([a, b]) if hi[0] - lo[0] >= hi[1] - lo[1] else np.array([b, a])
+    if turned:
+        _, a, b = footprint(drv, obj)
+        half = np.array([a, b]) if hi[0] - lo[0] >= hi[1] - lo[1] else np.array([b, a])
+    else:
+        olo, ohi = drv.aabb(obj)
+        half = (ohi[:2] - olo[:2]) / 2
     others = []
     for o in drv.spec.objects:
         if o.name in (obj, support):
@@ -680,26 +686,40 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
         return PrimitiveResult(False, 0, f"{obj} is not held")
     if into and region in drv.compartments:
         return place_through_door(drv, obj, region, release_after=release_after)
-    goal = _drop_point(drv, region, obj) if into else free_spot(drv, region, obj)
+    face_down = drv.cup_down(0.7)
+    yaw, a, b = footprint(drv, obj)
+    # Turn the object so its long side runs along the long side of the opening (or of the table top),
+    # but only when it hangs below a face-down cup and, on a table, has a long side: a turn swings a
+    # side-held globe so that it lands tilted, and gains nothing for a square camera.
+    turning = face_down and (into or a > SQUARE_RATIO * b)
+    goal = _drop_point(drv, region, obj) if into else free_spot(drv, region, obj, turned=turning)
     olo, ohi = drv.aabb(obj)
     below = drv.site[2] - olo[2]  # cup face to object bottom
     # carry face-down, or as held for a side grasp (turning the cup would turn the object over)
-    quat = quat_z_to(np.array([0.0, 0.0, -1.0])) if drv.cup_down(0.7) else drv.data.mocap_quat[drv._mocap].copy()
+    quat = quat_z_to(np.array([0.0, 0.0, -1.0])) if face_down else drv.data.mocap_quat[drv._mocap].copy()
     carry_z = max(drv.site[2], goal[2] + below + 0.1)
     drv.goto(np.array([*drv.site[:2], carry_z]), quat, max_steps=150)
-    # turn the object so its long side runs along the long side of the opening (or of the table top)
     lo, hi = opening(drv, region) if into else top_rect(drv, region)
     want = 0.0 if hi[0] - lo[0] >= hi[1] - lo[1] else np.pi / 2
-    turn = (want - _long_axis_yaw(drv, obj) + np.pi / 2) % np.pi - np.pi / 2
+    turn = (want - yaw + np.pi / 2) % np.pi - np.pi / 2 if turning else 0.0
     final = _yawed(quat, turn)
-    above, low = np.array([*goal[:2], carry_z]), goal + np.array([0, 0, below])
-    if not drv.place_base_near(goal, reach_poses=[(above, final), (low, final)]):
+    # Aim the object, not the cup: held by its side (or off-centre), the object's centre is well away
+    # from the cup, so the base is placed for the cup poses that put the object's centre on the goal.
+    olo, ohi = drv.aabb(obj)
+    off = (olo[:2] + ohi[:2]) / 2 - drv.site[:2]
+    off = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]]) @ off
+    cup_goal = np.array([*(goal[:2] - off), goal[2]])
+    above, low = np.array([*cup_goal[:2], carry_z]), cup_goal + np.array([0, 0, below])
+    if not drv.place_base_near(cup_goal, reach_poses=[(above, final), (low, final)]):
         return PrimitiveResult(False, drv.steps - s0, f"no collision-free base pose near {region}")
     if not drv.reach_planned((above,), final):
         drv.goto(above, quat, max_steps=250)
         for f in np.linspace(0.2, 1.0, 5):
             drv.goto(above, _yawed(quat, f * turn), max_steps=8)
     quat = final
+    _let_swing_die(drv, obj)
+    below = drv.site[2] - drv.aabb(obj)[0][2]  # again: the swing and the turn change how the object hangs
+    low = np.array([low[0], low[1], goal[2] + below])
     # aim the object, not the cup: held by its side, a globe's centre is a radius away from the cup
     for _ in range(2):
         olo, ohi = drv.aabb(obj)
@@ -709,6 +729,7 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
         above = np.array([above[0] + err[0], above[1] + err[1], above[2]])
         low = np.array([low[0] + err[0], low[1] + err[1], low[2]])
         drv.goto(above, quat, max_steps=120, tol=0.01)
+        _let_swing_die(drv, obj)
     ok = lower_until_contact(drv, obj, low, quat)
     if release_after:
         release(drv)
@@ -753,6 +774,16 @@ def place_through_door(drv: Driver, obj: str, region: str, *, release_after: boo
     return PrimitiveResult(ok, drv.steps - s0, f"{obj} {'slid into' if ok else 'not fully into'} {region} through its door")
 
 
+def _let_swing_die(drv: Driver, obj: str, max_steps: int = 40) -> None:
+    """Hold still until the carried object stops swinging: set down while swinging, it lands tilted."""
+    b = drv.body_id(obj)
+    for _ in range(max_steps):
+        w, v = drv.data.cvel[b][:3], drv.data.cvel[b][3:]
+        if np.linalg.norm(w) < 0.15 and np.linalg.norm(v) < 0.02:
+            return
+        drv.step()
+
+
 def lower_until_contact(drv: Driver, obj: str, target, quat, *, max_steps: int = 300, tol: float = 0.02) -> bool:
     """Lower the held object towards ``target`` (cup face) and stop the moment it touches anything.
 
@@ -779,6 +810,7 @@ def lower_until_contact(drv: Driver, obj: str, target, quat, *, max_steps: int =
         drv.dp = dp
 
 
+SQUARE_RATIO = 1.3  # an object whose footprint is less elongated than this is not turned before a set-down
 NEAR_EDGE = 0.15  # m: the knowledge base's near_edge distance for fragile things (move_fragile_from_edge)
 SLOW_DP = 0.003  # m per control step for the final part of a set-down
 
