@@ -84,6 +84,9 @@ class LearnConfig(Section):
         default_factory=list,
         description="recipe actions the knowledge planner hands to SAC instead of a primitive, e.g. close_joint",
     )
+    retries: int = Field(
+        1, ge=0, description="times a primitive sub-task whose success check fails right after it is run again"
+    )
     cem_iterations: int = Field(5, ge=1)
     video: bool = True
     reward_mode: Literal["spec", "code"] = "spec"

@@ -358,6 +358,7 @@ class SubTaskResult(Strict):
     steps: int = 0
     wall_s: float = 0.0
     detail: str = ""
+    attempts: int = Field(1, ge=1, description="executions of the sub-task: retried when its check failed")
 
 
 class SkillResult(Artefact):

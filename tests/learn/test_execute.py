@@ -110,3 +110,26 @@ def test_non_primitive_subtasks_are_reported_not_executed(built):
 def test_plan_type_round_trips(built):
     _, plan, _ = built["fridge"]
     assert Plan.model_validate_json(plan.model_dump_json()) == plan
+
+
+@pytest.mark.slow
+def test_a_subtask_whose_check_fails_is_run_again(built):
+    """Closed loop: the set-down is checked on the scene graph and, failing, redone from where it left
+    the object; ``retries=0`` runs it once. The check here cannot hold (3 m above the floor), so every
+    attempt is spent and the count shows in the result."""
+    from anomalygen.learn.execute import execute_plan
+    from anomalygen.schema import PredicateCall, SuccessSpec
+
+    scene_dir, plan, _ = built["litter"]
+    never = SuccessSpec(predicates=[PredicateCall(name="height_above_floor", args={"object": "$hazard", "min": 3.0})])
+    move = plan.subtasks[1].model_copy(update={"success": never})
+    plan = plan.model_copy(update={"subtasks": [plan.subtasks[0], move]})
+    once = execute_plan(scene_dir, plan, seed=0, retries=0, isolate=False)
+    twice = execute_plan(scene_dir, plan, seed=0, retries=1, isolate=False)
+    assert once.subtasks[0].attempts == 1 and once.subtasks[0].success  # the grasp's own check held
+    assert once.subtasks[1].attempts == 1 and not once.subtasks[1].success
+    assert twice.subtasks[1].attempts == 2 and "attempt 2: " in twice.subtasks[1].detail
+    # the second attempt really moved the robot again: more control steps than the single one
+    assert twice.subtasks[1].steps > once.subtasks[1].steps + 20
+    # the redo picked the wrapper out of the bucket and put it back: the plan's own goal still holds
+    assert twice.success and [p.call.name for p in twice.final_predicates if p.holds]

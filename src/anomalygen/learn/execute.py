@@ -140,8 +140,14 @@ def _evaluate(calls, model, data, spec, bindings) -> list[PredicateResult]:
 
 
 def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: str | Path | None = None,
-                 max_wall_s: float = 600.0, sac_steps: int = 0, isolate: bool = True) -> SkillResult:
+                 max_wall_s: float = 600.0, sac_steps: int = 0, isolate: bool = True,
+                 retries: int = 1) -> SkillResult:
     """Load the scene, run the plan's sub-tasks in order, check success, optionally record a video.
+
+    Execution is closed-loop: a primitive sub-task whose success check fails on the scene right after
+    it is run again, up to ``retries`` times, from the state it left (a camera set down 2 cm too near
+    the edge is picked up and set down again; a door that sprang back is pushed again). The check is
+    the sub-task's own SuccessSpec, evaluated on the scene graph the robot perceives.
 
     With ``isolate`` (default) the execution runs in a fresh process: OMPL's random generator is
     process-global and seeded once, so a path planned in a process that has planned before depends on
@@ -154,11 +160,12 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
 
         with ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn")) as pool:
             return pool.submit(_execute_here, str(scene_dir), plan, seed, None if video_path is None else
-                               str(video_path), max_wall_s, sac_steps).result()
-    return _execute_here(scene_dir, plan, seed, video_path, max_wall_s, sac_steps)
+                               str(video_path), max_wall_s, sac_steps, retries).result()
+    return _execute_here(scene_dir, plan, seed, video_path, max_wall_s, sac_steps, retries)
 
 
-def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float, sac_steps: int) -> SkillResult:
+def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float, sac_steps: int,
+                  retries: int = 1) -> SkillResult:
     from anomalygen.learn.primitives import Driver
     from anomalygen.rng import item_rng
     from anomalygen.scene.graph import load_scene
@@ -185,21 +192,27 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
             results.append(SubTaskResult(id=st.id, method=st.method, success=False, detail="not executed: time budget spent"))
             continue
         s0 = drv.steps
-        if st.method == SkillMethod.SAC:
-            from anomalygen.learn.sac_subtask import run_sac_subtask
+        details: list[str] = []
+        for attempt in range(1, 2 + (retries if st.method == SkillMethod.PRIMITIVE else 0)):
+            if st.method == SkillMethod.SAC:
+                from anomalygen.learn.sac_subtask import run_sac_subtask
 
-            res = run_sac_subtask(drv, st, plan, steps=sac_steps, seed=seed)
-        else:
-            res = run_subtask(drv, st, plan)
-        drv.settle(10)
-        ok = res.success
-        detail = res.detail
-        if st.success.predicates:
-            preds = _evaluate(st.success.predicates, model, data, spec, plan.bindings)
-            ok = all(p.holds for p in preds)
-            detail += "; " + "; ".join(f"{p.call.name}: {'yes' if p.holds else 'no'}" for p in preds)
+                res = run_sac_subtask(drv, st, plan, steps=sac_steps, seed=seed)
+            else:
+                res = run_subtask(drv, st, plan)
+            drv.settle(10)
+            ok = res.success
+            detail = res.detail
+            if st.success.predicates:
+                preds = _evaluate(st.success.predicates, model, data, spec, plan.bindings)
+                ok = all(p.holds for p in preds)
+                detail += "; " + "; ".join(f"{p.call.name}: {'yes' if p.holds else 'no'}" for p in preds)
+            details.append(detail if attempt == 1 else f"attempt {attempt}: {detail}")
+            if ok or time.perf_counter() - t0 > max_wall_s:
+                break
         results.append(SubTaskResult(id=st.id, method=st.method, success=ok, steps=drv.steps - s0,
-                                     wall_s=round(time.perf_counter() - ts, 3), detail=detail))
+                                     wall_s=round(time.perf_counter() - ts, 3), detail=" | ".join(details),
+                                     attempts=attempt))
     drv.settle(25)
     final = _evaluate(plan.success.predicates, model, data, spec, plan.bindings)
     timings["execute_s"] = round(time.perf_counter() - t0 - timings["load_s"], 3)
