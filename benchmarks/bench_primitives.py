@@ -5,7 +5,7 @@ Runs the real pipeline through the CLI in a scratch run folder: ``brainstorm --e
 primitives solve (store / move an object, close a door, drawer or lid, pick up from the floor). Prints
 the table and one JSON line: per-class and overall success over all (task, seed) runs.
 
-    .venv/bin/python benchmarks/bench_primitives.py [--n 111] [--seeds 3] [--workers 2] [--out DIR]
+    .venv/bin/python benchmarks/bench_primitives.py [--n 111] [--seeds 3] [--workers 2] [--out DIR] [--retries K]
 """
 
 from __future__ import annotations
@@ -42,9 +42,12 @@ def main() -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=None, help="run folder (default: a temporary one)")
+    ap.add_argument("--retries", type=int, default=None, help="learn.retries (closed-loop redos; default: config's)")
     a = ap.parse_args()
     run = Path(a.out or tempfile.mkdtemp(prefix="bench_primitives_")) / "run"
     env = {**os.environ, "ANOMALYGEN_LEARN__VIDEO": "false"}
+    if a.retries is not None:
+        env["ANOMALYGEN_LEARN__RETRIES"] = str(a.retries)
     t0 = time.perf_counter()
     _cli("brainstorm", "--run", str(run), "--engine", "knowledge", "--n", str(a.n), "--seed", str(a.seed))
     tasks = [json.loads(line) for line in (run / "tasks.jsonl").read_text().splitlines() if line.strip()]
@@ -80,7 +83,7 @@ def main() -> int:
         "runs": n, "successes": s, "rate": round(s / max(n, 1), 3),
         "by_class": {hc: {"n": k, "success": ok} for hc, (k, ok) in sorted(by_class.items())},
         "build_s": round(t_learn - t_build, 1), "learn_s": round(t_end - t_learn, 1),
-        "total_s": round(t_end - t0, 1), "run": str(run),
+        "retries": env.get("ANOMALYGEN_LEARN__RETRIES", "config"), "total_s": round(t_end - t0, 1), "run": str(run),
     }))
     return 0
 
