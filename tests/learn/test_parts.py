@@ -317,6 +317,27 @@ def test_free_spot_misses_what_stands_on_the_table_and_keeps_off_the_edges(scene
     assert top - 0.02 < spot[2] < top  # at the top, to be lowered until it touches
 
 
+def test_the_torso_lift_rises_only_for_a_pose_the_lowered_arm_cannot_reach(scenes):
+    """A cup-down pose 0.15 m over the table is reached with the lift down; one 0.55 m over it (a lid
+    on a box on a counter) only with the lift up, and the cup then really gets there."""
+    from anomalygen.learn.ik import quat_z_to
+    from anomalygen.scene import robot
+
+    drv = _driver(scenes, "box")
+    down = quat_z_to(np.array([0.0, 0.0, -1.0]))
+    lo, hi = drv.aabb(scenes["box"][1].bindings["$support"])
+    low = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 0.15])
+    high = low + np.array([0.0, 0.0, 0.4])
+    assert drv.place_base_near(low, reach_poses=[(low, down)]) and drv.reaches
+    assert robot.lift(drv.model) == 0.0
+    assert not drv._reaches([(high, down)])  # the lowered arm cannot put the cup there
+    assert drv.place_base_near(high, reach_poses=[(high, down)]) and drv.reaches
+    assert robot.lift(drv.model) > 0.1
+    assert drv.reach_planned((high,), down)  # IK + a planned joint path, as the primitives move
+    drv.settle(20)
+    assert np.linalg.norm(drv.site - high) < 0.02 and drv.cup_down(0.95)
+
+
 def test_free_spot_for_an_object_that_keeps_its_orientation(scenes):
     """A square object is set down as it hangs (turning it only swings it): the spot is chosen for
     its present box, which here lies across the table's long side."""

@@ -66,3 +66,20 @@ def test_suction_grabs_only_when_touching_and_carries_the_object():
     mujoco.mj_step(model, data, nstep=1000)
     assert data.body("box_0").xpos[2] < 0.05  # dropped back to the floor
     assert robot.held_object(model, data) is None
+
+
+def test_torso_lift_raises_the_arm_rigidly():
+    """``set_lift`` carries the whole arm up by its value, and it stays there while the arm's
+    actuators hold the pose; ``set_home`` lowers it again, where the arm reaches the floor."""
+    model, data = _robot_with_box()
+    assert robot.lift(model) == 0.0
+    z0 = float(data.site("suction_site").xpos[2])
+    assert robot.set_lift(model, data, 1.0) == robot.LIFT_MAX  # clipped to the column's travel
+    assert abs(float(data.site("suction_site").xpos[2]) - z0 - robot.LIFT_MAX) < 1e-9
+    mujoco.mj_step(model, data, nstep=500)
+    assert abs(float(data.site("suction_site").xpos[2]) - z0 - robot.LIFT_MAX) < 0.01
+    assert model.geom("torso_column").id in set(robot.robot_geom_ids(model).tolist())
+    robot.set_home(model, data, (0.0, 0.0, 0.0))
+    mujoco.mj_forward(model, data)
+    assert robot.lift(model) == 0.0 and abs(float(data.site("suction_site").xpos[2]) - z0) < 1e-6
+    assert model.nu == len(robot.ROBOT_JOINTS)  # no new actuator: envs see the same robot

@@ -99,6 +99,7 @@ def push_joint(env_like, joint: str, goal: float, point_site: str, *, tol: float
 
 PRE_CONTACT = 0.03  # metres off the surface before the straight approach along the normal
 BASE_REACH = (0.55, 0.45, 0.65, 0.75)  # base-to-target horizontal distances tried, in order
+LIFT_LEVELS = (0.0, 0.15, 0.3)  # torso lift heights tried, lowest first (robot.LIFT_MAX is the top)
 
 
 class Driver:
@@ -244,8 +245,9 @@ class Driver:
         Candidates: rings of 24 headings at each distance in ``reach``, tried nearest-to-current first;
         with ``side`` (a horizontal direction from the point), only poses on that side (within 70 deg).
         With ``reach_poses`` ((pos, quat) pairs) a pose must also let the arm reach each of them by IK
-        (else the first free pose is taken). A held object is carried rigidly with the base. Returns
-        False (base unchanged) if none is free.
+        (else the first free pose is taken); the torso lift stays down unless only a raised arm
+        reaches them (a lid on a box on a counter), then it rises in steps. A held object is carried
+        rigidly with the base. Returns False (base unchanged) if none is free.
         """
         import mujoco
 
@@ -257,28 +259,32 @@ class Driver:
         sd = None if side is None else np.asarray(side, dtype=float)[:2] / (np.linalg.norm(np.asarray(side)[:2]) + 1e-9)
         on_side = (lambda b: True) if sd is None else (
             lambda b: float(np.dot(b - p[:2], sd)) > 0.34 * float(np.linalg.norm(b - p[:2])))
-        if np.hypot(*(p[:2] - cur[:2])) < 0.62 and self._facing(cur, p) and on_side(cur[:2]):
+        lift0 = robot.lift(m)
+        if (np.hypot(*(p[:2] - cur[:2])) < 0.62 and self._facing(cur, p) and on_side(cur[:2])
+                and (lift0 < 0.01 or reach_poses) and self._reaches(reach_poses)):
             return True
         saved = (d.qpos.copy(), d.qvel.copy(), d.mocap_pos.copy(), d.mocap_quat.copy())
         held = self.held
         hb = self.body_id(held) if held else -1
         hq = m.jnt_qposadr[m.body_jntadr[hb]] if held and m.body_jntadr[hb] >= 0 else -1
-        for r in reach:
-            angles = self.ring_offset + np.linspace(0, 2 * np.pi, 24, endpoint=False)
-            cands = [b for b in (p[:2] + r * np.array([np.cos(a), np.sin(a)]) for a in angles) if on_side(b)]
-            cands.sort(key=lambda b: float(np.hypot(*(b - cur[:2]))))
-            for b in cands:
-                yaw = float(np.arctan2(p[1] - b[1], p[0] - b[0]))
-                self._move_base_rigid(cur, np.array([b[0], b[1], yaw]), saved, hq)
-                mujoco.mj_forward(m, d)
-                if not self._robot_in_collision() and self._reaches(reach_poses):
-                    for j, v in zip(robot.BASE_JOINTS, (b[0], b[1], yaw), strict=True):
-                        d.actuator(j).ctrl[0] = v
-                    d.qvel[:] = 0.0
-                    self.settle(10)
-                    self.reaches = True
-                    return True
+        for lift in LIFT_LEVELS if reach_poses else LIFT_LEVELS[:1]:
+            for r in reach:
+                angles = self.ring_offset + np.linspace(0, 2 * np.pi, 24, endpoint=False)
+                cands = [b for b in (p[:2] + r * np.array([np.cos(a), np.sin(a)]) for a in angles) if on_side(b)]
+                cands.sort(key=lambda b: float(np.hypot(*(b - cur[:2]))))
+                for b in cands:
+                    yaw = float(np.arctan2(p[1] - b[1], p[0] - b[0]))
+                    self._move_base_rigid(np.array([*cur, lift0]), np.array([b[0], b[1], yaw, lift]), saved, hq)
+                    mujoco.mj_forward(m, d)
+                    if not self._robot_in_collision() and self._reaches(reach_poses):
+                        for j, v in zip(robot.BASE_JOINTS, (b[0], b[1], yaw), strict=True):
+                            d.actuator(j).ctrl[0] = v
+                        d.qvel[:] = 0.0
+                        self.settle(10)
+                        self.reaches = True
+                        return True
         d.qpos[:], d.qvel[:], d.mocap_pos[:], d.mocap_quat[:] = saved
+        robot.set_lift(m, d, lift0)
         mujoco.mj_forward(m, d)
         if tuck and self.tuck():  # an outstretched arm collides everywhere: fold it in and try again
             return self.place_base_near(point, reach=reach, side=side, tuck=False, reach_poses=reach_poses)
@@ -320,7 +326,8 @@ class Driver:
         return abs((want - base[2] + np.pi) % (2 * np.pi) - np.pi) < 0.6
 
     def _move_base_rigid(self, cur, new, saved, hq) -> None:
-        """Set base joints to ``new`` and carry the mocap target (and a held object) rigidly along."""
+        """Set the base joints and torso lift to ``new`` (x, y, yaw, lift) and carry the mocap target
+        (and a held object) rigidly along."""
         import mujoco
 
         from anomalygen.scene import robot
@@ -328,14 +335,15 @@ class Driver:
         d = self.data
         qpos0, _, mpos0, mquat0 = saved
         d.qpos[:] = qpos0
-        for j, v in zip(robot.BASE_JOINTS, new, strict=True):
+        for j, v in zip(robot.BASE_JOINTS, new[:3], strict=True):
             d.joint(j).qpos[0] = v
+        robot.set_lift(self.model, d, new[3])
         dyaw = new[2] - cur[2]
         c, s = np.cos(dyaw), np.sin(dyaw)
         rz = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
         qz = np.array([np.cos(dyaw / 2), 0, 0, np.sin(dyaw / 2)])
-        base0 = np.array([cur[0], cur[1], 0.0])
-        base1 = np.array([new[0], new[1], 0.0])
+        base0 = np.array([cur[0], cur[1], cur[3]])
+        base1 = np.array([new[0], new[1], new[3]])
 
         def carry(pos, quat):
             q = np.zeros(4)
@@ -697,9 +705,11 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     below = drv.site[2] - olo[2]  # cup face to object bottom
     # carry face-down, or as held for a side grasp (turning the cup would turn the object over)
     quat = quat_z_to(np.array([0.0, 0.0, -1.0])) if face_down else drv.data.mocap_quat[drv._mocap].copy()
-    carry_z = max(drv.site[2], goal[2] + below + 0.1)
-    drv.goto(np.array([*drv.site[:2], carry_z]), quat, max_steps=150)
     lo, hi = opening(drv, region) if into else top_rect(drv, region)
+    # carried high enough that the object's bottom clears the container's rim (a box on a counter is
+    # deeper than the 0.1 m above its floor that the set-down point gives)
+    carry_z = max(drv.site[2], goal[2] + below + 0.1, hi[2] + below + 0.05)
+    drv.goto(np.array([*drv.site[:2], carry_z]), quat, max_steps=150)
     want = 0.0 if hi[0] - lo[0] >= hi[1] - lo[1] else np.pi / 2
     turn = (want - yaw + np.pi / 2) % np.pi - np.pi / 2 if turning else 0.0
     final = _yawed(quat, turn)

@@ -8,13 +8,16 @@ paper) and rename joints to plain ``panda_joint1..7``.
 
 Why a mobile base: household hazards lie on the floor, on counters and on shelves across a room; a
 fixed arm reaches none of that. Three joints (``base_x``, ``base_y`` slide, ``base_yaw`` hinge) move
-the base on the floor, with position actuators of the same names.
+the base on the floor, with position actuators of the same names. Why a torso lift (body ``torso``
+under the arm, as on Fetch, TIAGo or Stretch): with the arm's shoulder at counter height the cup
+cannot reach, face-down, the lid of a box that stands on a 0.9 m counter; raised by up to
+``LIFT_MAX`` it can. It rests at 0, where the arm reaches the floor; ``set_lift`` moves it.
 
 Names other stages rely on (see docs/scene.md):
 
 * joints ``base_x base_y base_yaw panda_joint1 .. panda_joint7`` (``ROBOT_JOINTS``), each with a
   position actuator of the same name (``ctrl`` = target joint value);
-* bodies ``base``, ``panda_link0 .. panda_link7``, ``suction`` (the cup);
+* bodies ``base``, ``torso`` (carried by the lift), ``panda_link0 .. panda_link7``, ``suction`` (the cup);
 * sites ``ee_site`` (tool frame, z axis pointing out of the cup) and ``suction_site`` (cup face);
 * mocap body ``ee_target`` and weld ``ee_track`` (inactive unless the Gymnasium env drives the arm
   by end-effector deltas);
@@ -43,11 +46,12 @@ ROBOT_JOINTS = BASE_JOINTS + ARM_JOINTS
 # (found by forward kinematics; tests check it): tucked and above counter height, so the base can
 # drive up to tables and counters without the arm hitting them.
 HOME_ARM = (0.0, -0.5, 0.0, -1.55, 0.0, -0.55, -0.785)
-BASE_HEIGHT = 0.30  # top of the mobile base, where the arm's link0 stands
+BASE_HEIGHT = 0.30  # top of the mobile base, where the arm's link0 stands with the lift down
+LIFT_MAX = 0.30  # metres the torso lift raises the arm
 BASE_RADIUS = 0.22
 SUCTION_RANGE = 0.012  # metres: how far from the cup face an object may be and still be grabbed
 SUCTION_PREFIX = "suction__"
-ROBOT_BODY_PREFIXES = ("base", "panda_", "suction", "ee_target")
+ROBOT_BODY_PREFIXES = ("base", "torso", "panda_", "suction", "ee_target")
 # Arm position gains from the source actuator.xml (kp and force limits of each joint).
 _ARM_GAINS = ((870, 87), (870, 87), (870, 87), (870, 87), (120, 12), (120, 12), (120, 12))
 
@@ -103,7 +107,7 @@ def _arm_xml() -> str:
     chain = chain.replace('<body name="panda_link0"', f'<body name="panda_link0" pos="0 0 {BASE_HEIGHT}"', 1)
     return (
         f'<mujoco model="panda"><compiler angle="radian" meshdir="{root / "meshes"}"/>'
-        f'{assets}<worldbody><body name="base">{chain}</body></worldbody></mujoco>'
+        f'{assets}<worldbody><body name="base"><body name="torso">{chain}</body></body></worldbody></mujoco>'
     )
 
 
@@ -145,6 +149,20 @@ def build_robot_spec(base_xyyaw=(0.0, 0.0, 0.0)) -> mujoco.MjSpec:
         pos=[0, 0, BASE_HEIGHT / 2 + 0.005],
         rgba=[0.25, 0.27, 0.3, 1],
         mass=40.0,
+    )
+    # The torso the arm stands on. The lift moves it kinematically (``set_lift`` edits its model
+    # position, as the primitives place the base): a lift joint driven by an actuator gave way by
+    # 2 cm under the end-effector weld's forces and changed every Gymnasium env's dynamics.
+    torso = spec.body("torso")
+    torso.add_geom(
+        name="torso_column",
+        type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+        size=[0.075, (LIFT_MAX - 0.02) / 2, 0],
+        pos=[0, 0, BASE_HEIGHT - (LIFT_MAX - 0.02) / 2],
+        rgba=[0.25, 0.27, 0.3, 1],
+        mass=0.0,
+        contype=0,
+        conaffinity=0,
     )
     for body in spec.bodies:
         if body.name.startswith("panda_"):
@@ -233,8 +251,27 @@ def set_home(model: mujoco.MjModel, data: mujoco.MjData, base_xyyaw=None) -> Non
     if base_xyyaw is not None:
         for name, value in zip(BASE_JOINTS, base_xyyaw, strict=True):
             data.joint(name).qpos[0] = value
+    set_lift(model, data, 0.0)
     for name in BASE_JOINTS:
         data.actuator(name).ctrl[0] = data.joint(name).qpos[0]
+
+
+def lift(model: mujoco.MjModel) -> float:
+    """How far the torso lift has raised the arm (metres)."""
+    return float(model.body("torso").pos[2])
+
+
+def set_lift(model: mujoco.MjModel, data: mujoco.MjData, value: float) -> float:
+    """Raise the arm by ``value`` (clipped to 0..LIFT_MAX) and update the kinematics; returns the value.
+
+    Kinematic, like the primitives' base placement: the lift is set between motions, never while the
+    arm pushes on something. It lives in the model, so it applies to every MjData of that model."""
+    import mujoco
+
+    value = float(np.clip(value, 0.0, LIFT_MAX))
+    model.body("torso").pos[2] = value
+    mujoco.mj_kinematics(model, data)
+    return value
 
 
 def enable_ee_tracking(model: mujoco.MjModel, data: mujoco.MjData) -> int:
