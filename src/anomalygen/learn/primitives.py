@@ -512,14 +512,30 @@ def release(drv: Driver) -> PrimitiveResult:
     return PrimitiveResult(held is not None, drv.steps - s0, f"released {held}" if held else "nothing held")
 
 
+def _opened_drawer(drv: Driver, region: str) -> str | None:
+    """The drawer joint that ``open_for_access`` pulled out of ``region``, if any."""
+    from anomalygen.learn import parts
+
+    return next((j for j in drv.opened.get(region, []) if drv.model.jnt_type[drv.model.joint(j).id] == parts.SLIDE),
+                None)
+
+
+def _rim_z(drv: Driver, region: str) -> float:
+    """Height the bottom of an object carried into ``region`` must clear: the top of the drawer pulled
+    out of it, else the top of its opening."""
+    drawer = _opened_drawer(drv, region)
+    if drawer is not None:
+        return float(drv.aabb(drv.model.body(int(drv.model.joint(drawer).bodyid[0])).name)[1][2])
+    return float(opening(drv, region)[1][2])
+
+
 def _drop_point(drv: Driver, region: str, obj: str) -> np.ndarray:
     """Where to hold the object's bottom before release: above the opening of the container's carcass
     (an open lid's own box does not count), inside an opened drawer's exposed part, or above the
     centre of a support's top."""
     from anomalygen.learn import parts
 
-    drawer = next((j for j in drv.opened.get(region, []) if drv.model.jnt_type[drv.model.joint(j).id] == parts.SLIDE),
-                  None)
+    drawer = _opened_drawer(drv, region)
     if drawer is not None:
         body = drv.model.body(int(drv.model.joint(drawer).bodyid[0])).name
         dlo, dhi = drv.aabb(body)
@@ -708,7 +724,8 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     lo, hi = opening(drv, region) if into else top_rect(drv, region)
     # carried high enough that the object's bottom clears the container's rim (a box on a counter is
     # deeper than the 0.1 m above its floor that the set-down point gives)
-    carry_z = max(drv.site[2], goal[2] + below + 0.1, hi[2] + below + 0.05)
+    rim = _rim_z(drv, region) if into else hi[2]
+    carry_z = max(drv.site[2], goal[2] + below + 0.1, rim + below + 0.05)
     drv.goto(np.array([*drv.site[:2], carry_z]), quat, max_steps=150)
     want = 0.0 if hi[0] - lo[0] >= hi[1] - lo[1] else np.pi / 2
     turn = (want - yaw + np.pi / 2) % np.pi - np.pi / 2 if turning else 0.0
