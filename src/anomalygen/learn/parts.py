@@ -367,7 +367,7 @@ def static_box(drv, obj: str) -> tuple[np.ndarray, np.ndarray]:
 def best_drawer(drv, obj: str, drawers: list):
     """The drawer to put things in: the highest one whose top is within the arm's comfortable band."""
     def top(js) -> float:
-        return float(drv.aabb(drv.model.body(int(drv.model.joint(js.name).bodyid[0])).name)[1][2])
+        return float(drv.aabb(drv.joint_body(js.name))[1][2])
 
     ok = [js for js in drawers if 0.2 < top(js) < 1.15]
     return max(ok or drawers, key=top) if (ok or drawers) else None
@@ -376,9 +376,7 @@ def best_drawer(drv, obj: str, drawers: list):
 def compartment_behind(drv, obj: str, js) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(lo, hi, outward normal) of the space behind a shut door: the door's face extent, as deep as
     the carcass reaches behind it."""
-    m = drv.model
-    body = m.body(int(m.joint(js.name).bodyid[0])).name
-    dlo, dhi = drv.aabb(body)
+    dlo, dhi = drv.aabb(drv.joint_body(js.name))
     clo, chi = static_box(drv, obj)
     g = grasp_candidates(drv, js.name, js.closed_value)[0]
     n = _world(drv, g)[1]

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from anomalygen.scene.robot import LIFT_MAX
+
 
 @dataclass
 class PrimitiveResult:
@@ -99,7 +101,7 @@ def push_joint(env_like, joint: str, goal: float, point_site: str, *, tol: float
 
 PRE_CONTACT = 0.03  # metres off the surface before the straight approach along the normal
 BASE_REACH = (0.55, 0.45, 0.65, 0.75)  # base-to-target horizontal distances tried, in order
-LIFT_LEVELS = (0.0, 0.15, 0.3)  # torso lift heights tried, lowest first (robot.LIFT_MAX is the top)
+LIFT_LEVELS = (0.0, LIFT_MAX / 2, LIFT_MAX)  # torso lift heights tried, lowest first
 
 
 class Driver:
@@ -200,6 +202,10 @@ class Driver:
         import mujoco
 
         return mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name)
+
+    def joint_body(self, joint: str) -> str:
+        """Name of the body a joint moves (a drawer's box, a door's panel)."""
+        return self.model.body(int(self.model.joint(joint).bodyid[0])).name
 
     def aabb(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """World AABB of all geoms of body ``name`` and its descendants (collision geoms first)."""
@@ -525,7 +531,7 @@ def _rim_z(drv: Driver, region: str) -> float:
     out of it, else the top of its opening."""
     drawer = _opened_drawer(drv, region)
     if drawer is not None:
-        return float(drv.aabb(drv.model.body(int(drv.model.joint(drawer).bodyid[0])).name)[1][2])
+        return float(drv.aabb(drv.joint_body(drawer))[1][2])
     return float(opening(drv, region)[1][2])
 
 
@@ -537,8 +543,7 @@ def _drop_point(drv: Driver, region: str, obj: str) -> np.ndarray:
 
     drawer = _opened_drawer(drv, region)
     if drawer is not None:
-        body = drv.model.body(int(drv.model.joint(drawer).bodyid[0])).name
-        dlo, dhi = drv.aabb(body)
+        dlo, dhi = drv.aabb(drv.joint_body(drawer))
         clo, chi = parts.static_box(drv, region)
         axis = np.abs(drv.data.xaxis[drv.model.joint(drawer).id])
         k = int(np.argmax(axis[:2]))
@@ -747,7 +752,7 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     _let_swing_die(drv, obj)
     below = drv.site[2] - drv.aabb(obj)[0][2]  # again: the swing and the turn change how the object hangs
     low = np.array([low[0], low[1], goal[2] + below])
-    # aim the object, not the cup: held by its side, a globe's centre is a radius away from the cup
+    # correct what is left of the object's offset from the spot (the base pose only approximates it)
     for _ in range(2):
         olo, ohi = drv.aabb(obj)
         err = goal[:2] - (olo[:2] + ohi[:2]) / 2
