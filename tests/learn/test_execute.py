@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from anomalygen.schema import Plan, SkillResult
+from support.kb_scenes import build_with_kb_plans
 
 
 def make_task(task_id, hazard_class, target, hazard, placement, *, articulations=(), room="kitchen", container=None):
@@ -28,17 +29,8 @@ TASKS = {
 
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
-    """Scenes built with the scene stage and their KB plans (building costs about a second each)."""
-    from anomalygen.config import Settings
-    from anomalygen.learn.planner import plan_from_kb
-    from anomalygen.scene.build import build_scene
-
-    root = tmp_path_factory.mktemp("learn_scenes")
-    out = {}
-    for key, task in TASKS.items():
-        spec = build_scene(task, seed=0, settings=Settings(build={"clutter": 1}), out_dir=root / key)
-        out[key] = (root / key, plan_from_kb(task.id, task.hazard_class, dict(spec.bindings), spec=spec), spec)
-    return out
+    """Scenes built with the scene stage and their KB plans: {key: (folder, SceneSpec, Plan)}."""
+    return build_with_kb_plans(TASKS, tmp_path_factory.mktemp("learn_scenes"), clutter=1)
 
 
 def _joint(scene_dir, name):
@@ -53,7 +45,7 @@ def test_fridge_door_gets_closed(built, tmp_path):
     from anomalygen.learn.execute import execute_plan
     from anomalygen.runfolder import read_model, write_model
 
-    scene_dir, plan, spec = built["fridge"]
+    scene_dir, spec, plan = built["fridge"]
     fridge = next(o for o in spec.objects if o.asset.category == "Refrigerator")
     before = {j.name: _joint(scene_dir, j.name) for j in fridge.joint_states if j.label == "door"}
     assert max(abs(v) for v in before.values()) > 0.3, "the test scene should start with a door open"
@@ -75,7 +67,7 @@ def test_litter_is_picked_off_the_floor_into_the_bucket(built):
     from anomalygen.learn.execute import execute_plan
     from anomalygen.scene.graph import load_scene
 
-    scene_dir, plan, spec = built["litter"]
+    scene_dir, spec, plan = built["litter"]
     hazard = spec.bindings["$hazard"]
     _, d0, _ = load_scene(scene_dir)
     z0 = float(d0.body(hazard).xpos[2])
@@ -99,7 +91,7 @@ def test_non_primitive_subtasks_are_reported_not_executed(built):
     from anomalygen.learn.execute import execute_plan
     from anomalygen.schema import SkillMethod
 
-    scene_dir, plan, _ = built["fridge"]
+    scene_dir, _, plan = built["fridge"]
     sac_plan = plan.model_copy(update={"subtasks": [plan.subtasks[0].model_copy(update={"method": SkillMethod.SAC})]})
     res = execute_plan(scene_dir, sac_plan, seed=0)
     assert not res.success and not res.subtasks[0].success
@@ -108,7 +100,7 @@ def test_non_primitive_subtasks_are_reported_not_executed(built):
 
 
 def test_plan_type_round_trips(built):
-    _, plan, _ = built["fridge"]
+    _, _, plan = built["fridge"]
     assert Plan.model_validate_json(plan.model_dump_json()) == plan
 
 
@@ -120,7 +112,7 @@ def test_a_subtask_whose_check_fails_is_run_again(built):
     from anomalygen.learn.execute import execute_plan
     from anomalygen.schema import PredicateCall, SuccessSpec
 
-    scene_dir, plan, _ = built["litter"]
+    scene_dir, _, plan = built["litter"]
     never = SuccessSpec(predicates=[PredicateCall(name="height_above_floor", args={"object": "$hazard", "min": 3.0})])
     move = plan.subtasks[1].model_copy(update={"success": never})
     plan = plan.model_copy(update={"subtasks": [plan.subtasks[0], move]})

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from anomalygen.schema import TaskProposal
+from support.kb_scenes import build_with_kb_plans
 
 
 def _task(task_id, hazard_class, target, hazard, placement, *, container=None, articulations=()) -> TaskProposal:
@@ -39,16 +40,7 @@ TASKS = {
 
 @pytest.fixture(scope="module")
 def scenes(tmp_path_factory):
-    from anomalygen.config import Settings
-    from anomalygen.learn.planner import plan_from_kb
-    from anomalygen.scene.build import build_scene
-
-    root = tmp_path_factory.mktemp("parts_scenes")
-    out = {}
-    for key, task in TASKS.items():
-        spec = build_scene(task, seed=0, settings=Settings(build={"clutter": 2}), out_dir=root / key)
-        out[key] = (root / key, spec, plan_from_kb(task.id, task.hazard_class, dict(spec.bindings), spec=spec))
-    return out
+    return build_with_kb_plans(TASKS, tmp_path_factory.mktemp("parts_scenes"), clutter=2)
 
 
 def _driver(scenes, key, seed=0):
