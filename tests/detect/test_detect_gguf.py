@@ -7,7 +7,6 @@ import time
 import detect_graphs as g
 import pytest
 
-pytest.importorskip("llama_cpp")
 
 
 @pytest.mark.slow

@@ -312,7 +312,6 @@ def test_plan_stage_llm_engine_without_an_llm_says_so(tmp_path):
 @pytest.mark.slow
 @pytest.mark.gguf
 def test_plan_stage_on_the_bundled_gguf_ends_each_item_cleanly(tmp_path):
-    pytest.importorskip("llama_cpp")
     from anomalygen.config import LLMConfig
 
     run = _run(tmp_path)

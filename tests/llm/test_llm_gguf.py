@@ -9,7 +9,6 @@ from typer.testing import CliRunner
 
 from anomalygen.schema import TaskProposal
 
-pytest.importorskip("llama_cpp")
 
 
 @pytest.mark.slow
@@ -36,3 +35,93 @@ def test_llamacpp_cli_ask_returns_schema_valid_task_proposal(tmp_path, monkeypat
     assert again.exit_code == 0, again.output
     assert TaskProposal.model_validate_json(again.stdout) == proposal
     assert "requests=0" in again.stderr and "1hit" in again.stderr
+
+
+# --------------------------------------------------------------------------- the server child process
+
+FILLER = " ".join(f"Item {i}: a cup, a knife and a cable lie on the kitchen floor." for i in range(40))
+
+
+@pytest.fixture(scope="module")
+def gguf_backend():
+    from anomalygen.config import LLMConfig
+    from anomalygen.llm.backends.llamacpp_backend import LlamaCppBackend
+
+    backend = LlamaCppBackend(LLMConfig(backend="llamacpp", cache=False, n_ctx=2048))
+    yield backend
+    backend.close()
+
+
+@pytest.mark.slow
+@pytest.mark.gguf
+def test_every_artefact_schema_constrains_the_real_server(gguf_backend):
+    """llama.cpp builds a grammar from each bounded artefact schema and the first tokens obey it."""
+    from anomalygen.llm.backends import Request
+    from anomalygen.llm.schema_tools import bounded_schema
+    from anomalygen.schema import ARTEFACTS
+
+    for name, model in sorted(ARTEFACTS.items()):
+        schema = bounded_schema(model, max_string=80, max_items=2, required_only=False)
+        msgs = [{"role": "user", "content": f"Write a {name} as JSON."}]
+        reply = gguf_backend.complete_raw(Request(msgs, name, schema, 0.0, 0, 12))
+        assert reply.text.lstrip().startswith("{"), (name, reply.text)
+        assert reply.completion_tokens > 0
+
+
+@pytest.mark.slow
+@pytest.mark.gguf
+def test_a_server_killed_mid_request_fails_one_item_and_the_batch_goes_on(gguf_backend):
+    """A native crash (here SIGKILL while the prompt is evaluated) ends one item with a clear line; the
+    next request starts a fresh server and answers."""
+    import os
+    import signal
+    import threading
+
+    from anomalygen.config import LLMConfig
+    from anomalygen.llm import LLMItemError
+    from anomalygen.llm.client import LLMClient
+
+    config = LLMConfig(backend="llamacpp", cache=False, concurrency=1, max_tokens=24, http_retries=2)
+    client = LLMClient(config, gguf_backend, backoff_base_s=0.01)
+    server = gguf_backend.server
+    server.ensure_running()
+    starts_before, pid = server.starts, server.pid
+    log_offset = server._log_path.stat().st_size  # earlier tests' requests are in the log already
+
+    def kill_when_busy():
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            with open(server._log_path, "rb") as log:
+                log.seek(log_offset)
+                if b"processing task" in log.read():
+                    os.kill(pid, signal.SIGKILL)
+                    return
+            time.sleep(0.005)
+
+    killer = threading.Thread(target=kill_when_busy)
+    killer.start()
+    batch = [
+        [{"role": "user", "content": FILLER + " Which item is the most dangerous?"}],
+        [{"role": "user", "content": "Name one kitchen hazard."}],
+        [{"role": "user", "content": "Name one bathroom hazard."}],
+    ]
+    results = client.complete_many(batch, seed=0)
+    killer.join()
+    assert isinstance(results[0], LLMItemError)
+    message = str(results[0])
+    assert "crashed during this request (killed by SIGKILL)" in message and "\n" not in message
+    assert all(isinstance(r, str) and r.strip() for r in results[1:]), results
+    assert server.starts == starts_before + 1 and server.pid != pid and server.running
+    assert client.usage.requests == 2
+
+
+def test_a_model_file_that_cannot_load_fails_the_item_with_the_servers_words(tmp_path):
+    from anomalygen.config import LLMConfig
+    from anomalygen.llm import LLMItemError, get_client
+
+    bad = tmp_path / "broken.gguf"
+    bad.write_bytes(b"GGUF" + b"\0" * 64)
+    client = get_client(LLMConfig(backend="llamacpp", model_path=str(bad), cache=False, http_retries=0))
+    with pytest.raises(LLMItemError, match=r"the llama.cpp server for broken.gguf did not start \(exited"):
+        client.complete([{"role": "user", "content": "hi"}])
+    client.backend.close()

