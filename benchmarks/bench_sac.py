@@ -26,8 +26,8 @@ def main() -> None:
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
 
-    from anomalygen.learn.door_env import DoorCloseEnv
-    from anomalygen.learn.sac import train_sac
+    from anomalygen.rl.door_env import DoorCloseEnv
+    from anomalygen.rl.sac import train_sac
 
     t0 = time.perf_counter()
     _, res = train_sac(DoorCloseEnv, args.steps, seed=args.seed, eval_every=args.eval_every,

@@ -204,7 +204,7 @@ def plan(
     settings = _common(config, None, quiet, backend=backend, model=model,
                        **{"learn.plan_source": source, "learn.engine": engine})
     folder = _open_run(run)
-    fn = _stage("anomalygen.learn.plan_stage")
+    fn = _stage("anomalygen.plan.stage")
     _finish(fn(folder, settings, force=force, only=only), as_json)
 
 

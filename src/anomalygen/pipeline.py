@@ -23,7 +23,7 @@ STAGES: list[tuple[str, str]] = [
     ("brainstorm", "anomalygen.brainstorm.stage"),
     ("build", "anomalygen.scene.stage"),
     ("detect", "anomalygen.detect.stage"),
-    ("plan", "anomalygen.learn.plan_stage"),
+    ("plan", "anomalygen.plan.stage"),
     ("learn", "anomalygen.learn.stage"),
     ("evaluate", "anomalygen.evaluate.stage"),
     ("report", "anomalygen.evaluate.report"),

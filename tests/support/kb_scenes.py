@@ -6,7 +6,7 @@ from __future__ import annotations
 def build_with_kb_plans(tasks: dict, root, *, clutter: int) -> dict:
     """{key: (scene folder, SceneSpec, Plan)} for each TaskProposal in ``tasks``, built with seed 0."""
     from anomalygen.config import Settings
-    from anomalygen.learn.planner import plan_from_kb
+    from anomalygen.plan.planner import plan_from_kb
     from anomalygen.scene.build import build_scene
 
     out = {}

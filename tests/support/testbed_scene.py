@@ -1,4 +1,4 @@
-"""The learn test scene (``anomalygen.learn.testbed``), optionally with a box obstacle, for motion tests."""
+"""The learn test scene (``anomalygen.rl.testbed``), optionally with a box obstacle, for motion tests."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ def scene_with_obstacle(obstacle_at=None, half=0.03):
     ``half``-sized box obstacle centred at ``obstacle_at``."""
     import mujoco
 
-    from anomalygen.learn.testbed import build_spec
+    from anomalygen.rl.testbed import build_spec
     from anomalygen.scene.robot import set_home
 
     spec, _ = build_spec()

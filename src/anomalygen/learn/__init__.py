@@ -1,1 +1,1 @@
-"""learn stage."""
+"""learn stage: execute each plan with primitives, SAC or CEM and check success."""

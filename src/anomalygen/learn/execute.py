@@ -1,7 +1,7 @@
 """Run one plan on its built scene: each sub-task by its method, success checked on the scene graph.
 
-Primitive sub-tasks are executed by :mod:`anomalygen.learn.primitives` on one shared
-:class:`~anomalygen.learn.primitives.Driver`, so the state flows from one step to the next (a grasp
+Primitive sub-tasks are executed by :mod:`anomalygen.control.primitives` on one shared
+:class:`~anomalygen.control.primitives.Driver`, so the state flows from one step to the next (a grasp
 is followed by a move with the object still held). A sub-task succeeds when its SuccessSpec holds on
 ``scene_graph`` right after it (or, with an empty spec, when the primitive reports success); the task
 succeeds when the plan's SuccessSpec holds on the final, settled state. SAC sub-tasks are learned on
@@ -43,8 +43,8 @@ def _drive_joints(drv, st: SubTask, obj: str, prim: str, prm: dict):
     The planner names the object's first joint, but a fridge has a freezer and a main door and either
     may be the open one; the scene state says which to push, so the joints are re-chosen here.
     """
-    from anomalygen.learn import primitives as P
-    from anomalygen.learn.parts import actuate_part
+    from anomalygen.control import primitives as P
+    from anomalygen.control.parts import actuate_part
 
     label = _label_of(st, prm)
     opening = prim in ("pull", "open_joint")
@@ -94,7 +94,7 @@ def _closed_parts(drv, name: str) -> list[str]:
 
 def run_subtask(drv, st: SubTask, plan: Plan):
     """Execute one primitive sub-task on the driver; returns a PrimitiveResult."""
-    from anomalygen.learn import primitives as P
+    from anomalygen.control import primitives as P
 
     prm = dict(st.params)
     obj = str(prm.get("object", plan.bindings.get("$hazard", "")))
@@ -122,7 +122,7 @@ def run_subtask(drv, st: SubTask, plan: Plan):
             res.detail += f"; {region}'s {', '.join(shut)} closed and the plan did not open it"
         return res
     if prim in ("push", "pull") and prm.get("access"):  # open a container to put something in / shut it again
-        from anomalygen.learn import parts
+        from anomalygen.control import parts
 
         if prim == "pull":
             return parts.open_for_access(drv, obj, str(prm.get("part", "lid")).split("|"))
@@ -166,7 +166,7 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
 
 def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float, sac_steps: int,
                   retries: int = 1) -> SkillResult:
-    from anomalygen.learn.primitives import Driver
+    from anomalygen.control.primitives import Driver
     from anomalygen.rng import item_rng
     from anomalygen.scene.graph import load_scene
 
@@ -175,7 +175,7 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
     timings = {"load_s": round(time.perf_counter() - t0, 3)}
     rec = None
     if video_path is not None:
-        from anomalygen.learn.video import VideoRecorder
+        from anomalygen.control.video import VideoRecorder
 
         rec = VideoRecorder(model)
     drv = Driver(model, data, spec, rng=item_rng(seed, plan.task_id),
@@ -185,7 +185,7 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
         ts = time.perf_counter()
         if st.method == SkillMethod.CEM:
             results.append(SubTaskResult(id=st.id, method=st.method, success=False, detail=(
-                "not executed: CEM plans the motion of a legged robot (learn/cem.py, the Gymnasium Ant); "
+                "not executed: CEM plans the motion of a legged robot (rl/cem.py, the Gymnasium Ant); "
                 "household scenes carry the wheeled arm")))
             continue
         if time.perf_counter() - t0 > max_wall_s:
@@ -195,7 +195,7 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
         details: list[str] = []
         for attempt in range(1, 2 + (retries if st.method == SkillMethod.PRIMITIVE else 0)):
             if st.method == SkillMethod.SAC:
-                from anomalygen.learn.sac_subtask import run_sac_subtask
+                from anomalygen.rl.sac_subtask import run_sac_subtask
 
                 res = run_sac_subtask(drv, st, plan, steps=sac_steps, seed=seed)
             else:

@@ -31,7 +31,7 @@ class CollisionChecker:
 
         import mujoco
 
-        from anomalygen.learn.ik import joint_dofs
+        from anomalygen.control.ik import joint_dofs
         from anomalygen.scene.robot import robot_geom_ids
 
         self._mj = mujoco
@@ -159,7 +159,7 @@ def plan_path(model, data, joint_names, q_goal, *, time_limit: float = 2.0, seed
 def goal_from_pose(model, data, site: str, pos, quat=None, *, joint_names=None, seed: int = 0,
                    restarts: int = 5) -> np.ndarray | None:
     """Arm joint values putting ``site`` at ``pos`` (and ``quat``), by IK; None when IK fails."""
-    from anomalygen.learn.ik import joint_dofs, solve_ik
+    from anomalygen.control.ik import joint_dofs, solve_ik
     from anomalygen.scene.robot import ARM_JOINTS
 
     joint_names = list(joint_names or ARM_JOINTS)

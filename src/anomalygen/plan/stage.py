@@ -20,7 +20,7 @@ STAGE = "plan"
 
 
 def plan_item(task_id: str, payload: dict, ctx: StageContext) -> str:
-    from anomalygen.learn.planner import plan_from_kb
+    from anomalygen.plan.planner import plan_from_kb
 
     run, settings = ctx.run, ctx.settings
     spec = try_read_model(run.scene_dir(task_id) / "scene.json", SceneSpec)
@@ -50,7 +50,7 @@ def plan_item(task_id: str, payload: dict, ctx: StageContext) -> str:
 def _plan_with_llm(task_id: str, payload: dict, ctx: StageContext, hazard_class: str, bindings: dict[str, str],
                    spec: SceneSpec | None, hypothesis: dict | None) -> Plan:
     """The LLM engine for one item; its usage goes to the manifest whether or not the item succeeds."""
-    from anomalygen.learn.plan_llm import hazard_text_from_hypothesis, hazard_text_from_task, plan_from_llm
+    from anomalygen.plan.plan_llm import hazard_text_from_hypothesis, hazard_text_from_task, plan_from_llm
     from anomalygen.llm import record_usage, shared_client
 
     settings = ctx.settings

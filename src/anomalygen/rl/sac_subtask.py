@@ -7,9 +7,9 @@
    front of it, where suction can take hold), or above the object for object sub-tasks. These
    steps run on the Driver and show in the video. Before that, a closing reward about a part that
    is already closed is moved to the open part of the same object (:func:`retarget_joints`).
-2. Snapshot the Driver's full physics state and train SAC (:func:`~anomalygen.learn.sac.train_sac`,
+2. Snapshot the Driver's full physics state and train SAC (:func:`~anomalygen.rl.sac.train_sac`,
    paper settings, evaluation every ``min(steps, 1000)`` steps, stop at 90 % success) on
-   :class:`~anomalygen.learn.subtask_env.SubTaskEnv`, which owns copies of model and data.
+   :class:`~anomalygen.rl.subtask_env.SubTaskEnv`, which owns copies of model and data.
 3. Replay the best policy once, deterministically, on the Driver's own data from the snapshot,
    through the env's own ``control_step`` with ``drv.step`` as the physics advance (frameskip set
    to the env's 2 for the rollout), so the video hook records it and it behaves as in training.
@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from anomalygen.learn.primitives import PrimitiveResult
+from anomalygen.control.primitives import PrimitiveResult
 from anomalygen.schema import Plan, SubTask
 
 STANDOFF = 0.06  # m behind the part point, as push_part approaches
@@ -54,7 +54,7 @@ def retarget_joints(drv, st: SubTask) -> tuple[SubTask, str]:
     target is its joint's closed value and whose joint is already closed moves to the most open joint
     of the same object whose label the step's predicates (or ``part`` param) name.
     """
-    from anomalygen.learn.subtask_env import JOINT_TOL_FRACTION
+    from anomalygen.rl.subtask_env import JOINT_TOL_FRACTION
 
     if st.reward is None:
         return st, ""
@@ -90,7 +90,7 @@ def retarget_joints(drv, st: SubTask) -> tuple[SubTask, str]:
 
 def pre_position(drv, st: SubTask, plan: Plan, readout) -> str:
     """Bring base and cup to where the sub-task's contact happens; returns a note for the detail."""
-    from anomalygen.learn import primitives as P
+    from anomalygen.control import primitives as P
 
     joint_terms = [t for t in (st.reward.terms if st.reward else []) if t.kind == "joint"]
     if joint_terms:
@@ -133,8 +133,8 @@ def run_sac_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, thre
     ``result.steps`` counts the Driver's control steps (pre-positioning plus the rollout); the
     detail says the training budget, best evaluation success and what the rollout did.
     """
-    from anomalygen.learn.sac import train_sac
-    from anomalygen.learn.subtask_env import FRAMESKIP, HORIZON, SubTaskEnv, SubTaskReadout, control_step
+    from anomalygen.rl.sac import train_sac
+    from anomalygen.rl.subtask_env import FRAMESKIP, HORIZON, SubTaskEnv, SubTaskReadout, control_step
 
     if steps <= 0:
         return PrimitiveResult(False, 0, "not executed: sac_steps is 0")

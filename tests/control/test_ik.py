@@ -4,8 +4,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from anomalygen.learn.ik import quat_z_to, site_pose, solve_ik
-from anomalygen.learn.testbed import build
+from anomalygen.control.ik import quat_z_to, site_pose, solve_ik
+from anomalygen.rl.testbed import build
 from anomalygen.scene.robot import ARM_JOINTS
 
 

@@ -2,12 +2,12 @@
 
 RoboGen-style: a learned sub-task starts where the plan's previous steps left the robot, so the env
 is built from a full physics snapshot (``mj_getState(..., mjSTATE_INTEGRATION)``: qpos, qvel, ctrl,
-mocap pose, active welds, ...) of the :class:`~anomalygen.learn.primitives.Driver`'s data, and every
+mocap pose, active welds, ...) of the :class:`~anomalygen.control.primitives.Driver`'s data, and every
 ``reset`` restores it (plus +-2 cm noise on the end-effector target, drawn from ``np_random``). The
 env owns a copy of the model and its own MjData: suction rewrites the weld pose in ``model.eq_data``,
 and training must never touch the scene the Driver runs on.
 
-Paper settings, as in :mod:`~anomalygen.learn.door_env`: 7-D action (3 cm per step cup translation,
+Paper settings, as in :mod:`~anomalygen.rl.door_env`: 7-D action (3 cm per step cup translation,
 0.1 rad per step rotation in the cup frame, suction on when the last entry is > 0), horizon 100,
 frameskip 2. :func:`apply_action` is the one action mapping; ``run_sac_subtask`` replays the trained
 policy on the Driver's own data through it, so training and the recorded rollout behave the same.
@@ -37,7 +37,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from anomalygen.learn.reward import evaluate_spec
+from anomalygen.rl.reward import evaluate_spec
 from anomalygen.schema import RewardSpec, SceneSpec, SubTask
 
 HORIZON = 100
@@ -267,7 +267,7 @@ class SubTaskReadout:
         return self.goal_terms_hold(state)
 
     def goal_terms_hold(self, state: dict) -> tuple[bool, str]:
-        from anomalygen.learn.reward import box_of, position_of
+        from anomalygen.rl.reward import box_of, position_of
 
         checks, why = [], []
         for t in self.reward.terms:

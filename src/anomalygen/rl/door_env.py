@@ -21,7 +21,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from anomalygen.learn.reward import evaluate_spec
+from anomalygen.rl.reward import evaluate_spec
 from anomalygen.schema import RewardSpec, RewardTerm
 
 # Scales: the door term (~1 rad -> 0) dominates; the distance term keeps the cup on the handle's
@@ -42,7 +42,7 @@ class DoorCloseEnv(gym.Env):
                  near_start: bool = True, start_noise: float = 0.02, terminate_on_success: bool = True):
         import mujoco
 
-        from anomalygen.learn.testbed import build
+        from anomalygen.rl.testbed import build
 
         self._mj = mujoco
         tb = build(with_objects=False, door_open=open_range[1])
@@ -112,7 +112,7 @@ class DoorCloseEnv(gym.Env):
         d.joint("cabinet_0:door_hinge").qpos[0] = self.np_random.uniform(*self.open_range)
         mj.mj_forward(m, d)
         if self.near_start:
-            from anomalygen.learn.ik import site_pose, solve_ik
+            from anomalygen.control.ik import site_pose, solve_ik
 
             _, quat = site_pose(m, d, "ee_site")
             R = d.xmat[self._door_body].reshape(3, 3)

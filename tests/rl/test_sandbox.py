@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from anomalygen.learn.reward import evaluate_spec, spec_to_code
-from anomalygen.learn.sandbox import RewardCodeError, SandboxedReward, check_code
+from anomalygen.rl.reward import evaluate_spec, spec_to_code
+from anomalygen.rl.sandbox import RewardCodeError, SandboxedReward, check_code
 from anomalygen.schema import RewardSpec, RewardTerm
 
 CORPUS = json.loads((Path(__file__).parent / "data" / "bad_rewards.json").read_text())["cases"]

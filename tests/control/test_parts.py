@@ -44,7 +44,7 @@ def scenes(tmp_path_factory):
 
 
 def _driver(scenes, key, seed=0):
-    from anomalygen.learn.primitives import Driver
+    from anomalygen.control.primitives import Driver
     from anomalygen.scene.graph import load_scene
 
     m, d, spec = load_scene(scenes[key][0])
@@ -60,7 +60,7 @@ def _js(drv, obj: str, label: str):
 
 
 def _fraction(drv, js) -> float:
-    from anomalygen.learn.parts import _far
+    from anomalygen.control.parts import _far
 
     return abs(_q(drv, js.name) - js.closed_value) / abs(_far(js) - js.closed_value)
 
@@ -75,7 +75,7 @@ def oven_run(scenes):
     """Close the folded-down oven door with actuate_part, recording every suction activation."""
     import mujoco
 
-    from anomalygen.learn.parts import actuate_part
+    from anomalygen.control.parts import actuate_part
     from anomalygen.scene import robot
 
     drv = _driver(scenes, "oven")
@@ -158,7 +158,7 @@ def test_loose_objects_are_welded_by_their_massive_body(scenes):
 
 
 def test_shut_lid_is_opened_for_access_and_closed_again(scenes):
-    from anomalygen.learn.parts import close_opened, open_for_access
+    from anomalygen.control.parts import close_opened, open_for_access
 
     drv = _driver(scenes, "box")
     (lid,) = _js(drv, "storage_box_0", "lid")
@@ -179,7 +179,7 @@ def test_shut_lid_is_opened_for_access_and_closed_again(scenes):
 @pytest.fixture(scope="module")
 def drawer_run(scenes):
     """open_for_access on the shut cabinet, then close_opened: joint values after each."""
-    from anomalygen.learn.parts import close_opened, open_for_access
+    from anomalygen.control.parts import close_opened, open_for_access
 
     drv = _driver(scenes, "drawers")
     obj = scenes["drawers"][1].bindings["$container"]
@@ -200,7 +200,7 @@ def drawer_run(scenes):
 
 
 def test_cabinet_gets_exactly_one_drawer_chosen_the_highest_in_reach(drawer_run):
-    from anomalygen.learn.parts import SLIDE
+    from anomalygen.control.parts import SLIDE
 
     r = drawer_run
     assert len(r["drawers"]) >= 2 and r["shut_before"], "the test scene should offer a choice of shut drawers"
@@ -236,7 +236,7 @@ def _ray_down(drv, xy, z0) -> tuple[int, float]:
 
 
 def test_first_grasp_point_on_pliers_lies_over_the_pliers(scenes):
-    from anomalygen.learn.primitives import grasp_points
+    from anomalygen.control.primitives import grasp_points
     from anomalygen.scene import robot
 
     drv = _driver(scenes, "box")
@@ -271,8 +271,8 @@ def _footprint_clear(drv, spot, obj, support, *, turned=True):
 
     The footprint is the object's, turned to lie along the top's long side, as ``move_to`` sets down
     an elongated object; not ``turned``, the object's box as it lies now."""
-    from anomalygen.learn.parts import static_box
-    from anomalygen.learn.primitives import footprint, top_rect
+    from anomalygen.control.parts import static_box
+    from anomalygen.control.primitives import footprint, top_rect
 
     _, a, b = footprint(drv, obj)
     rlo, rhi = top_rect(drv, support)
@@ -294,7 +294,7 @@ def _footprint_clear(drv, spot, obj, support, *, turned=True):
 
 
 def test_free_spot_misses_what_stands_on_the_table_and_keeps_off_the_edges(scenes):
-    from anomalygen.learn.primitives import free_spot
+    from anomalygen.control.primitives import free_spot
 
     drv = _driver(scenes, "box")
     support = scenes["box"][1].bindings["$support"]
@@ -312,7 +312,7 @@ def test_free_spot_misses_what_stands_on_the_table_and_keeps_off_the_edges(scene
 def test_the_torso_lift_rises_only_for_a_pose_the_lowered_arm_cannot_reach(scenes):
     """A cup-down pose 0.15 m over the table is reached with the lift down; one 0.55 m over it (a lid
     on a box on a counter) only with the lift up, and the cup then really gets there."""
-    from anomalygen.learn.ik import quat_z_to
+    from anomalygen.control.ik import quat_z_to
     from anomalygen.scene import robot
 
     drv = _driver(scenes, "box")
@@ -335,7 +335,7 @@ def test_free_spot_for_an_object_that_keeps_its_orientation(scenes):
     its present box, which here lies across the table's long side."""
     import mujoco
 
-    from anomalygen.learn.primitives import free_spot
+    from anomalygen.control.primitives import free_spot
 
     drv = _driver(scenes, "box")
     support = scenes["box"][1].bindings["$support"]
@@ -358,7 +358,7 @@ def test_free_spot_for_an_object_that_keeps_its_orientation(scenes):
 def test_free_spot_prefers_a_clear_spot_over_the_edge_margin(scenes):
     """A bread loaf fills the middle of the side table: no spot keeps 0.2 m from the edges and misses
     it, so the pliers go to a clear spot nearer an edge rather than onto the loaf."""
-    from anomalygen.learn.primitives import free_spot
+    from anomalygen.control.primitives import free_spot
 
     drv = _driver(scenes, "box")
     side = next(o.support for o in drv.spec.objects if o.role == "clutter")
@@ -390,7 +390,7 @@ print(json.dumps(out))
 @pytest.fixture(scope="module")
 def fresh_runs(scenes, tmp_path_factory):
     """Both store plans executed in two fresh interpreters. OMPL's random generator is process-wide
-    (learn/arm_motion.py), so a run repeats exactly from a fresh process, not after other planning."""
+    (control/arm_motion.py), so a run repeats exactly from a fresh process, not after other planning."""
     from anomalygen.runfolder import write_model
 
     root = tmp_path_factory.mktemp("plans")

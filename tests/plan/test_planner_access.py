@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pytest
 
-from anomalygen.learn.planner import access_steps, closed_closures, plan_from_kb
+from anomalygen.plan.planner import access_steps, closed_closures, plan_from_kb
 from anomalygen.schema import (
     AssetRef,
     Engine,
@@ -156,7 +156,7 @@ def _task(tid: str, hazard_class: str, target: str) -> TaskProposal:
 
 def test_plan_stage_honours_settings_sac_actions(tmp_path):
     from anomalygen.config import Settings
-    from anomalygen.learn.plan_stage import run_stage
+    from anomalygen.plan.stage import run_stage
     from anomalygen.runfolder import RunFolder, read_model, write_jsonl, write_model
 
     run = RunFolder.create(tmp_path / "r")

@@ -47,7 +47,7 @@ class Monitor:
 
 
 def _driver(m, d):
-    from anomalygen.learn.primitives import Driver
+    from anomalygen.control.primitives import Driver
 
     drv = Driver(m, d, None)
     drv.settle(5)
@@ -56,7 +56,7 @@ def _driver(m, d):
 
 def _goal_joints(m, d, pos, quat):
     """The IK goal move_arm_planned starts from (first attempt: from the current joints)."""
-    from anomalygen.learn.ik import joint_dofs, solve_ik
+    from anomalygen.control.ik import joint_dofs, solve_ik
 
     qadr, _ = joint_dofs(m, ARM_JOINTS)
     res = solve_ik(m, d, "suction_site", ARM_JOINTS, pos, quat, q_init=d.qpos[qadr].copy())
@@ -65,8 +65,8 @@ def _goal_joints(m, d, pos, quat):
 
 
 def test_reaches_a_pose_above_the_table_without_contact_then_mocap_tracking_works():
-    from anomalygen.learn.arm_motion import move_arm_planned
-    from anomalygen.learn.ik import quat_z_to, site_pose
+    from anomalygen.control.arm_motion import move_arm_planned
+    from anomalygen.control.ik import quat_z_to, site_pose
 
     m, d = _scene()
     drv = _driver(m, d)
@@ -93,9 +93,9 @@ def test_reaches_a_pose_above_the_table_without_contact_then_mocap_tracking_work
 def test_goes_around_an_obstacle_on_the_straight_route():
     import mujoco
 
-    from anomalygen.learn.arm_motion import move_arm_planned
-    from anomalygen.learn.ik import quat_z_to
-    from anomalygen.learn.motion import CollisionChecker, interpolate
+    from anomalygen.control.arm_motion import move_arm_planned
+    from anomalygen.control.ik import quat_z_to
+    from anomalygen.control.motion import CollisionChecker, interpolate
 
     m0, d0 = _scene()
     target = d0.body("box_0").xpos + np.array([0.0, 0.0, 0.15])
@@ -121,8 +121,8 @@ def test_goes_around_an_obstacle_on_the_straight_route():
 
 
 def test_unreachable_target_moves_nothing():
-    from anomalygen.learn.arm_motion import move_arm_planned
-    from anomalygen.learn.ik import quat_z_to
+    from anomalygen.control.arm_motion import move_arm_planned
+    from anomalygen.control.ik import quat_z_to
 
     m, d = _scene()
     drv = _driver(m, d)
@@ -138,9 +138,9 @@ def test_unreachable_target_moves_nothing():
 
 
 def test_held_object_is_carried_and_checked():
-    from anomalygen.learn.arm_motion import CarryingChecker, move_arm_planned
-    from anomalygen.learn.ik import quat_z_to
-    from anomalygen.learn.primitives import grasp
+    from anomalygen.control.arm_motion import CarryingChecker, move_arm_planned
+    from anomalygen.control.ik import quat_z_to
+    from anomalygen.control.primitives import grasp
 
     m, d = _scene()
     drv = _driver(m, d)
@@ -160,8 +160,8 @@ def test_held_object_is_carried_and_checked():
     chk.valid(d.qpos[chk.qadr])
     assert np.linalg.norm(chk.data.body("box_0").xpos - d.body("box_0").xpos) < 0.005
     # ... and counts its contacts: cup face 3 cm above the table top (arm clear), box through it
-    from anomalygen.learn.ik import joint_dofs, solve_ik
-    from anomalygen.learn.motion import CollisionChecker
+    from anomalygen.control.ik import joint_dofs, solve_ik
+    from anomalygen.control.motion import CollisionChecker
 
     top = d.body("table_0").xpos + np.array([-0.05, 0.1, 0.40])
     ik = solve_ik(m, d, "suction_site", ARM_JOINTS, top + np.array([0.0, 0.0, 0.03]), quat_z_to(DOWN),
@@ -175,8 +175,8 @@ def test_held_object_is_carried_and_checked():
 def test_base_off_its_set_point_is_planned_for_where_it_settles():
     """A preceding move can leave the soft base servo centimetres off its set point; the cup must still
     land on the target (IK and path use the base at its set point)."""
-    from anomalygen.learn.arm_motion import move_arm_planned
-    from anomalygen.learn.ik import quat_z_to
+    from anomalygen.control.arm_motion import move_arm_planned
+    from anomalygen.control.ik import quat_z_to
 
     m, d = _scene()
     drv = _driver(m, d)
@@ -190,8 +190,8 @@ def test_base_off_its_set_point_is_planned_for_where_it_settles():
 
 
 def test_start_near_an_obstacle_shrinks_the_margin_start_touching_fails():
-    from anomalygen.learn.arm_motion import move_arm_planned
-    from anomalygen.learn.ik import quat_z_to
+    from anomalygen.control.arm_motion import move_arm_planned
+    from anomalygen.control.ik import quat_z_to
 
     m0, d0 = _scene()
     cup = d0.site("suction_site").xpos.copy()
@@ -210,7 +210,7 @@ def test_start_near_an_obstacle_shrinks_the_margin_start_touching_fails():
 
 
 def test_arm_gains_restored_exactly_as_compiled():
-    from anomalygen.learn.arm_motion import arm_gains_on
+    from anomalygen.control.arm_motion import arm_gains_on
     from anomalygen.scene.robot import enable_ee_tracking
 
     m, d = _scene()
@@ -224,9 +224,9 @@ def test_arm_gains_restored_exactly_as_compiled():
 
 def test_ik_goal_repeats_for_a_seed():
     """Same scene, same seed: the same IK goal (OMPL's path itself depends on the process's RNG history)."""
-    from anomalygen.learn.arm_motion import _ik_goal
-    from anomalygen.learn.ik import quat_z_to
-    from anomalygen.learn.motion import CollisionChecker
+    from anomalygen.control.arm_motion import _ik_goal
+    from anomalygen.control.ik import quat_z_to
+    from anomalygen.control.motion import CollisionChecker
 
     goals = []
     for _ in range(2):

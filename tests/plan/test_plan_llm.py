@@ -11,8 +11,8 @@ import json
 import pytest
 
 from anomalygen.config import load_settings
-from anomalygen.learn import plan_llm as P
-from anomalygen.learn.plan_stage import run_stage
+from anomalygen.plan import plan_llm as P
+from anomalygen.plan.stage import run_stage
 from anomalygen.llm import get_client
 from anomalygen.runfolder import RunFolder, read_model, write_jsonl, write_model
 from anomalygen.schema import (

@@ -43,10 +43,10 @@ def door_plan() -> tuple[SubTask, Plan]:
 
 def door_driver(q: float = 1.0, *, approach: bool = True):
     """The test scene (no table: the open door would swing into it) with the cup brought to the door."""
-    from anomalygen.learn.primitives import Driver
-    from anomalygen.learn.sac_subtask import pre_position
-    from anomalygen.learn.subtask_env import SubTaskReadout
-    from anomalygen.learn.testbed import build
+    from anomalygen.control.primitives import Driver
+    from anomalygen.rl.sac_subtask import pre_position
+    from anomalygen.rl.subtask_env import SubTaskReadout
+    from anomalygen.rl.testbed import build
 
     tb = build(with_objects=False, door_open=q)
     drv = Driver(tb.model, tb.data, door_spec(q), rng=np.random.default_rng(0))
@@ -59,7 +59,7 @@ def door_driver(q: float = 1.0, *, approach: bool = True):
 
 def _push_action(env_or_drv, data) -> np.ndarray:
     """A scripted closing push at the handle (3 cm/step towards 6 cm past it)."""
-    from anomalygen.learn import primitives as P
+    from anomalygen.control import primitives as P
 
     m = env_or_drv.model
     h = data.site_xpos[m.site("cabinet_0:door_handle").id]
@@ -78,8 +78,8 @@ def test_env_api_and_exact_reset(at_door):
     import mujoco
     from gymnasium.utils.env_checker import check_env
 
-    from anomalygen.learn.sac_subtask import snapshot
-    from anomalygen.learn.subtask_env import SubTaskEnv
+    from anomalygen.rl.sac_subtask import snapshot
+    from anomalygen.rl.subtask_env import SubTaskEnv
 
     drv, st, plan = at_door
     snap = snapshot(drv.model, drv.data)
@@ -112,9 +112,9 @@ def test_env_api_and_exact_reset(at_door):
 
 
 def test_reward_is_the_spec_on_the_state_and_success_ends_the_episode(at_door):
-    from anomalygen.learn.reward import evaluate_spec
-    from anomalygen.learn.sac_subtask import snapshot
-    from anomalygen.learn.subtask_env import SubTaskEnv
+    from anomalygen.rl.reward import evaluate_spec
+    from anomalygen.rl.sac_subtask import snapshot
+    from anomalygen.rl.subtask_env import SubTaskEnv
 
     drv, st, plan = at_door
     env = SubTaskEnv(drv.model, snapshot(drv.model, drv.data), drv.spec, st, plan.bindings)
@@ -142,8 +142,8 @@ def test_reward_is_the_spec_on_the_state_and_success_ends_the_episode(at_door):
 
 def test_env_and_driver_rollout_share_one_control_step(at_door):
     """The same actions from the same snapshot give bit-identical physics on the env and on the Driver."""
-    from anomalygen.learn.sac_subtask import restore, snapshot
-    from anomalygen.learn.subtask_env import SubTaskEnv, SubTaskReadout, control_step
+    from anomalygen.rl.sac_subtask import restore, snapshot
+    from anomalygen.rl.subtask_env import SubTaskEnv, SubTaskReadout, control_step
 
     drv, st, plan = at_door
     snap = snapshot(drv.model, drv.data)
@@ -164,9 +164,9 @@ def test_env_and_driver_rollout_share_one_control_step(at_door):
 
 
 def test_suction_action_grabs_and_releases():
-    from anomalygen.learn import primitives as P
-    from anomalygen.learn.subtask_env import apply_action, control_ids
-    from anomalygen.learn.testbed import build
+    from anomalygen.control import primitives as P
+    from anomalygen.rl.subtask_env import apply_action, control_ids
+    from anomalygen.rl.testbed import build
     from anomalygen.scene import robot
 
     tb = build(with_cabinet=False)
@@ -183,7 +183,7 @@ def test_suction_action_grabs_and_releases():
 
 
 def test_zero_budget_is_not_executed(at_door):
-    from anomalygen.learn.sac_subtask import run_sac_subtask
+    from anomalygen.rl.sac_subtask import run_sac_subtask
 
     drv, st, plan = at_door
     s0 = drv.steps
@@ -193,7 +193,7 @@ def test_zero_budget_is_not_executed(at_door):
 
 @pytest.mark.slow
 def test_run_sac_subtask_trains_and_replays_on_the_driver_deterministically():
-    from anomalygen.learn.sac_subtask import run_sac_subtask
+    from anomalygen.rl.sac_subtask import run_sac_subtask
 
     outs = []
     for _ in range(2):
@@ -218,9 +218,9 @@ def test_a_closing_reward_about_an_already_closed_part_moves_to_the_open_one(tmp
     from test_execute import TASKS
 
     from anomalygen.config import Settings
-    from anomalygen.learn.planner import plan_from_kb
-    from anomalygen.learn.primitives import Driver
-    from anomalygen.learn.sac_subtask import retarget_joints
+    from anomalygen.plan.planner import plan_from_kb
+    from anomalygen.control.primitives import Driver
+    from anomalygen.rl.sac_subtask import retarget_joints
     from anomalygen.scene.build import build_scene
     from anomalygen.scene.graph import load_scene
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from anomalygen.learn.door_env import DoorCloseEnv
+from anomalygen.rl.door_env import DoorCloseEnv
 
 
 def _scripted_close(env, seed):
@@ -35,7 +35,7 @@ def test_pushing_the_door_closes_it_and_the_reward_rises():
 
 @pytest.mark.slow
 def test_sac_keeps_the_best_success_checkpoint():
-    from anomalygen.learn.sac import train_sac
+    from anomalygen.rl.sac import train_sac
 
     model, res = train_sac(DoorCloseEnv, 200, eval_every=100, eval_episodes=1, learning_starts=50)
     assert [c["step"] for c in res.curve] == [0, 100, 200]
@@ -48,7 +48,7 @@ def test_sac_keeps_the_best_success_checkpoint():
 @pytest.mark.slow
 def test_sac_improves_the_evaluation_return_within_a_small_budget():
     """Same evaluation seeds before and after: the trained policy's mean return is clearly higher."""
-    from anomalygen.learn.sac import train_sac
+    from anomalygen.rl.sac import train_sac
 
     _, res = train_sac(DoorCloseEnv, 2000, seed=0, eval_every=1000, eval_episodes=4, learning_starts=500)
     initial = res.curve[0]["return"]

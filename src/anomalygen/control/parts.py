@@ -181,8 +181,8 @@ def _accessible(n_w: np.ndarray) -> bool:
 def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.02, attempts: int = 4,
                  max_steps: int = 900):
     """Hold the part by suction and lead it to ``goal``; re-grasp when it stops following."""
-    from anomalygen.learn.ik import quat_z_to
-    from anomalygen.learn.primitives import PRE_CONTACT, PrimitiveResult
+    from anomalygen.control.ik import quat_z_to
+    from anomalygen.control.primitives import PRE_CONTACT, PrimitiveResult
     from anomalygen.scene import robot
 
     m, d = drv.model, drv.data
@@ -409,7 +409,7 @@ def open_for_access(drv, obj: str, labels):
     Records what was opened in ``drv.opened[obj]`` (so the place step drops into an opened drawer
     and the close step shuts exactly these) and returns a PrimitiveResult.
     """
-    from anomalygen.learn.primitives import PrimitiveResult
+    from anomalygen.control.primitives import PrimitiveResult
 
     s0 = drv.steps
     lids = closure_joints(drv, obj, [lab for lab in labels if lab in LIDS])
@@ -453,7 +453,7 @@ def _falls_shut(drv, joint: str, closed: float) -> bool:
 
 def close_opened(drv, obj: str):
     """Shut the parts ``open_for_access`` opened on ``obj`` (hinged lids last-opened first)."""
-    from anomalygen.learn.primitives import PrimitiveResult
+    from anomalygen.control.primitives import PrimitiveResult
 
     s0 = drv.steps
     names = list(reversed(drv.opened.get(obj, [])))

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from anomalygen.learn.cem import CEMConfig, WalkToGoal, run_cem
+from anomalygen.rl.cem import CEMConfig, WalkToGoal, run_cem
 
 
 def test_ant_walks_to_goal_by_cem():

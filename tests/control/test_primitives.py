@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from anomalygen.learn.door_env import DoorCloseEnv
-from anomalygen.learn.primitives import joint_motion_direction, push_joint
+from anomalygen.rl.door_env import DoorCloseEnv
+from anomalygen.control.primitives import joint_motion_direction, push_joint
 
 
 @pytest.mark.parametrize("seed", [0, 1, 4])

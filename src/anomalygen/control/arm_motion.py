@@ -4,7 +4,7 @@ Why: the primitives' straight mocap lines sweep the arm through whatever lies be
 goal (a shelf board, a table edge). Here the arm instead goes to the goal configuration along a
 collision-checked joint-space path (``motion.plan_path``, OMPL BIT*), executed with real dynamics.
 
-How the arm is driven: a :class:`~anomalygen.learn.primitives.Driver` keeps the arm limp (zero
+How the arm is driven: a :class:`~anomalygen.control.primitives.Driver` keeps the arm limp (zero
 actuator gains) and pulls the cup with the ``ee_track`` weld. For the planned motion the weld is
 switched off and the arm's position actuators get back the gains the model was compiled with
 (``robot._ARM_GAINS``); the path's waypoints become the actuators' ``ctrl``, one per control step
@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from anomalygen.learn.motion import CollisionChecker
+from anomalygen.control.motion import CollisionChecker
 
 
 @dataclass
@@ -111,7 +111,7 @@ def arm_gains_on(model) -> None:
 
 def retime(path, max_step: float) -> list[np.ndarray]:
     """Waypoints no more than ``max_step`` rad apart on any joint (one per control step)."""
-    from anomalygen.learn.motion import interpolate
+    from anomalygen.control.motion import interpolate
 
     return interpolate(path, max_step) if len(path) > 1 else [np.asarray(path[0], dtype=float)]
 
@@ -119,7 +119,7 @@ def retime(path, max_step: float) -> list[np.ndarray]:
 def _ik_goal(m, d, checker: CollisionChecker, target_pos, quat, rng: np.random.Generator, attempts: int):
     """Collision-free IK solution, (q, why-not): the one reached from the current arm if valid, else the
     nearer (largest joint change) of the first two from random restarts."""
-    from anomalygen.learn.ik import solve_ik
+    from anomalygen.control.ik import solve_ik
     from anomalygen.scene.robot import ARM_JOINTS
 
     q0 = d.qpos[checker.qadr].copy()
@@ -222,7 +222,7 @@ def move_arm_planned(drv, target_pos, quat, *, time_limit: float = 1.0, seed: in
     (then ``ok`` is False, "did not settle", with the arm moved). ``allowed_bodies``: bodies the arm
     may touch; a held object is added and carried automatically.
     """
-    from anomalygen.learn.motion import plan_path
+    from anomalygen.control.motion import plan_path
     from anomalygen.scene import robot
 
     m, d = drv.model, drv.data
@@ -263,7 +263,7 @@ def rehome(drv, *, time_limit: float = 1.0, seed: int = 0, max_steps: int = 300)
     the arm starts touching something the joints are interpolated straight to home; when home itself
     collides (a drawer just pulled open in front of the robot) nothing moves and False is returned.
     """
-    from anomalygen.learn.motion import plan_path
+    from anomalygen.control.motion import plan_path
     from anomalygen.scene import robot
 
     m, d = drv.model, drv.data

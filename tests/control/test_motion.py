@@ -14,8 +14,8 @@ _scene = scene_with_obstacle
 @pytest.fixture(scope="module")
 def pregrasp():
     """Home scene and the arm configuration 15 cm above the table's box, cup pointing down."""
-    from anomalygen.learn.ik import quat_z_to
-    from anomalygen.learn.motion import goal_from_pose
+    from anomalygen.control.ik import quat_z_to
+    from anomalygen.control.motion import goal_from_pose
 
     m, d = _scene()
     box = d.body("box_0").xpos.copy()
@@ -25,8 +25,8 @@ def pregrasp():
 
 
 def test_path_to_pregrasp_is_collision_free(pregrasp):
-    from anomalygen.learn.ik import site_pose
-    from anomalygen.learn.motion import CollisionChecker, interpolate, plan_path
+    from anomalygen.control.ik import site_pose
+    from anomalygen.control.motion import CollisionChecker, interpolate, plan_path
 
     m, d, g = pregrasp
     path = plan_path(m, d, ARM_JOINTS, g, time_limit=2.0, seed=0)
@@ -49,7 +49,7 @@ def test_path_to_pregrasp_is_collision_free(pregrasp):
 def test_planner_goes_around_an_obstacle_and_stops_at_the_first_solution(pregrasp):
     import mujoco
 
-    from anomalygen.learn.motion import CollisionChecker, interpolate, plan_path
+    from anomalygen.control.motion import CollisionChecker, interpolate, plan_path
 
     m0, d0, g = pregrasp
     qadr = CollisionChecker(m0, d0, ARM_JOINTS).qadr
@@ -74,13 +74,13 @@ def test_planner_goes_around_an_obstacle_and_stops_at_the_first_solution(pregras
 
 
 def test_goal_in_collision_gives_none(pregrasp):
-    from anomalygen.learn.motion import plan_path
+    from anomalygen.control.motion import plan_path
 
     m, d, _ = pregrasp
     q = d.qpos[[m.joint(n).qposadr[0] for n in ARM_JOINTS]].copy()
     q[1] = 1.7  # shoulder far forward and down: the arm is in the floor/table
     q[3] = -0.1
-    from anomalygen.learn.motion import CollisionChecker
+    from anomalygen.control.motion import CollisionChecker
 
     assert not CollisionChecker(m, d, ARM_JOINTS).valid(q)
     assert plan_path(m, d, ARM_JOINTS, q, time_limit=0.5) is None

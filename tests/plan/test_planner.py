@@ -1,7 +1,7 @@
 """KB-recipe plans: every class with a recipe yields typed sub-tasks bound to scene instances."""
 
 from anomalygen.knowledge.base import load_kb
-from anomalygen.learn.planner import plan_from_kb
+from anomalygen.plan.planner import plan_from_kb
 from anomalygen.schema import Plan, SkillMethod
 
 
@@ -37,7 +37,7 @@ def _task(tid, hazard_class):
 
 def test_plan_stage_writes_plans_and_fails_one_item(tmp_path):
     from anomalygen.config import Settings
-    from anomalygen.learn.plan_stage import run_stage
+    from anomalygen.plan.stage import run_stage
     from anomalygen.runfolder import RunFolder, read_model, write_jsonl
 
     run = RunFolder.create(tmp_path / "r")
@@ -52,7 +52,7 @@ def test_plan_stage_writes_plans_and_fails_one_item(tmp_path):
 
 def test_detected_source_plans_the_top_hypothesis(tmp_path):
     from anomalygen.config import Settings
-    from anomalygen.learn.plan_stage import run_stage
+    from anomalygen.plan.stage import run_stage
     from anomalygen.runfolder import RunFolder, read_model, write_jsonl
     from anomalygen.schema import Detection, Hypothesis
 

@@ -151,7 +151,7 @@ class Driver:
         False, with nothing moved, when none is (or planned motion is off): the caller moves straight."""
         if not self.planned_motion:
             return False
-        from anomalygen.learn.arm_motion import move_arm_planned
+        from anomalygen.control.arm_motion import move_arm_planned
 
         return any(move_arm_planned(self, g, quat, seed=self.plan_seed, ik_attempts=3).ok for g in goals)
 
@@ -160,7 +160,7 @@ class Driver:
         configuration: a straight cup-down move from there winds the wrist into the furniture."""
         if not self.planned_motion or self.cup_down():
             return
-        from anomalygen.learn.arm_motion import rehome
+        from anomalygen.control.arm_motion import rehome
 
         if lift > 0:
             self.goto(self.site + np.array([0.0, 0.0, lift]), max_steps=lift_steps, tol=0.03)
@@ -304,7 +304,7 @@ class Driver:
         """Can the arm (base where it is now) put the cup face at each (pos, quat)? IK on a copy."""
         if not poses:
             return True
-        from anomalygen.learn.ik import solve_ik
+        from anomalygen.control.ik import solve_ik
         from anomalygen.scene import robot
 
         home = np.asarray(robot.HOME_ARM, dtype=float)
@@ -317,7 +317,7 @@ class Driver:
 
     def tuck(self) -> bool:
         """Bring the cup (and anything held) in close above the base, cup down, before a base move."""
-        from anomalygen.learn.ik import quat_z_to
+        from anomalygen.control.ik import quat_z_to
         from anomalygen.scene import robot
 
         d = self.data
@@ -400,7 +400,7 @@ def approach(drv: Driver, obj: str, point=None) -> PrimitiveResult:
 
     The pre-contact pose is reached by IK and a collision-free joint path (``arm_motion``), as the
     paper does; when planning fails the cup rises and comes down straight instead."""
-    from anomalygen.learn.ik import quat_z_to
+    from anomalygen.control.ik import quat_z_to
 
     s0 = drv.steps
     normal = np.array([0.0, 0.0, 1.0])
@@ -427,7 +427,7 @@ def grasp(drv: Driver, obj: str, *, lift: float = 0.12) -> PrimitiveResult:
     """Approach, move along the normal until the cup touches, switch suction on, lift by ``lift``.
 
     Tries up to three grasp points (``grasp_points``) before giving up."""
-    from anomalygen.learn.ik import quat_z_to
+    from anomalygen.control.ik import quat_z_to
     from anomalygen.scene import robot
 
     s0 = drv.steps
@@ -470,7 +470,7 @@ def side_grasp(drv: Driver, obj: str, *, lift: float = 0.12) -> PrimitiveResult:
     surface; the weld then holds the object's body, so it is carried upright."""
     import mujoco
 
-    from anomalygen.learn.ik import quat_z_to
+    from anomalygen.control.ik import quat_z_to
     from anomalygen.scene import robot
     from anomalygen.scene.graph import geom_world_aabbs
 
@@ -520,7 +520,7 @@ def release(drv: Driver) -> PrimitiveResult:
 
 def _opened_drawer(drv: Driver, region: str) -> str | None:
     """The drawer joint that ``open_for_access`` pulled out of ``region``, if any."""
-    from anomalygen.learn import parts
+    from anomalygen.control import parts
 
     return next((j for j in drv.opened.get(region, []) if drv.model.jnt_type[drv.model.joint(j).id] == parts.SLIDE),
                 None)
@@ -539,7 +539,7 @@ def _drop_point(drv: Driver, region: str, obj: str) -> np.ndarray:
     """Where to hold the object's bottom before release: above the opening of the container's carcass
     (an open lid's own box does not count), inside an opened drawer's exposed part, or above the
     centre of a support's top."""
-    from anomalygen.learn import parts
+    from anomalygen.control import parts
 
     drawer = _opened_drawer(drv, region)
     if drawer is not None:
@@ -649,7 +649,7 @@ def opening(drv: Driver, region: str) -> tuple[np.ndarray, np.ndarray]:
     """The box above which a dropped object falls into ``region``: the carcass's top rectangle, minus
     the strip that a half-open lid still hangs over (the lid swings about a horizontal axis, so it
     covers the side of the opening next to its hinge)."""
-    from anomalygen.learn import parts
+    from anomalygen.control import parts
 
     if not drv.opened.get(region):
         return drv.aabb(region)
@@ -708,7 +708,7 @@ def _yawed(quat: np.ndarray, yaw: float) -> np.ndarray:
 def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, into: bool = True) -> PrimitiveResult:
     """Carry the held ``obj`` above ``region`` and lower it: into a container's opening (``into``) or
     onto a free spot of a support's top; then release."""
-    from anomalygen.learn.ik import quat_z_to
+    from anomalygen.control.ik import quat_z_to
 
     s0 = drv.steps
     if drv.held != obj:
@@ -775,7 +775,7 @@ def place_through_door(drv: Driver, obj: str, region: str, *, release_after: boo
     The cup stays face-down, so the object is carried level at a height just clearing the
     compartment's floor, turned to lie across the opening, pushed in horizontally, lowered until it
     touches, released; the cup then backs out the way it came."""
-    from anomalygen.learn.ik import quat_z_to
+    from anomalygen.control.ik import quat_z_to
 
     s0 = drv.steps
     lo, hi, out = drv.compartments[region]

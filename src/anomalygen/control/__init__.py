@@ -1,0 +1,1 @@
+"""Robot control: the simulation driver, motion primitives, IK and motion planning."""

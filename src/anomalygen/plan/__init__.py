@@ -1,0 +1,1 @@
+"""plan stage: decompose each fix into sub-tasks (knowledge base or LLM)."""
