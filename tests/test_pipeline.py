@@ -1,6 +1,7 @@
-"""The one-command pipeline: missing stages are skipped, a killed run resumes without duplicates,
-and Ray produces the same artefacts as the local executor."""
+"""The one-command pipeline: it follows the one stage registry, a failing stage does not stop the
+others, a killed run resumes without duplicates, and Ray produces the same artefacts as locally."""
 
+import importlib
 import json
 import os
 import signal
@@ -8,25 +9,57 @@ import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
 from anomalygen import pipeline
+from anomalygen import stages as registry
 from anomalygen.config import Settings, load_settings
+from anomalygen.errors import UserError
 from anomalygen.runfolder import RunFolder
 
 
-def test_missing_stage_modules_are_reported_as_skipped(tmp_path, monkeypatch, capsys):
-    monkeypatch.setattr(pipeline, "STAGES", [("ghost", "anomalygen.no_such_stage"), ("report", "anomalygen.evaluate.report")])
+@dataclass(frozen=True)
+class _FailingStage:
+    name: str = "ghost"
+    inputs: tuple = ()
+    outputs: tuple = ()
+
+    def run(self, run, settings, *, force=False, only=None):
+        raise UserError("ghost has nothing to work on")
+
+
+def test_a_failing_stage_is_reported_and_later_stages_still_run(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(registry, "STAGES", (_FailingStage(), registry.stage("report")))
     settings = Settings(quiet=True)
     settings.evaluate.baselines = False
     result = pipeline.run_pipeline(RunFolder.create(tmp_path / "r"), settings)
-    assert result["stages"]["ghost"]["status"] == "skipped"
-    assert "not implemented yet" in result["stages"]["ghost"]["reason"]
+    assert result["stages"]["ghost"] == {"status": "failed", "reason": "ghost has nothing to work on"}
     assert result["stages"]["report"]["status"] == "done"
     assert result["report"].endswith("index.html") and Path(result["report"]).is_file()
     assert "report: " in capsys.readouterr().out
+
+
+def test_one_registry_names_every_stage_the_cli_and_the_pipeline_run():
+    from anomalygen.cli import app
+
+    names = [s.name for s in registry.STAGES]
+    assert names == ["brainstorm", "build", "detect", "plan", "learn", "evaluate", "report"]
+    commands = {c.name or c.callback.__name__ for c in app.registered_commands}
+    assert set(names) <= commands
+    for s in registry.STAGES:  # every module exists and has the entry point the registry calls
+        assert callable(importlib.import_module(s.module).run_stage)
+        assert s.outputs, s.name
+    # stage modules live in the package of the same name (build's package is scene/, report's evaluate/)
+    assert registry.stage("plan").module == "anomalygen.plan.stage"
+    assert registry.stage("learn").module == "anomalygen.learn.stage"
+
+
+def test_a_whole_run_stage_refuses_only(tmp_path):
+    with pytest.raises(ValueError, match="takes no --only"):
+        registry.stage("evaluate").run(RunFolder.create(tmp_path / "r"), Settings(quiet=True), only=["t"])
 
 
 def test_demo_defaults_are_the_embedded_offline_ones():

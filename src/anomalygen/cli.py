@@ -16,7 +16,7 @@ from typing import Annotated, Any
 import typer
 from rich.console import Console
 
-from anomalygen.errors import AnomalygenError, NotImplementedYet, UserError
+from anomalygen.errors import AnomalygenError, UserError
 
 app = typer.Typer(
     name="anomalygen",
@@ -72,17 +72,11 @@ def _common(
     return _settings(config, **overrides)
 
 
-def _stage(module: str, func: str = "run_stage"):
-    """Import a stage entry point, or explain that the stage has not landed yet."""
-    try:
-        mod = importlib.import_module(module)
-    except ModuleNotFoundError as exc:
-        if exc.name and exc.name.startswith("anomalygen"):
-            raise NotImplementedYet(f"this stage is not implemented yet ({module})") from exc
-        raise
-    if not hasattr(mod, func):
-        raise NotImplementedYet(f"this stage is not implemented yet ({module}.{func})")
-    return getattr(mod, func)
+def _run_stage(name: str, run, settings, **kwargs):
+    """Run a registered stage (``anomalygen.stages``, the list ``anomalygen run`` also follows)."""
+    from anomalygen.stages import stage
+
+    return stage(name).run(run, settings, **kwargs)
 
 
 def _finish(summary, as_json: bool) -> None:
@@ -140,8 +134,7 @@ def brainstorm(
         **{"brainstorm.engine": engine, "brainstorm.mode": mode, "brainstorm.n": n, "brainstorm.agents": agents,
            "brainstorm.rounds": rounds, "brainstorm.tasks_file": str(tasks) if tasks else None},
     )
-    fn = _stage("anomalygen.brainstorm.stage")
-    _finish(fn(_open_run(run, create=True, settings=settings), settings, force=force), as_json)
+    _finish(_run_stage("brainstorm", _open_run(run, create=True, settings=settings), settings, force=force), as_json)
 
 
 @app.command()
@@ -161,8 +154,7 @@ def build(
     """Stage 2: build each task as a validated MuJoCo scene (writes scenes/<task_id>/)."""
     settings = _common(config, seed, quiet, workers, executor, address, **{"build.clutter": clutter})
     folder = _open_run(run)
-    fn = _stage("anomalygen.scene.stage")
-    _finish(fn(folder, settings, force=force, only=only), as_json)
+    _finish(_run_stage("build", folder, settings, force=force, only=only), as_json)
 
 
 @app.command()
@@ -183,8 +175,7 @@ def detect(
     settings = _common(config, None, quiet, backend=backend, model=model, no_cache=no_cache,
                        **{"detect.detector": detector, "detect.k": k})
     folder = _open_run(run)
-    fn = _stage("anomalygen.detect.stage")
-    _finish(fn(folder, settings, force=force, only=only), as_json)
+    _finish(_run_stage("detect", folder, settings, force=force, only=only), as_json)
 
 
 @app.command()
@@ -204,8 +195,7 @@ def plan(
     settings = _common(config, None, quiet, backend=backend, model=model,
                        **{"learn.plan_source": source, "learn.engine": engine})
     folder = _open_run(run)
-    fn = _stage("anomalygen.plan.stage")
-    _finish(fn(folder, settings, force=force, only=only), as_json)
+    _finish(_run_stage("plan", folder, settings, force=force, only=only), as_json)
 
 
 @app.command()
@@ -227,8 +217,7 @@ def learn(
     settings = _common(config, seed, quiet, workers, executor, address,
                        **{"learn.sac_steps": sac_steps, "learn.seeds": seeds})
     folder = _open_run(run)
-    fn = _stage("anomalygen.learn.stage")
-    _finish(fn(folder, settings, force=force, only=only), as_json)
+    _finish(_run_stage("learn", folder, settings, force=force, only=only), as_json)
 
 
 @app.command()
@@ -242,8 +231,7 @@ def evaluate(
     """Measure diversity, detection hit@k and success; print the diversity table with baselines."""
     settings = _common(config, None, quiet, **{"evaluate.image_metrics": False if no_images else None})
     folder = _open_run(run)
-    fn = _stage("anomalygen.evaluate.stage")
-    _finish(fn(folder, settings), as_json)
+    _finish(_run_stage("evaluate", folder, settings), as_json)
 
 
 @app.command()
@@ -256,8 +244,7 @@ def report(
     """Write report/index.html, report.json and summary.md for a run."""
     settings = _common(config, None, quiet)
     folder = _open_run(run)
-    fn = _stage("anomalygen.evaluate.report")
-    _finish(fn(folder, settings), as_json)
+    _finish(_run_stage("report", folder, settings), as_json)
 
 
 @app.command("run")
@@ -317,23 +304,12 @@ def _drop_none(d):
 
 
 def _register_subapps() -> None:
-    """Sub-apps owned by their packages; a missing one becomes a stub that explains itself."""
+    """Sub-apps owned by their packages (imported here; typer needs them to build the command tree)."""
     for name, module, help_text in (
         ("assets", "anomalygen.assets.cli", "Asset library: list, show, render, validate, search, gallery."),
         ("llm", "anomalygen.llm.cli", "Talk to the configured LLM: ping, ask."),
     ):
-        try:
-            sub = importlib.import_module(module).app
-        except ModuleNotFoundError as exc:
-            if not (exc.name or "").startswith("anomalygen"):
-                raise
-            sub = typer.Typer(help=help_text)
-
-            @sub.callback(invoke_without_command=True)
-            def _missing(_name=name):
-                raise NotImplementedYet(f"'anomalygen {_name}' is not implemented yet")
-
-        app.add_typer(sub, name=name, help=help_text)
+        app.add_typer(importlib.import_module(module).app, name=name, help=help_text)
 
 
 _register_subapps()
@@ -353,9 +329,6 @@ def main(argv: list[str] | None = None) -> None:
 
     try:
         app(args=argv, standalone_mode=False)
-    except NotImplementedYet as exc:
-        err.print(f"[yellow]not implemented yet:[/yellow] {escape(str(exc))}", highlight=False, soft_wrap=True)
-        sys.exit(3)
     except (AnomalygenError, ValidationError) as exc:
         msg = format_validation_error(exc) if isinstance(exc, ValidationError) else str(exc)
         err.print(f"[red]error:[/red] {escape(msg)}", highlight=False, soft_wrap=True)

@@ -12,6 +12,3 @@ class UserError(AnomalygenError):
 class ItemFailed(AnomalygenError):
     """One item of a stage failed; the batch carries on and records the reason."""
 
-
-class NotImplementedYet(UserError):
-    """A subcommand whose stage has not landed yet."""

@@ -1,33 +1,25 @@
 """``anomalygen run``: every stage in order, each through its own ``run_stage``, resumable per item.
 
 The pipeline owns no stage logic. It calls brainstorm → build → detect → plan → learn → evaluate →
-report; each stage skips items whose outputs already exist (``anomalygen.runner``), so re-running
-after a crash or a kill continues where it stopped. A stage whose module has not been installed is
-reported as skipped, and a stage that fails is reported and the later stages still run on whatever
-exists (the report says which sections were "not run").
+report (the order of ``anomalygen.stages.STAGES``, the same list the CLI reads); each stage skips
+items whose outputs already exist (``anomalygen.runner``), so re-running after a crash or a kill
+continues where it stopped. A stage that fails is reported and the later stages still run on
+whatever exists (the report says which sections were "not run").
 """
 
 from __future__ import annotations
 
-import importlib
-import inspect
 import time
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from anomalygen import stages as registry
 from anomalygen.errors import AnomalygenError
 from anomalygen.runfolder import RunFolder
 
-STAGES: list[tuple[str, str]] = [
-    ("brainstorm", "anomalygen.brainstorm.stage"),
-    ("build", "anomalygen.scene.stage"),
-    ("detect", "anomalygen.detect.stage"),
-    ("plan", "anomalygen.plan.stage"),
-    ("learn", "anomalygen.learn.stage"),
-    ("evaluate", "anomalygen.evaluate.stage"),
-    ("report", "anomalygen.evaluate.report"),
-]
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
 
 
 def demo_config_path() -> Path:
@@ -35,45 +27,19 @@ def demo_config_path() -> Path:
     return Path(str(resources.files("anomalygen").joinpath("data/demo.toml")))
 
 
-def _entry_point(module: str):
-    """The stage's ``run_stage``, or None when its module is not there yet."""
-    try:
-        mod = importlib.import_module(module)
-    except ModuleNotFoundError as exc:
-        if exc.name and (module == exc.name or module.startswith(exc.name + ".")):
-            return None
-        raise
-    return getattr(mod, "run_stage", None)
-
-
-def _call(fn, run: RunFolder, settings, force: bool):
-    """Pass ``force``/``only`` only to stages whose signature takes them (evaluate/report do not)."""
-    params = inspect.signature(fn).parameters
-    kwargs: dict[str, Any] = {}
-    if "force" in params:
-        kwargs["force"] = force
-    if "only" in params:
-        kwargs["only"] = None
-    return fn(run, settings, **kwargs)
-
-
-def run_pipeline(run: RunFolder, settings, *, force: bool = False, stages: list[str] | None = None) -> dict:
+def run_pipeline(run: RunFolder, settings: Settings, *, force: bool = False, stages: list[str] | None = None) -> dict:
     """Run the stages in order; returns ``{"stages": {name: {...}}, "report": path or None, "wall_s": s}``."""
     from rich.console import Console
 
     err = Console(stderr=True)
     started = time.perf_counter()
     outcome: dict[str, Any] = {"run": str(run.root), "stages": {}, "report": None}
-    for name, module in STAGES:
+    for stage in registry.STAGES:
+        name = stage.name
         if stages is not None and name not in stages:
             continue
-        fn = _entry_point(module)
-        if fn is None:
-            outcome["stages"][name] = {"status": "skipped", "reason": f"stage not implemented yet ({module})"}
-            err.print(f"[yellow]{name}: skipped — not implemented yet ({module})[/yellow]", highlight=False)
-            continue
         try:
-            summary = _call(fn, run, settings, force)
+            summary = stage.run(run, settings, force=force)
         except AnomalygenError as exc:
             outcome["stages"][name] = {"status": "failed", "reason": str(exc)}
             err.print(f"[red]{name}: failed — {exc}[/red]", highlight=False)

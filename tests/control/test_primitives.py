@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from anomalygen.rl.door_env import DoorCloseEnv
 from anomalygen.control.primitives import joint_motion_direction, push_joint
+from anomalygen.rl.door_env import DoorCloseEnv
 
 
 @pytest.mark.parametrize("seed", [0, 1, 4])

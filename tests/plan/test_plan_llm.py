@@ -11,9 +11,9 @@ import json
 import pytest
 
 from anomalygen.config import load_settings
+from anomalygen.llm import get_client
 from anomalygen.plan import plan_llm as P
 from anomalygen.plan.stage import run_stage
-from anomalygen.llm import get_client
 from anomalygen.runfolder import RunFolder, read_model, write_jsonl, write_model
 from anomalygen.schema import (
     AssetRef,

@@ -218,8 +218,8 @@ def test_a_closing_reward_about_an_already_closed_part_moves_to_the_open_one(tmp
     from test_execute import TASKS
 
     from anomalygen.config import Settings
-    from anomalygen.plan.planner import plan_from_kb
     from anomalygen.control.primitives import Driver
+    from anomalygen.plan.planner import plan_from_kb
     from anomalygen.rl.sac_subtask import retarget_joints
     from anomalygen.scene.build import build_scene
     from anomalygen.scene.graph import load_scene

@@ -50,8 +50,8 @@ def plan_item(task_id: str, payload: dict, ctx: StageContext) -> str:
 def _plan_with_llm(task_id: str, payload: dict, ctx: StageContext, hazard_class: str, bindings: dict[str, str],
                    spec: SceneSpec | None, hypothesis: dict | None) -> Plan:
     """The LLM engine for one item; its usage goes to the manifest whether or not the item succeeds."""
-    from anomalygen.plan.plan_llm import hazard_text_from_hypothesis, hazard_text_from_task, plan_from_llm
     from anomalygen.llm import record_usage, shared_client
+    from anomalygen.plan.plan_llm import hazard_text_from_hypothesis, hazard_text_from_task, plan_from_llm
 
     settings = ctx.settings
     if spec is None:
