@@ -47,7 +47,7 @@ class Monitor:
 
 
 def _driver(m, d):
-    from anomalygen.control.primitives import Driver
+    from anomalygen.control.driver import Driver
 
     drv = Driver(m, d, None)
     drv.settle(5)

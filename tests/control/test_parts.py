@@ -44,7 +44,7 @@ def scenes(tmp_path_factory):
 
 
 def _driver(scenes, key, seed=0):
-    from anomalygen.control.primitives import Driver
+    from anomalygen.control.driver import Driver
     from anomalygen.scene.graph import load_scene
 
     m, d, spec = load_scene(scenes[key][0])
@@ -200,7 +200,7 @@ def drawer_run(scenes):
 
 
 def test_cabinet_gets_exactly_one_drawer_chosen_the_highest_in_reach(drawer_run):
-    from anomalygen.control.parts import SLIDE
+    from anomalygen.control.geometry import SLIDE
 
     r = drawer_run
     assert len(r["drawers"]) >= 2 and r["shut_before"], "the test scene should offer a choice of shut drawers"
@@ -236,7 +236,7 @@ def _ray_down(drv, xy, z0) -> tuple[int, float]:
 
 
 def test_first_grasp_point_on_pliers_lies_over_the_pliers(scenes):
-    from anomalygen.control.primitives import grasp_points
+    from anomalygen.control.geometry import grasp_points
     from anomalygen.scene import robot
 
     drv = _driver(scenes, "box")
@@ -271,8 +271,7 @@ def _footprint_clear(drv, spot, obj, support, *, turned=True):
 
     The footprint is the object's, turned to lie along the top's long side, as ``move_to`` sets down
     an elongated object; not ``turned``, the object's box as it lies now."""
-    from anomalygen.control.parts import static_box
-    from anomalygen.control.primitives import footprint, top_rect
+    from anomalygen.control.geometry import footprint, static_box, top_rect
 
     _, a, b = footprint(drv, obj)
     rlo, rhi = top_rect(drv, support)
@@ -294,7 +293,7 @@ def _footprint_clear(drv, spot, obj, support, *, turned=True):
 
 
 def test_free_spot_misses_what_stands_on_the_table_and_keeps_off_the_edges(scenes):
-    from anomalygen.control.primitives import free_spot
+    from anomalygen.control.geometry import free_spot
 
     drv = _driver(scenes, "box")
     support = scenes["box"][1].bindings["$support"]
@@ -335,7 +334,7 @@ def test_free_spot_for_an_object_that_keeps_its_orientation(scenes):
     its present box, which here lies across the table's long side."""
     import mujoco
 
-    from anomalygen.control.primitives import free_spot
+    from anomalygen.control.geometry import free_spot
 
     drv = _driver(scenes, "box")
     support = scenes["box"][1].bindings["$support"]
@@ -358,7 +357,7 @@ def test_free_spot_for_an_object_that_keeps_its_orientation(scenes):
 def test_free_spot_prefers_a_clear_spot_over_the_edge_margin(scenes):
     """A bread loaf fills the middle of the side table: no spot keeps 0.2 m from the edges and misses
     it, so the pliers go to a clear spot nearer an edge rather than onto the loaf."""
-    from anomalygen.control.primitives import free_spot
+    from anomalygen.control.geometry import free_spot
 
     drv = _driver(scenes, "box")
     side = next(o.support for o in drv.spec.objects if o.role == "clutter")

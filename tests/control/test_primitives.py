@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from anomalygen.control.primitives import joint_motion_direction, push_joint
+from anomalygen.control.geometry import joint_motion_direction
+from anomalygen.control.primitives import push_joint
 from anomalygen.rl.door_env import DoorCloseEnv
 
 

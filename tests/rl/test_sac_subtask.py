@@ -43,7 +43,7 @@ def door_plan() -> tuple[SubTask, Plan]:
 
 def door_driver(q: float = 1.0, *, approach: bool = True):
     """The test scene (no table: the open door would swing into it) with the cup brought to the door."""
-    from anomalygen.control.primitives import Driver
+    from anomalygen.control.driver import Driver
     from anomalygen.rl.sac_subtask import pre_position
     from anomalygen.rl.subtask_env import SubTaskReadout
     from anomalygen.rl.testbed import build
@@ -59,11 +59,11 @@ def door_driver(q: float = 1.0, *, approach: bool = True):
 
 def _push_action(env_or_drv, data) -> np.ndarray:
     """A scripted closing push at the handle (3 cm/step towards 6 cm past it)."""
-    from anomalygen.control import primitives as P
+    from anomalygen.control import geometry as G
 
     m = env_or_drv.model
     h = data.site_xpos[m.site("cabinet_0:door_handle").id]
-    v = -P.joint_motion_direction(m, data, HINGE, h)
+    v = -G.joint_motion_direction(m, data, HINGE, h)
     a = np.zeros(7)
     a[:3] = np.clip((h + 0.06 * v - data.site_xpos[m.site("suction_site").id]) / 0.03, -1, 1)
     return a
@@ -165,12 +165,13 @@ def test_env_and_driver_rollout_share_one_control_step(at_door):
 
 def test_suction_action_grabs_and_releases():
     from anomalygen.control import primitives as P
+    from anomalygen.control.driver import Driver
     from anomalygen.rl.subtask_env import apply_action, control_ids
     from anomalygen.rl.testbed import build
     from anomalygen.scene import robot
 
     tb = build(with_cabinet=False)
-    drv = P.Driver(tb.model, tb.data, SceneSpec(scene_id="tb", task_id="t", room="kitchen", seed=0, objects=[]))
+    drv = Driver(tb.model, tb.data, SceneSpec(scene_id="tb", task_id="t", room="kitchen", seed=0, objects=[]))
     assert P.grasp(drv, "box_0").success
     robot.suction_off(drv.model, drv.data)
     ids = control_ids(drv.model)
@@ -218,7 +219,7 @@ def test_a_closing_reward_about_an_already_closed_part_moves_to_the_open_one(tmp
     from test_execute import TASKS
 
     from anomalygen.config import Settings
-    from anomalygen.control.primitives import Driver
+    from anomalygen.control.driver import Driver
     from anomalygen.plan.planner import plan_from_kb
     from anomalygen.rl.sac_subtask import retarget_joints
     from anomalygen.scene.build import build_scene

@@ -21,7 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-HINGE, SLIDE = 3, 2  # mujoco.mjtJoint values
+from anomalygen.control.driver import PRE_CONTACT, PrimitiveResult
+from anomalygen.control.geometry import HINGE, SLIDE, static_box
+
 INNER_FACE_STOP = 0.4  # rad: a grasp on the inner face lets go this far from closed
 LEAD_HINGE = 0.06
 MAX_DRAG = 0.10  # m the container may be dragged by its part before the drive gives up
@@ -182,7 +184,6 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
                  max_steps: int = 900):
     """Hold the part by suction and lead it to ``goal``; re-grasp when it stops following."""
     from anomalygen.control.ik import quat_z_to
-    from anomalygen.control.primitives import PRE_CONTACT, PrimitiveResult
     from anomalygen.scene import robot
 
     m, d = drv.model, drv.data
@@ -339,31 +340,6 @@ def _far(js) -> float:
     return hi if abs(hi - js.closed_value) >= abs(lo - js.closed_value) else lo
 
 
-def static_box(drv, obj: str) -> tuple[np.ndarray, np.ndarray]:
-    """World AABB of the object's carcass: its collision geoms that no hinge or slide moves."""
-    from anomalygen.scene import robot
-    from anomalygen.scene.graph import geom_world_aabbs
-
-    m = drv.model
-    root = drv.body_id(obj)
-    moving = {int(m.jnt_bodyid[k]) for k in range(m.njnt) if m.jnt_type[k] in (HINGE, SLIDE)}
-
-    def moves(b: int) -> bool:
-        while b != root and b > 0:
-            if b in moving:
-                return True
-            b = int(m.body_parentid[b])
-        return False
-
-    lo, hi = geom_world_aabbs(m, drv.data)
-    sub = robot._subtree_geoms(m, root)
-    sel = [g for g in np.flatnonzero(sub) if not moves(int(m.geom_bodyid[g]))
-           and (m.geom_contype[g] or m.geom_conaffinity[g])]
-    if not sel:
-        return drv.aabb(obj)
-    return lo[sel].min(axis=0), hi[sel].max(axis=0)
-
-
 def best_drawer(drv, obj: str, drawers: list):
     """The drawer to put things in: the highest one whose top is within the arm's comfortable band."""
     def top(js) -> float:
@@ -409,7 +385,6 @@ def open_for_access(drv, obj: str, labels):
     Records what was opened in ``drv.opened[obj]`` (so the place step drops into an opened drawer
     and the close step shuts exactly these) and returns a PrimitiveResult.
     """
-    from anomalygen.control.primitives import PrimitiveResult
 
     s0 = drv.steps
     lids = closure_joints(drv, obj, [lab for lab in labels if lab in LIDS])
@@ -453,7 +428,6 @@ def _falls_shut(drv, joint: str, closed: float) -> bool:
 
 def close_opened(drv, obj: str):
     """Shut the parts ``open_for_access`` opened on ``obj`` (hinged lids last-opened first)."""
-    from anomalygen.control.primitives import PrimitiveResult
 
     s0 = drv.steps
     names = list(reversed(drv.opened.get(obj, [])))

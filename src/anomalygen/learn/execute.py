@@ -15,6 +15,8 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+from anomalygen.control.driver import PrimitiveResult
+from anomalygen.control.geometry import surface_centre_of
 from anomalygen.schema import Plan, PredicateResult, SkillMethod, SkillResult, SubTask, SubTaskResult
 
 
@@ -43,7 +45,6 @@ def _drive_joints(drv, st: SubTask, obj: str, prim: str, prm: dict):
     The planner names the object's first joint, but a fridge has a freezer and a main door and either
     may be the open one; the scene state says which to push, so the joints are re-chosen here.
     """
-    from anomalygen.control import primitives as P
     from anomalygen.control.parts import actuate_part
 
     label = _label_of(st, prm)
@@ -65,7 +66,7 @@ def _drive_joints(drv, st: SubTask, obj: str, prim: str, prm: dict):
     if not cands and prm.get("joint") is not None:
         cands = [(1.0, str(prm["joint"]), float(prm.get("target", 0.0)), 0.0, 0.02)]
     if not cands:
-        return P.PrimitiveResult(False, 0, f"{obj} has no articulated part labelled {label!r} to {prim}")
+        return PrimitiveResult(False, 0, f"{obj} has no articulated part labelled {label!r} to {prim}")
     cands.sort(key=lambda c: -c[0])
     steps, details = 0, {}
     for _ in range(2):  # a second pass: closing one door can knock a neighbour open again
@@ -76,7 +77,7 @@ def _drive_joints(drv, st: SubTask, obj: str, prim: str, prm: dict):
             steps += r.steps
             details[joint] = r.detail
     ok = all(abs(float(drv.data.joint(j).qpos[0]) - g) <= t for _, j, g, _, t in cands)
-    return P.PrimitiveResult(ok, steps, "; ".join(details.values()) or f"{label} parts of {obj} already there")
+    return PrimitiveResult(ok, steps, "; ".join(details.values()) or f"{label} parts of {obj} already there")
 
 
 def _closed_parts(drv, name: str) -> list[str]:
@@ -108,9 +109,9 @@ def run_subtask(drv, st: SubTask, plan: Plan):
     if prim in ("move_to", "place_inside", "place_on"):
         region = str(prm.get("region") or prm.get("container") or prm.get("support") or "")
         if region == "surface_centre":
-            region = P.surface_centre_of(drv, obj) or ""
+            region = surface_centre_of(drv, obj) or ""
             if not region:
-                return P.PrimitiveResult(False, 0, f"{obj} stands on no support to re-centre it on")
+                return PrimitiveResult(False, 0, f"{obj} stands on no support to re-centre it on")
         if drv.held != obj:  # move_to without a preceding grasp (move_away_from_edge): pick first
             g = P.grasp(drv, obj)
             if not g.success:
@@ -129,7 +130,7 @@ def run_subtask(drv, st: SubTask, plan: Plan):
         return parts.close_opened(drv, obj)
     if prim in ("push", "pull", "close_joint", "open_joint", "switch_off"):
         return _drive_joints(drv, st, obj, prim, prm)
-    return P.PrimitiveResult(False, 0, f"primitive {prim!r} is not implemented")
+    return PrimitiveResult(False, 0, f"primitive {prim!r} is not implemented")
 
 
 def _evaluate(calls, model, data, spec, bindings) -> list[PredicateResult]:
@@ -166,7 +167,7 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
 
 def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float, sac_steps: int,
                   retries: int = 1) -> SkillResult:
-    from anomalygen.control.primitives import Driver
+    from anomalygen.control.driver import Driver
     from anomalygen.rng import item_rng
     from anomalygen.scene.graph import load_scene
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from anomalygen.control.primitives import PrimitiveResult
+from anomalygen.control.driver import PrimitiveResult
 from anomalygen.schema import Plan, SubTask
 
 STANDOFF = 0.06  # m behind the part point, as push_part approaches
@@ -90,7 +90,7 @@ def retarget_joints(drv, st: SubTask) -> tuple[SubTask, str]:
 
 def pre_position(drv, st: SubTask, plan: Plan, readout) -> str:
     """Bring base and cup to where the sub-task's contact happens; returns a note for the detail."""
-    from anomalygen.control import primitives as P
+    from anomalygen.control import geometry as G
 
     joint_terms = [t for t in (st.reward.terms if st.reward else []) if t.kind == "joint"]
     if joint_terms:
@@ -100,7 +100,7 @@ def pre_position(drv, st: SubTask, plan: Plan, readout) -> str:
         q = float(drv.data.joint(joint).qpos[0])
         if abs(q - goal) <= readout.joint_tol[joint]:
             return f"{joint} already at its goal"
-        body, local = P.part_point_local(drv, joint)
+        body, local = G.part_point_local(drv, joint)
 
         def h() -> np.ndarray:
             return drv.data.xpos[body] + drv.data.xmat[body].reshape(3, 3) @ local
@@ -109,19 +109,21 @@ def pre_position(drv, st: SubTask, plan: Plan, readout) -> str:
         # push from behind the motion; a pull (open) starts in front of the face, where suction can
         # hold it: behind a closed door is inside the cabinet
         pull = st.primitive in ("pull", "open_joint")
-        side = (1.0 if pull else -1.0) * sign * P.joint_motion_direction(drv.model, drv.data, joint, h())
+        side = (1.0 if pull else -1.0) * sign * G.joint_motion_direction(drv.model, drv.data, joint, h())
         if not (drv.place_base_near(h(), side=side) or drv.place_base_near(h())):
             return f"no collision-free base pose near {joint}"
         off = PULL_STANDOFF if pull else STANDOFF
         for extra in (0.15, 0.0):
-            v = (1.0 if pull else -1.0) * sign * P.joint_motion_direction(drv.model, drv.data, joint, h())
+            v = (1.0 if pull else -1.0) * sign * G.joint_motion_direction(drv.model, drv.data, joint, h())
             ok = drv.goto(h() + (off + extra) * v, max_steps=200, tol=0.02)
         where = "in front of" if pull else "behind"
         return f"cup {'placed' if ok else 'not quite placed'} {off * 100:.0f} cm {where} the part of {joint}"
     obj = st.params.get("object")
     if isinstance(obj, str) and obj and drv.held != obj:
         obj = plan.bindings.get(obj, obj) if obj.startswith("$") else obj
-        return P.approach(drv, obj).detail
+        from anomalygen.control.primitives import approach
+
+        return approach(drv, obj).detail
     return "no pre-positioning"
 
 
