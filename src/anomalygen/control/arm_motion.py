@@ -4,7 +4,7 @@ Why: the primitives' straight mocap lines sweep the arm through whatever lies be
 goal (a shelf board, a table edge). Here the arm instead goes to the goal configuration along a
 collision-checked joint-space path (``motion.plan_path``, OMPL BIT*), executed with real dynamics.
 
-How the arm is driven: a :class:`~anomalygen.control.primitives.Driver` keeps the arm limp (zero
+How the arm is driven: a :class:`~anomalygen.control.driver.Driver` keeps the arm limp (zero
 actuator gains) and pulls the cup with the ``ee_track`` weld. For the planned motion the weld is
 switched off and the arm's position actuators get back the gains the model was compiled with
 (``robot._ARM_GAINS``); the path's waypoints become the actuators' ``ctrl``, one per control step

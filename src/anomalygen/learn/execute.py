@@ -1,7 +1,7 @@
 """Run one plan on its built scene: each sub-task by its method, success checked on the scene graph.
 
 Primitive sub-tasks are executed by :mod:`anomalygen.control.primitives` on one shared
-:class:`~anomalygen.control.primitives.Driver`, so the state flows from one step to the next (a grasp
+:class:`~anomalygen.control.driver.Driver`, so the state flows from one step to the next (a grasp
 is followed by a move with the object still held). A sub-task succeeds when its SuccessSpec holds on
 ``scene_graph`` right after it (or, with an empty spec, when the primitive reports success); the task
 succeeds when the plan's SuccessSpec holds on the final, settled state. SAC sub-tasks are learned on

@@ -2,7 +2,7 @@
 
 RoboGen-style: a learned sub-task starts where the plan's previous steps left the robot, so the env
 is built from a full physics snapshot (``mj_getState(..., mjSTATE_INTEGRATION)``: qpos, qvel, ctrl,
-mocap pose, active welds, ...) of the :class:`~anomalygen.control.primitives.Driver`'s data, and every
+mocap pose, active welds, ...) of the :class:`~anomalygen.control.driver.Driver`'s data, and every
 ``reset`` restores it (plus +-2 cm noise on the end-effector target, drawn from ``np_random``). The
 env owns a copy of the model and its own MjData: suction rewrites the weld pose in ``model.eq_data``,
 and training must never touch the scene the Driver runs on.
