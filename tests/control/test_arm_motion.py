@@ -24,7 +24,7 @@ class Monitor:
         self.robot[robot.robot_geom_ids(m)] = True
         self.held, self.rel0 = robot.held_object(m, d), None
         if self.held:
-            self.robot |= robot._subtree_geoms(m, m.body(self.held).id)
+            self.robot |= robot.subtree_geoms(m, m.body(self.held).id)
             self.rel0 = self._rel()
         self.deepest, self.drift, self.steps, self.lost = 0.0, 0.0, 0, False
 

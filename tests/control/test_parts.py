@@ -91,7 +91,7 @@ def oven_run(scenes):
     def recording(model, data, name=None, *, torquescale=1.0):
         ok = real(model, data, name, torquescale=torquescale)
         if ok:
-            eq = robot._suction_eq(model, name)
+            eq = robot.suction_eq(model, name)
             probe = copy.copy(data)  # evaluate the constraint on a copy: the run itself is untouched
             mujoco.mj_forward(model, probe)
             rows = [i for i in range(probe.nefc) if probe.efc_type[i] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
@@ -144,13 +144,13 @@ def test_loose_objects_are_welded_by_their_massive_body(scenes):
     drv = _driver(scenes, "box")
     m = drv.model
     for name in ("pliers_0", "storage_box_0"):
-        eq = robot._suction_eq(m, name)
+        eq = robot.suction_eq(m, name)
         held = int(m.eq_obj2id[eq])
         wrapper = drv.body_id(name)
         assert held != wrapper and m.body_parentid[held] == wrapper
         assert m.body_mass[wrapper] == 0.0 and m.body_mass[held] > 0.0
     # a part's weld holds the part body itself
-    eq = robot._suction_eq(m, "storage_box_0/lid")
+    eq = robot.suction_eq(m, "storage_box_0/lid")
     assert m.body(int(m.eq_obj2id[eq])).name == "storage_box_0/lid"
 
 
@@ -242,7 +242,7 @@ def test_first_grasp_point_on_pliers_lies_over_the_pliers(scenes):
     drv = _driver(scenes, "box")
     m = drv.model
     lo, hi = drv.aabb("pliers_0")
-    mine = robot._subtree_geoms(m, drv.body_id("pliers_0")) & (m.geom_contype | m.geom_conaffinity).astype(bool)
+    mine = robot.subtree_geoms(m, drv.body_id("pliers_0")) & (m.geom_contype | m.geom_conaffinity).astype(bool)
     g, _ = _ray_down(drv, (lo + hi) / 2, hi[2] + 0.05)
     assert g < 0 or not mine[g], "the pliers should leave a gap under the middle of their box"
     pts = grasp_points(drv, "pliers_0")

@@ -20,6 +20,21 @@ def _scripted_close(env, seed):
     return info, rewards
 
 
+def test_door_env_passes_gymnasiums_checker_and_is_registered():
+    import gymnasium as gym
+    from gymnasium.utils.env_checker import check_env
+
+    from anomalygen.rl.door_env import DOOR_ENV_ID
+
+    check_env(DoorCloseEnv(), skip_render_check=True)
+    env = gym.make(DOOR_ENV_ID)
+    assert env.spec.max_episode_steps == env.unwrapped.horizon == 100
+    _, info = env.reset(seed=0)
+    _, _, _, _, info = env.step(np.zeros(7))
+    assert info["is_success"] is False
+    env.close()
+
+
 def test_pushing_the_door_closes_it_and_the_reward_rises():
     env = DoorCloseEnv()
     for seed in range(2):

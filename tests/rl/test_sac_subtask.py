@@ -101,7 +101,7 @@ def test_env_api_and_exact_reset(at_door):
         if e is exact:
             assert diff.size == 0  # bit-exact restore
         else:  # only the cup target moved, by at most 2 cm per axis
-            mocap = e.readout.ids.mocap
+            mocap = e.readout.robot.mocap
             assert 0 < np.abs(e.data.mocap_pos[mocap] - drv.data.mocap_pos[mocap]).max() <= 0.02
             e.data.mocap_pos[mocap] = drv.data.mocap_pos[mocap]
             again = np.empty_like(snap)
@@ -166,7 +166,7 @@ def test_env_and_driver_rollout_share_one_control_step(at_door):
 def test_suction_action_grabs_and_releases():
     from anomalygen.control import primitives as P
     from anomalygen.control.driver import Driver
-    from anomalygen.rl.subtask_env import apply_action, control_ids
+    from anomalygen.rl.subtask_env import MAX_DELTA_POS, MAX_DELTA_ROT
     from anomalygen.rl.testbed import build
     from anomalygen.scene import robot
 
@@ -174,12 +174,12 @@ def test_suction_action_grabs_and_releases():
     drv = Driver(tb.model, tb.data, SceneSpec(scene_id="tb", task_id="t", room="kitchen", seed=0, objects=[]))
     assert P.grasp(drv, "box_0").success
     robot.suction_off(drv.model, drv.data)
-    ids = control_ids(drv.model)
+    bot = robot.Robot(drv.model)
     far = np.zeros(7)
-    apply_action(drv.model, drv.data, ids, np.r_[far[:6], 1.0])
+    bot.apply_action(drv.data, np.r_[far[:6], 1.0], dp=MAX_DELTA_POS, dr=MAX_DELTA_ROT)
     assert drv.held == "box_0"
     assert drv.model.eq_data[drv.model.equality("suction__box_0").id, 10] == 1.0  # free object: held rigidly
-    apply_action(drv.model, drv.data, ids, np.r_[far[:6], -0.2])
+    bot.apply_action(drv.data, np.r_[far[:6], -0.2], dp=MAX_DELTA_POS, dr=MAX_DELTA_ROT)
     assert drv.held is None
 
 

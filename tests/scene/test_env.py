@@ -1,10 +1,11 @@
-"""The Gymnasium env: spaces, determinism under a seed, suction carries an object."""
+"""The Gymnasium env: Gymnasium's own checker, TimeLimit from the registry, determinism under a seed,
+suction carries an object, success reaches ``info["is_success"]``."""
 
 import gymnasium as gym
 import numpy as np
 
 import anomalygen
-from anomalygen.scene.env import ENV_ID
+from anomalygen.scene.env import ENV_ID, HORIZON
 
 
 def test_spaces_and_step(built_scenes):
@@ -23,11 +24,42 @@ def test_spaces_and_step(built_scenes):
     env.close()
 
 
-def test_registered_with_gymnasium(built_scenes):
-    env = gym.make(ENV_ID, scene_dir=built_scenes["floor"], frameskip=2, horizon=3)
-    obs, _ = env.reset(seed=1)
-    assert env.observation_space.contains(obs)
+def test_passes_gymnasiums_env_checker(built_scenes):
+    from gymnasium.utils.env_checker import check_env
+
+    env = anomalygen.make_env(built_scenes["knife_edge"], frameskip=2, horizon=5)
+    check_env(env)
     env.close()
+
+
+def test_registered_with_gymnasium_and_time_limited_by_it(built_scenes):
+    env = gym.make(ENV_ID, scene_dir=built_scenes["floor"], frameskip=2)
+    assert env.spec.max_episode_steps == HORIZON  # the EnvSpec is Gymnasium's, the scene lives elsewhere
+    assert env.unwrapped.horizon is None and env.unwrapped.scene.bindings
+    obs, info = env.reset(seed=1)
+    assert env.observation_space.contains(obs) and info == {"is_success": False}
+    steps, truncated = 0, False
+    while not truncated:
+        obs, _, terminated, truncated, info = env.step(np.zeros(7))
+        steps += 1
+        assert not terminated and info["is_success"] is False
+    assert steps == HORIZON
+    graph = env.unwrapped.graph()  # reads the scene, not the EnvSpec gym.make put in env.spec
+    assert {o.name for o in graph.objects} == {o.name for o in env.unwrapped.scene.objects}
+    env.close()
+
+
+def test_rotation_turns_the_cup_about_its_own_axes(built_scenes):
+    env = anomalygen.make_env(built_scenes["floor"], horizon=1000)
+    env.reset(seed=0)
+    d, r = env.data, env.robot
+    before = d.mocap_quat[r.mocap].copy()
+    env.step(np.array([0, 0, 0, 0, 0, 1.0, -1.0]))  # +dr about the cup's z axis
+    want = np.zeros(4)
+    import mujoco
+
+    mujoco.mju_mulQuat(want, before, np.array([np.cos(env.max_delta_rot / 2), 0, 0, np.sin(env.max_delta_rot / 2)]))
+    assert np.allclose(d.mocap_quat[r.mocap], want, atol=1e-12)
 
 
 def test_reset_is_deterministic_under_seed(built_scenes):
@@ -59,7 +91,7 @@ def test_suction_attaches_and_carries(built_scenes):
     env = anomalygen.make_env(built_scenes["knife_edge"], horizon=1000)
     obs, _ = env.reset(seed=0)
     L = env.obs_layout
-    name = env.spec.bindings["$hazard"]
+    name = env.scene.bindings["$hazard"]
     k = env.task_objects.index(name)
     pos = lambda o: o[L["object_pos"]][3 * k : 3 * k + 3]  # noqa: E731
     target = pos(obs).copy()
@@ -91,9 +123,9 @@ def test_reward_and_success_hooks(built_scenes):
         success_fn=lambda e: e.t >= 2,
     )
     env.reset(seed=0)
-    _, r, term, _, _ = env.step(np.zeros(7))
-    assert r == 0.5 and not term
-    _, _, term, _, _ = env.step(np.zeros(7))
-    assert term and calls == [1, 2]
+    _, r, term, _, info = env.step(np.zeros(7))
+    assert r == 0.5 and not term and info == {"is_success": False}
+    _, _, term, _, info = env.step(np.zeros(7))
+    assert term and calls == [1, 2] and info == {"is_success": True}
     graph = env.graph()
-    assert {o.name for o in graph.objects} == {o.name for o in env.spec.objects}
+    assert {o.name for o in graph.objects} == {o.name for o in env.scene.objects}

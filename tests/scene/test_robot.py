@@ -3,16 +3,16 @@
 import mujoco
 import numpy as np
 
-from anomalygen.scene import robot
+from anomalygen.scene import robot, robot_model
 
 
 def _robot_with_box():
-    spec = robot.build_robot_spec((0.0, 0.0, 0.0))
+    spec = robot_model.build_robot_spec((0.0, 0.0, 0.0))
     spec.worldbody.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[3, 3, 0.1])
     box = spec.worldbody.add_body(name="box_0", pos=[0.5, 0.0, 0.03])
     box.add_freejoint(name="box_0/free")
     box.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.03, 0.03, 0.03], mass=0.2)
-    robot.add_suction_welds(spec, ["box_0"])
+    robot_model.add_suction_welds(spec, ["box_0"])
     model = spec.compile()
     data = mujoco.MjData(model)
     robot.set_home(model, data, (0.0, 0.0, 0.0))

@@ -7,7 +7,7 @@ collision-checked joint-space path (``motion.plan_path``, OMPL BIT*), executed w
 How the arm is driven: a :class:`~anomalygen.control.driver.Driver` keeps the arm limp (zero
 actuator gains) and pulls the cup with the ``ee_track`` weld. For the planned motion the weld is
 switched off and the arm's position actuators get back the gains the model was compiled with
-(``robot._ARM_GAINS``); the path's waypoints become the actuators' ``ctrl``, one per control step
+(``robot.ARM_GAINS``); the path's waypoints become the actuators' ``ctrl``, one per control step
 through ``Driver.step`` (so the step counter and video hook see every step). At the end
 ``robot.enable_ee_tracking`` puts the mocap target on the cup and makes the arm limp again, so
 ``Driver.goto`` carries on from there. The suction welds are separate equality constraints, so a held
@@ -34,6 +34,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from anomalygen.control.motion import CollisionChecker
+from anomalygen.scene import robot
+from anomalygen.scene.robot import ARM_JOINTS
 
 
 @dataclass
@@ -59,7 +61,6 @@ class CarryingChecker(CollisionChecker):
     def __init__(self, model, data, joint_names, held: str, *, margin: float = 0.01, allowed_bodies=(), rel=None):
         import mujoco
 
-        from anomalygen.scene import robot
 
         super().__init__(model, data, joint_names, margin=margin, allowed_bodies=(*allowed_bodies, held))
         body = model.body(held).id
@@ -67,13 +68,13 @@ class CarryingChecker(CollisionChecker):
         if jnt < 0 or model.jnt_type[jnt] != mujoco.mjtJoint.mjJNT_FREE:
             raise ValueError(f"held object {held!r} has no free joint; it cannot be carried by the checker")
         self._qadr_obj = int(model.jnt_qposadr[jnt])
-        self._cup = model.body("suction").id
+        self._cup = model.body(robot.CUP_BODY).id
         if rel is None:
             mujoco.mj_kinematics(self.model, self.data)
             rel = robot.relative_pose(self.data.xpos[self._cup], self.data.xquat[self._cup],
                                       self.data.xpos[body], self.data.xquat[body])
         self._rel = rel
-        self._held = robot._subtree_geoms(model, body)
+        self._held = robot.subtree_geoms(model, body)
         self.model.geom_margin[self._held] = np.maximum(self.model.geom_margin[self._held], margin)
         widen_body_margins(self, margin)
 
@@ -99,9 +100,8 @@ class CarryingChecker(CollisionChecker):
 def arm_gains_on(model) -> None:
     """Give the arm's position actuators the gains they were compiled with (``set_to_position(kp)``:
     gain ``kp``, bias ``(0, -kp, 0)``); ``enable_ee_tracking`` zeroes them. Force limits are untouched."""
-    from anomalygen.scene import robot
 
-    for name, (kp, _) in zip(robot.ARM_JOINTS, robot._ARM_GAINS, strict=True):
+    for name, (kp, _) in zip(robot.ARM_JOINTS, robot.ARM_GAINS, strict=True):
         a = model.actuator(name).id
         model.actuator_gainprm[a, :] = 0.0
         model.actuator_biasprm[a, :] = 0.0
@@ -120,14 +120,13 @@ def _ik_goal(m, d, checker: CollisionChecker, target_pos, quat, rng: np.random.G
     """Collision-free IK solution, (q, why-not): the one reached from the current arm if valid, else the
     nearer (largest joint change) of the first two from random restarts."""
     from anomalygen.control.ik import solve_ik
-    from anomalygen.scene.robot import ARM_JOINTS
 
     q0 = d.qpos[checker.qadr].copy()
     lim = np.array([m.jnt_range[m.joint(n).id] for n in ARM_JOINTS])
     found, any_ik = [], False
     for k in range(attempts):
         q_init = q0 if k == 0 else rng.uniform(lim[:, 0], lim[:, 1])
-        res = solve_ik(m, d, "suction_site", ARM_JOINTS, target_pos, quat, q_init=q_init)
+        res = solve_ik(m, d, robot.CUP_SITE, ARM_JOINTS, target_pos, quat, q_init=q_init)
         if not res.success:
             continue
         any_ik = True
@@ -150,7 +149,6 @@ def _reference_state(model, data):
     """
     import mujoco
 
-    from anomalygen.scene import robot
 
     ref = mujoco.MjData(model)
     ref.qpos[:] = data.qpos
@@ -165,12 +163,11 @@ def _held_relative_pose(model, data, held: str):
     """Pose of the held body in the cup frame, from ``data``'s joint values."""
     import mujoco
 
-    from anomalygen.scene import robot
 
     sc = mujoco.MjData(model)
     sc.qpos[:] = data.qpos
     mujoco.mj_kinematics(model, sc)
-    cup, body = model.body("suction").id, model.body(held).id
+    cup, body = model.body(robot.CUP_BODY).id, model.body(held).id
     return robot.relative_pose(sc.xpos[cup], sc.xquat[cup], sc.xpos[body], sc.xquat[body])
 
 
@@ -196,7 +193,6 @@ def widen_body_margins(checker: CollisionChecker, margin: float) -> None:
 
 
 def _checker(model, data, held, rel, margin, allowed_bodies) -> CollisionChecker:
-    from anomalygen.scene import robot
 
     if held is not None:
         return CarryingChecker(model, data, robot.ARM_JOINTS, held, margin=margin, allowed_bodies=allowed_bodies,
@@ -223,7 +219,6 @@ def move_arm_planned(drv, target_pos, quat, *, time_limit: float = 1.0, seed: in
     may touch; a held object is added and carried automatically.
     """
     from anomalygen.control.motion import plan_path
-    from anomalygen.scene import robot
 
     m, d = drv.model, drv.data
     t0 = time.perf_counter()
@@ -264,7 +259,6 @@ def rehome(drv, *, time_limit: float = 1.0, seed: int = 0, max_steps: int = 300)
     collides (a drawer just pulled open in front of the robot) nothing moves and False is returned.
     """
     from anomalygen.control.motion import plan_path
-    from anomalygen.scene import robot
 
     m, d = drv.model, drv.data
     held = robot.held_object(m, d)
@@ -283,7 +277,6 @@ def rehome(drv, *, time_limit: float = 1.0, seed: int = 0, max_steps: int = 300)
 
 def follow_joint_path(drv, path, *, max_steps: int = 400, joint_speed: float = 1.0, tol: float = 0.01):
     """Execute an arm joint path under position control; returns (settled, waypoints, steps)."""
-    from anomalygen.scene import robot
 
     m, d = drv.model, drv.data
     goal = np.asarray(path[-1], dtype=float)
@@ -296,7 +289,7 @@ def follow_joint_path(drv, path, *, max_steps: int = 400, joint_speed: float = 1
     dadr = [m.jnt_dofadr[m.joint(n).id] for n in robot.ARM_JOINTS]
     bq = [m.jnt_qposadr[m.joint(n).id] for n in robot.BASE_JOINTS]
     base_set = np.array([d.actuator(n).ctrl[0] for n in robot.BASE_JOINTS])
-    track = m.equality("ee_track").id
+    track = m.equality(robot.EE_TRACK).id
     s0 = drv.steps
     d.ctrl[acts] = q0
     arm_gains_on(m)

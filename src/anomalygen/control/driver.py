@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from anomalygen.scene import robot
 from anomalygen.scene.robot import LIFT_MAX
 
 PRE_CONTACT = 0.03  # metres off the surface before the straight approach along the normal
@@ -40,7 +41,7 @@ class Driver:
                  rng: np.random.Generator | None = None, planned_motion: bool = True):
         import mujoco
 
-        from anomalygen.scene import robot
+        from anomalygen.scene.graph import FLOOR_GEOM
 
         self.model, self.data, self.spec = model, data, spec
         self.frameskip, self.dp, self.on_step = int(frameskip), float(dp), on_step
@@ -52,14 +53,14 @@ class Driver:
         self.plan_seed = int(rng.integers(2**31)) if rng is not None else 0
         # The seed only turns the ring of candidate base poses, so seeds try different approach sides.
         self.ring_offset = float(rng.uniform(0.0, 2 * np.pi / 24)) if rng is not None else 0.0
-        self._mocap = robot.enable_ee_tracking(model, data)
-        self._cup = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "suction")
-        self._site_ee = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "suction_site")
+        self.robot = robot.Robot(model)
+        self._mocap = self.robot.enable_ee_tracking(data)
+        self._cup, self._site_ee = self.robot.cup, self.robot.cup_site
         mujoco.mj_forward(model, data)
         r = data.xmat[self._cup].reshape(3, 3)
         self._site_local = r.T @ (data.site_xpos[self._site_ee] - data.xpos[self._cup])
-        self._robot_geoms = set(robot.robot_geom_ids(model).tolist())
-        self._floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "floor")
+        self._robot_geoms = set(self.robot.geoms.tolist())
+        self._floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, FLOOR_GEOM)
 
     # ---------------------------------------------------------------- low level
     def step(self) -> None:
@@ -114,13 +115,7 @@ class Driver:
         for _ in range(max_steps):
             rq = np.zeros(9)
             mujoco.mju_quat2Mat(rq, d.mocap_quat[self._mocap])
-            want = target - rq.reshape(3, 3) @ self._site_local
-            delta = want - d.mocap_pos[self._mocap]
-            n = np.linalg.norm(delta)
-            if n > self.dp:
-                delta *= self.dp / n
-            cup = d.xpos[self._cup]
-            d.mocap_pos[self._mocap] = cup + np.clip(d.mocap_pos[self._mocap] + delta - cup, -0.08, 0.08)
+            self.robot.target_towards(d, target - rq.reshape(3, 3) @ self._site_local, self.dp)
             self.step()
             if np.linalg.norm(self.site - target) < tol:
                 return True
@@ -138,10 +133,9 @@ class Driver:
 
     def aabb(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """World AABB of all geoms of body ``name`` and its descendants (collision geoms first)."""
-        from anomalygen.scene import robot
         from anomalygen.scene.graph import geom_world_aabbs
 
-        mask = robot._subtree_geoms(self.model, self.body_id(name))
+        mask = self.robot.subtree_geoms(self.body_id(name))
         lo, hi = geom_world_aabbs(self.model, self.data)
         coll = mask & (self.model.geom_contype | self.model.geom_conaffinity).astype(bool)
         use = coll if coll.any() else mask
@@ -149,11 +143,10 @@ class Driver:
 
     def _robot_in_collision(self) -> bool:
         """Robot or the object it holds penetrating the world (the floor under the base excepted)."""
-        from anomalygen.scene import robot
 
         d = self.data
         held = self.held
-        carried = robot._subtree_geoms(self.model, self.body_id(held)) if held is not None else None
+        carried = self.robot.subtree_geoms(self.body_id(held)) if held is not None else None
         for i in range(d.ncon):
             g1, g2 = int(d.contact.geom1[i]), int(d.contact.geom2[i])
             r1 = g1 in self._robot_geoms or (carried is not None and carried[g1])
@@ -163,15 +156,12 @@ class Driver:
         return False
 
     def _in_body(self, geom: int, name: str) -> bool:
-        from anomalygen.scene import robot
 
-        return bool(robot._subtree_geoms(self.model, self.body_id(name))[geom])
+        return bool(self.robot.subtree_geoms(self.body_id(name))[geom])
 
     @property
     def held(self) -> str | None:
-        from anomalygen.scene import robot
-
-        return robot.held_object(self.model, self.data)
+        return self.robot.held(self.data)
 
     # ---------------------------------------------------------------- base
     def place_base_near(self, point, *, reach=BASE_REACH, side=None, tuck: bool = True, reach_poses=()) -> bool:
@@ -185,8 +175,6 @@ class Driver:
         rigidly with the base. Returns False (base unchanged) if none is free.
         """
         import mujoco
-
-        from anomalygen.scene import robot
 
         m, d = self.model, self.data
         p = np.asarray(point, dtype=float)
@@ -234,11 +222,9 @@ class Driver:
         if not poses:
             return True
         from anomalygen.control.ik import solve_ik
-        from anomalygen.scene import robot
-
         home = np.asarray(robot.HOME_ARM, dtype=float)
         for pos, quat in poses:
-            r = solve_ik(self.model, self.data, "suction_site", robot.ARM_JOINTS, pos, quat, q_init=home,
+            r = solve_ik(self.model, self.data, robot.CUP_SITE, robot.ARM_JOINTS, pos, quat, q_init=home,
                          iterations=150)
             if not r.success:
                 return False
@@ -247,8 +233,6 @@ class Driver:
     def tuck(self) -> bool:
         """Bring the cup (and anything held) in close above the base, cup down, before a base move."""
         from anomalygen.control.ik import quat_z_to
-        from anomalygen.scene import robot
-
         d = self.data
         x, y, yaw = (float(d.joint(j).qpos[0]) for j in robot.BASE_JOINTS)
         here = np.array([x + 0.35 * np.cos(yaw), y + 0.35 * np.sin(yaw), max(0.9, float(self.site[2]))])
@@ -264,8 +248,6 @@ class Driver:
         """Set the base joints and torso lift to ``new`` (x, y, yaw, lift) and carry the mocap target
         (and a held object) rigidly along."""
         import mujoco
-
-        from anomalygen.scene import robot
 
         d = self.data
         qpos0, _, mpos0, mquat0 = saved

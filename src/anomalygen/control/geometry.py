@@ -39,7 +39,7 @@ def grasp_points(drv: Driver, obj: str, n: int = 3) -> list[np.ndarray]:
     m = drv.model
     lo, hi = drv.aabb(obj)
     glo, ghi = geom_world_aabbs(m, drv.data)
-    mask = robot._subtree_geoms(m, drv.body_id(obj)) & (m.geom_contype | m.geom_conaffinity).astype(bool)
+    mask = robot.subtree_geoms(m, drv.body_id(obj)) & (m.geom_contype | m.geom_conaffinity).astype(bool)
     cands = []
     for g in np.flatnonzero(mask):
         area = float(np.prod(ghi[g, :2] - glo[g, :2]))
@@ -113,7 +113,7 @@ def floor_below(drv: Driver, point: np.ndarray, obj: str) -> float | None:
     from anomalygen.scene import robot
 
     m, d = drv.model, drv.data
-    skip = robot._subtree_geoms(m, drv.body_id(obj)) | np.isin(np.arange(m.ngeom), list(drv._robot_geoms))
+    skip = robot.subtree_geoms(m, drv.body_id(obj)) | np.isin(np.arange(m.ngeom), list(drv._robot_geoms))
     start = np.asarray(point, dtype=float).copy()
     geomid = np.zeros(1, dtype=np.int32)
     for _ in range(8):  # step past ignored geoms
@@ -216,7 +216,7 @@ def footprint(drv: Driver, obj: str) -> tuple[float, float, float]:
     from anomalygen.scene import robot
 
     m, d = drv.model, drv.data
-    mask = robot._subtree_geoms(m, drv.body_id(obj))
+    mask = robot.subtree_geoms(m, drv.body_id(obj))
     pts = []
     for g in np.flatnonzero(mask):
         c, h = m.geom_aabb[g, :3], m.geom_aabb[g, 3:]
@@ -279,7 +279,7 @@ def static_box(drv, obj: str) -> tuple[np.ndarray, np.ndarray]:
         return False
 
     lo, hi = geom_world_aabbs(m, drv.data)
-    sub = robot._subtree_geoms(m, root)
+    sub = robot.subtree_geoms(m, root)
     sel = [g for g in np.flatnonzero(sub) if not moves(int(m.geom_bodyid[g]))
            and (m.geom_contype[g] or m.geom_conaffinity[g])]
     if not sel:

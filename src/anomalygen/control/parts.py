@@ -158,7 +158,7 @@ def _on_surface(drv, g: PartGrasp) -> PartGrasp:
 
     m, d = drv.model, drv.data
     p, n = _world(drv, g)
-    part = robot._subtree_geoms(m, g.body)
+    part = robot.subtree_geoms(m, g.body)
     start = p + n * 0.05
     geomid = np.zeros(1, dtype=np.int32)
     travelled = 0.0

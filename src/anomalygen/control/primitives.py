@@ -29,19 +29,12 @@ from anomalygen.control.geometry import (
 
 
 def _step(env_like, target_pos) -> None:
-    """Move the mocap target towards ``target_pos`` at most ``dp`` per control step, then simulate."""
+    """Move the target towards ``target_pos`` at most ``dp`` per control step, then simulate."""
     import mujoco
 
-    m, d = env_like.model, env_like.data
-    mid = env_like._mocap
-    cup = d.xpos[env_like._cup]
-    delta = np.asarray(target_pos) - d.mocap_pos[mid]
-    n = np.linalg.norm(delta)
-    if n > env_like.dp:
-        delta *= env_like.dp / n
-    d.mocap_pos[mid] = cup + np.clip(d.mocap_pos[mid] + delta - cup, -0.08, 0.08)
+    env_like.robot.target_towards(env_like.data, target_pos, env_like.dp)
     for _ in range(env_like.frameskip):
-        mujoco.mj_step(m, d)
+        mujoco.mj_step(env_like.model, env_like.data)
 
 
 def push_joint(env_like, joint: str, goal: float, point_site: str, *, tol: float = 0.08, max_steps: int = 300,
@@ -67,7 +60,7 @@ def push_joint(env_like, joint: str, goal: float, point_site: str, *, tol: float
             steps += 1
             if on_step:
                 on_step()
-            if np.linalg.norm(d.site_xpos[env_like._site_ee] - pre) < 0.02:
+            if np.linalg.norm(d.site_xpos[env_like.robot.ee_site] - pre) < 0.02:
                 break
     # 2. push: follow the moving point, aiming past it along the motion
     while steps < max_steps and abs(q() - goal) > tol and sign * (goal - q()) > 0:
@@ -168,7 +161,7 @@ def side_grasp(drv: Driver, obj: str, *, lift: float = 0.12) -> PrimitiveResult:
     s0 = drv.steps
     m, d = drv.model, drv.data
     glo, ghi = geom_world_aabbs(m, d)
-    mask = robot._subtree_geoms(m, drv.body_id(obj)) & (m.geom_contype | m.geom_conaffinity).astype(bool)
+    mask = robot.subtree_geoms(m, drv.body_id(obj)) & (m.geom_contype | m.geom_conaffinity).astype(bool)
     g = max(np.flatnonzero(mask), key=lambda k: float(np.prod(ghi[k, :2] - glo[k, :2])))
     centre = (glo[g] + ghi[g]) / 2
     base = np.array([float(d.joint(j).qpos[0]) for j in robot.BASE_JOINTS[:2]])
@@ -363,7 +356,7 @@ def held_touches(drv: Driver, obj: str) -> bool:
     from anomalygen.scene import robot
 
     d = drv.data
-    mask = robot._subtree_geoms(drv.model, drv.body_id(obj))
+    mask = robot.subtree_geoms(drv.model, drv.body_id(obj))
     for i in range(d.ncon):
         g1, g2 = int(d.contact.geom1[i]), int(d.contact.geom2[i])
         if mask[g1] == mask[g2]:

@@ -22,6 +22,7 @@ import numpy as np
 from gymnasium import spaces
 
 from anomalygen.rl.reward import evaluate_spec
+from anomalygen.scene.robot import EE_SITE, Robot
 from anomalygen.schema import RewardSpec, RewardTerm
 
 # Scales: the door term (~1 rad -> 0) dominates; the distance term keeps the cup on the handle's
@@ -60,11 +61,10 @@ class DoorCloseEnv(gym.Env):
         self.dp, self.dr = max_delta_pos, max_delta_rot
         self.action_space = spaces.Box(-1.0, 1.0, shape=(7,), dtype=np.float32)
         self.observation_space = spaces.Box(-np.inf, np.inf, shape=(13,), dtype=np.float64)
-        self._site_ee = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "ee_site")
+        self.robot = Robot(m)
+        self._site_ee = self.robot.ee_site
         self._site_h = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "cabinet_0:door_handle")
-        self._eq = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, "ee_track")
-        self._mocap = m.body_mocapid[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "ee_target")]
-        self._cup = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "suction")
+        self._mocap = self.robot.mocap
         self._door_body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "cabinet_0:door")
         self.near_start, self.start_noise, self.terminate_on_success = near_start, start_noise, terminate_on_success
         self._arm = [f"panda_joint{i}" for i in range(1, 8)]
@@ -114,18 +114,13 @@ class DoorCloseEnv(gym.Env):
         if self.near_start:
             from anomalygen.control.ik import site_pose, solve_ik
 
-            _, quat = site_pose(m, d, "ee_site")
+            _, quat = site_pose(m, d, EE_SITE)
             R = d.xmat[self._door_body].reshape(3, 3)
             start = (self.push_point() - 0.04 * R[:, 0]
                      + self.np_random.uniform(-self.start_noise, self.start_noise, size=3))
-            d.qpos[:] = solve_ik(m, d, "ee_site", self._arm, start, quat, iterations=150).qpos
+            d.qpos[:] = solve_ik(m, d, EE_SITE, self._arm, start, quat, iterations=150).qpos
             mj.mj_forward(m, d)
-        d.mocap_pos[self._mocap] = d.xpos[self._cup]
-        d.mocap_quat[self._mocap] = d.xquat[self._cup]
-        m.eq_data[self._eq, :] = 0.0
-        m.eq_data[self._eq, 6] = 1.0
-        m.eq_data[self._eq, 10] = 1.0
-        d.eq_active[self._eq] = 1
+        self.robot.enable_ee_tracking(d)
         mj.mj_forward(m, d)
         self._t = 0
         self._action = np.zeros(7)
@@ -133,17 +128,7 @@ class DoorCloseEnv(gym.Env):
 
     def step(self, action):
         mj, d = self._mj, self.data
-        a = np.clip(np.asarray(action, dtype=float), -1, 1)
-        self._action = a
-        pos = d.mocap_pos[self._mocap] + self.dp * a[:3]
-        # keep the target near the cup so the weld never yanks the arm
-        ee = d.xpos[self._cup]
-        d.mocap_pos[self._mocap] = ee + np.clip(pos - ee, -0.08, 0.08)
-        dq = np.zeros(4)
-        mj.mju_axisAngle2Quat(dq, a[3:6] / (np.linalg.norm(a[3:6]) + 1e-9), self.dr * min(1.0, np.linalg.norm(a[3:6])))
-        q = np.zeros(4)
-        mj.mju_mulQuat(q, d.mocap_quat[self._mocap], dq)  # rotation in the gripper frame
-        d.mocap_quat[self._mocap] = q / np.linalg.norm(q)
+        self._action = self.robot.apply_action(d, action, dp=self.dp, dr=self.dr)
         for _ in range(self.frameskip):
             mj.mj_step(self.model, d)
         self._t += 1
@@ -164,3 +149,15 @@ class DoorCloseEnv(gym.Env):
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
+
+
+DOOR_ENV_ID = "anomalygen/DoorClose-v0"
+
+
+def register() -> None:
+    """Register ``anomalygen/DoorClose-v0`` (idempotent); ``gym.make`` adds a TimeLimit at the horizon."""
+    if DOOR_ENV_ID not in gym.registry:
+        gym.register(id=DOOR_ENV_ID, entry_point="anomalygen.rl.door_env:DoorCloseEnv", max_episode_steps=100)
+
+
+register()

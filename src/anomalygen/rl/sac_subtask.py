@@ -157,7 +157,7 @@ def run_sac_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, thre
                             stop_at=0.9, log=log)
 
     restore(drv.model, drv.data, snap)
-    ee0 = drv.data.site_xpos[readout.ids.site].copy()
+    ee0 = drv.data.site_xpos[readout.robot.cup_site].copy()
     state = readout.state(drv.model, drv.data)
     fs, drv.frameskip = drv.frameskip, FRAMESKIP
     ok, why, t = False, "", 0

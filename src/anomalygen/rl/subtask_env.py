@@ -9,7 +9,8 @@ and training must never touch the scene the Driver runs on.
 
 Paper settings, as in :mod:`~anomalygen.rl.door_env`: 7-D action (3 cm per step cup translation,
 0.1 rad per step rotation in the cup frame, suction on when the last entry is > 0), horizon 100,
-frameskip 2. :func:`apply_action` is the one action mapping; ``run_sac_subtask`` replays the trained
+frameskip 2. :meth:`~anomalygen.scene.robot.Robot.apply_action` is the one action mapping (every env and
+the Driver share it); ``run_sac_subtask`` replays the trained
 policy on the Driver's own data through it, so training and the recorded rollout behave the same.
 
 Reward = ``reward.evaluate_spec(sub_task.reward, state)`` over the state dict of ``reward.py``
@@ -31,98 +32,28 @@ and an episode runs at most 3 steps past success (pressing on a closed door does
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
 from anomalygen.rl.reward import evaluate_spec
+from anomalygen.scene.robot import Robot, subtree_geoms
 from anomalygen.schema import RewardSpec, SceneSpec, SubTask
 
 HORIZON = 100
 FRAMESKIP = 2
 MAX_DELTA_POS = 0.03  # m per control step
 MAX_DELTA_ROT = 0.1  # rad per control step
-TARGET_LEASH = 0.08  # m: the mocap target never runs further than this ahead of the cup
 START_NOISE = 0.02  # m: +- noise on the end-effector target at reset
 JOINT_TOL_FRACTION = 0.05  # of the joint's range: the default of the joint_closed predicate
 SUCCESS_EVERY = 4
 POS_SCALE = 10.0  # positions in the observation are in dm (~unit scale for the networks)
 
 
-@dataclass(frozen=True)
-class ControlIds:
-    """What :func:`apply_action` writes to: the ``ee_target`` mocap index and the cup body."""
-
-    mocap: int
-    cup: int
-    site: int  # suction_site, the cup face: "ee" in the state dict
-
-
-def control_ids(model) -> ControlIds:
-    return ControlIds(mocap=int(model.body_mocapid[model.body("ee_target").id]), cup=int(model.body("suction").id),
-                      site=int(model.site("suction_site").id))
-
-
-def apply_action(model, data, ids: ControlIds, action, *, dp: float = MAX_DELTA_POS,
-                 dr: float = MAX_DELTA_ROT) -> np.ndarray:
-    """Map one 7-D action onto the mocap target and the suction toggle (no physics step).
-
-    Translation moves the target by ``dp * a[:3]``, kept within ``TARGET_LEASH`` of the cup so the
-    weld never yanks the arm; ``a[3:6]`` is an axis-angle rotation (at most ``dr``) in the cup frame;
-    ``a[6] > 0`` grabs the nearest suction candidate within range (see :func:`_grab_nearest`),
-    ``<= 0`` releases. Returns the clipped action (the reward's action penalty reads it).
-    """
-    import mujoco
-
-    from anomalygen.scene import robot
-
-    a = np.clip(np.asarray(action, dtype=float).reshape(7), -1.0, 1.0)
-    cup = data.xpos[ids.cup]
-    pos = data.mocap_pos[ids.mocap] + dp * a[:3]
-    data.mocap_pos[ids.mocap] = cup + np.clip(pos - cup, -TARGET_LEASH, TARGET_LEASH)
-    n = float(np.linalg.norm(a[3:6]))
-    if n > 1e-9:
-        dq, q = np.zeros(4), np.zeros(4)
-        mujoco.mju_axisAngle2Quat(dq, a[3:6] / n, dr * min(1.0, n))
-        mujoco.mju_mulQuat(q, data.mocap_quat[ids.mocap], dq)
-        data.mocap_quat[ids.mocap] = q / np.linalg.norm(q)
-    held = robot.held_object(model, data)
-    if a[6] > 0 and held is None:
-        _grab_nearest(model, data)
-    elif a[6] <= 0 and held is not None:
-        robot.suction_off(model, data)
-    return a
-
-
-def _grab_nearest(model, data) -> bool:
-    """Suction on the nearest candidate within range; a part (door, lid, drawer: a body on a hinge or
-    slide) is held by position only (torque scale 0), as the part primitives do, so it can turn under
-    the cup as it swings; a free object is held rigidly."""
-    import mujoco
-
-    from anomalygen.scene import robot
-
-    mujoco.mj_kinematics(model, data)
-    best, best_d = None, robot.SUCTION_RANGE
-    for name in robot.suction_candidates(model):
-        dist = robot.object_distance_to_cup(model, data, name)
-        if dist <= best_d:
-            best, best_d = name, dist
-    if best is None:
-        return False
-    j = int(model.body_jntadr[model.body(best).id])
-    part = j >= 0 and model.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE
-    return robot.suction_on(model, data, best, torquescale=0.0 if part else 1.0)
-
-
-def _subtree_geoms(model, body: int) -> np.ndarray:
-    bodies = {body}
-    for b in range(body + 1, model.nbody):
-        if int(model.body_parentid[b]) in bodies:
-            bodies.add(b)
-    return np.flatnonzero(np.isin(model.geom_bodyid, list(bodies)) & (model.geom_type != 0))
+def _collision_geoms(model, body: int) -> np.ndarray:
+    """Ids of the geoms of ``body`` and its descendants, planes left out (they have no finite box)."""
+    return np.flatnonzero(subtree_geoms(model, body) & (model.geom_type != 0))
 
 
 class SubTaskReadout:
@@ -141,14 +72,14 @@ class SubTaskReadout:
             raise ValueError(f"sub-task {sub_task.id} has no RewardSpec in mode 'spec' to learn from")
         self.spec, self.sub_task, self.bindings = spec, sub_task, dict(bindings)
         self.reward: RewardSpec = sub_task.reward
-        self.ids = control_ids(model)
+        self.robot = Robot(model)
         self._mj = mujoco
         # every spec object: (name, root body, geom ids); referenced links and sites added below
         self._boxes: dict[str, tuple[int, np.ndarray]] = {}
         for o in spec.objects:
             b = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, o.name)
             if b >= 0:
-                self._boxes[o.name] = (b, _subtree_geoms(model, b))
+                self._boxes[o.name] = (b, _collision_geoms(model, b))
         self._sites: dict[str, int] = {}
         self._alias: dict[str, str] = {}  # name as written in the spec -> resolved name
         points: list[str | tuple] = []
@@ -198,7 +129,7 @@ class SubTaskReadout:
             return name
         b = mj.mj_name2id(model, mj.mjtObj.mjOBJ_BODY, name)
         if b >= 0:
-            self._boxes[name] = (b, _subtree_geoms(model, b))
+            self._boxes[name] = (b, _collision_geoms(model, b))
             return name
         s = mj.mj_name2id(model, mj.mjtObj.mjOBJ_SITE, name)
         if s >= 0:
@@ -209,12 +140,11 @@ class SubTaskReadout:
     # ------------------------------------------------------------------ readout
     def state(self, model, data, action=None) -> dict:
         """The reward.py state dict (call after mj_forward / mj_step)."""
-        from anomalygen.scene import robot
         from anomalygen.scene.graph import geom_world_aabbs
 
         glo, ghi = geom_world_aabbs(model, data)
         quat = np.zeros(4)
-        self._mj.mju_mat2Quat(quat, data.site_xmat[self.ids.site])
+        self._mj.mju_mat2Quat(quat, data.site_xmat[self.robot.cup_site])
         objects: dict[str, dict] = {}
         for name, (body, geoms) in self._boxes.items():
             if len(geoms):
@@ -233,8 +163,8 @@ class SubTaskReadout:
             for table in (objects, regions, joints):
                 if name in table:
                     table[ref] = table[name]
-        return {"ee": {"pos": data.site_xpos[self.ids.site].copy(), "quat": quat},
-                "suction": 1.0 if robot.held_object(model, data) is not None else 0.0,
+        return {"ee": {"pos": data.site_xpos[self.robot.cup_site].copy(), "quat": quat},
+                "suction": 1.0 if self.robot.held(data) is not None else 0.0,
                 "objects": objects, "joints": joints, "regions": regions,
                 "action": np.zeros(7) if action is None else np.asarray(action, dtype=float)}
 
@@ -312,7 +242,7 @@ class SubTaskEnv(gym.Env):
         self.action_space = spaces.Box(-1.0, 1.0, shape=(7,), dtype=np.float32)
         self.observation_space = spaces.Box(-np.inf, np.inf, shape=(self.readout.obs_dim,), dtype=np.float64)
         self._restore()
-        self._ee0 = self.data.site_xpos[self.readout.ids.site].copy()
+        self._ee0 = self.data.site_xpos[self.readout.robot.cup_site].copy()
         self._t = 0
         self._state = self.readout.state(self.model, self.data)
 
@@ -329,7 +259,7 @@ class SubTaskEnv(gym.Env):
         super().reset(seed=seed)
         self._restore()
         if self.start_noise > 0:
-            self.data.mocap_pos[self.readout.ids.mocap] += self.np_random.uniform(-self.start_noise, self.start_noise, 3)
+            self.data.mocap_pos[self.readout.robot.mocap] += self.np_random.uniform(-self.start_noise, self.start_noise, 3)
             self._mj.mj_forward(self.model, self.data)
         self._t = 0
         self._state = self.readout.state(self.model, self.data)
@@ -352,7 +282,7 @@ def control_step(readout: SubTaskReadout, model, data, action, t: int, advance, 
     """One control step, shared by the env and the Driver rollout: apply the action, ``advance()``
     the physics (frameskip steps), read the state; success is checked on the schedule described in
     the module docstring. ``t`` counts this step (1-based). Returns (state, reward, success, why)."""
-    a = apply_action(model, data, readout.ids, action)
+    a = readout.robot.apply_action(data, action, dp=MAX_DELTA_POS, dr=MAX_DELTA_ROT)
     advance()
     state = readout.state(model, data, a)
     reward = evaluate_spec(readout.reward, state)

@@ -44,7 +44,7 @@ def build_spec(*, with_cabinet=True, with_objects=True, door_open=1.2):
     """MjSpec of the test scene (robot at the origin facing +x)."""
     import mujoco
 
-    from anomalygen.scene.robot import add_suction_welds, build_robot_spec
+    from anomalygen.scene.robot_model import add_suction_welds, build_robot_spec
 
     spec = build_robot_spec((0.0, 0.0, 0.0))
     spec.option.timestep = TIMESTEP

@@ -30,7 +30,8 @@ import numpy as np
 from anomalygen.errors import ItemFailed
 from anomalygen.rng import item_rng, stable_hash
 from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
-from anomalygen.scene import furniture, layout, robot, select
+from anomalygen.scene import furniture, layout, robot, robot_model, select
+from anomalygen.scene.graph import FLOOR_GEOM
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.sensors import add_observation_sensors
 from anomalygen.schema import (
@@ -490,7 +491,7 @@ def _look_at_xyaxes(eye, target) -> list[float]:
 def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
     import mujoco
 
-    spec = robot.build_robot_spec(tuple(lay.base))
+    spec = robot_model.build_robot_spec(tuple(lay.base))
     spec.modelname = "anomalygen_scene"
     spec.option.timestep = 0.002
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
@@ -511,7 +512,7 @@ def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
     center = layout.ROOM_CENTER
     half = layout.ROOM_HALF + 0.6
     spec.worldbody.add_geom(
-        name="floor",
+        name=FLOOR_GEOM,
         type=mujoco.mjtGeom.mjGEOM_PLANE,
         size=[half[0], half[1], 0.05],
         pos=[center[0], center[1], 0],
@@ -587,7 +588,7 @@ def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
                 geom.priority = 1
                 geom.solref = [LOOSE_SOLREF, 1.0]
     # Suction can also hold a door, lid or drawer, so primitives can pull parts open or lift them shut.
-    robot.add_suction_welds(spec, [n for n, _ in loose] + parts, [r for _, r in loose] + parts)
+    robot_model.add_suction_welds(spec, [n for n, _ in loose] + parts, [r for _, r in loose] + parts)
     task_objects = [p for p in placed.values() if p.role != ObjectRole.CLUTTER]
     add_observation_sensors(
         spec,
@@ -845,9 +846,9 @@ def write_outputs(built: Built, settings, out_dir: Path) -> SceneSpec:
 
 def _write_xml(mjspec, out_dir: Path) -> None:
     """scene.xml with robot meshes under assets/franka, loadable from any working directory."""
-    src = robot.franka_assets_dir() / "meshes"
+    src = robot_model.franka_assets_dir() / "meshes"
     dst = out_dir / "assets" / "franka"
-    for rel in robot.mesh_files():
+    for rel in robot_model.mesh_files():
         target = dst / rel
         if target.exists():
             continue

@@ -1,8 +1,9 @@
 """A Gymnasium environment for a built scene: end-effector delta actions plus suction.
 
-Action (Box [-1, 1]^7), as in the paper: a delta translation (3) and a delta axis-angle rotation (3)
-of the end effector, scaled by ``max_delta_pos`` / ``max_delta_rot`` per step, plus suction (> 0 on,
-<= 0 off). The end effector follows a mocap target through the ``ee_track`` weld (MuJoCo solves it
+Action (Box [-1, 1]^7), as in the paper: a delta translation (3) and a delta axis-angle rotation (3,
+in the cup frame) of the end effector, scaled by ``max_delta_pos`` / ``max_delta_rot`` per step, plus
+suction (> 0 on, <= 0 off); :meth:`~anomalygen.scene.robot.Robot.move_target` maps it, as for every
+env. The end effector follows a mocap target through the ``ee_track`` weld (MuJoCo solves it
 inside the physics step), so a step costs almost exactly ``frameskip`` raw ``mj_step`` calls: no
 Python IK loop. Arm actuators go limp in this mode (gravity compensation keeps the arm up); the base
 actuators hold the mobile base where the scene put it.
@@ -15,12 +16,16 @@ Suction grabs an object whose geoms touch the cup (a contact, checked with numpy
 list) and welds it at the current relative pose; turning suction off releases it.
 
 Hooks: ``reward_fn(env) -> float`` and ``success_fn(env) -> bool`` let the skills stage plug in
-RewardSpec/SuccessSpec evaluation; ``env.graph()`` gives the current SceneGraph.
+RewardSpec/SuccessSpec evaluation (``info["is_success"]`` carries the latter, as SB3 reads it);
+``env.graph()`` gives the current SceneGraph. The loaded SceneSpec is ``env.scene``.
+
+Episode length: ``gym.make(ENV_ID, scene_dir=...)`` wraps the env in Gymnasium's ``TimeLimit``
+(``max_episode_steps=HORIZON``, set at registration); ``make_env`` returns the bare env, which
+truncates after its own ``horizon`` steps without the wrappers' per-step cost.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from pathlib import Path
 
@@ -31,6 +36,7 @@ from gymnasium import spaces
 from anomalygen.scene import robot
 
 ENV_ID = "anomalygen/Scene-v0"
+HORIZON = 100  # control steps per episode
 
 
 class SceneEnv(gym.Env):
@@ -40,7 +46,7 @@ class SceneEnv(gym.Env):
         self,
         scene_dir: str | Path,
         frameskip: int = 2,
-        horizon: int = 100,
+        horizon: int | None = None,
         *,
         render_mode: str | None = "rgb_array",
         camera: str = "front",
@@ -58,8 +64,10 @@ class SceneEnv(gym.Env):
 
         self._mj = mujoco
         self.scene_dir = Path(scene_dir)
-        self.model, self.data, self.spec = load_scene(self.scene_dir)
-        self.frameskip, self.horizon = int(frameskip), int(horizon)
+        # ``scene``, not ``spec``: Gymnasium keeps its EnvSpec in ``env.spec`` and ``gym.make`` sets it.
+        self.model, self.data, self.scene = load_scene(self.scene_dir)
+        self.frameskip = int(frameskip)
+        self.horizon = None if horizon is None else int(horizon)  # None: TimeLimit ends episodes
         self.render_mode, self.camera = render_mode, camera
         self.width, self.height = width, height
         self.max_delta_pos, self.max_delta_rot = float(max_delta_pos), float(max_delta_rot)
@@ -69,15 +77,13 @@ class SceneEnv(gym.Env):
 
         m = self.model
         name2id = mujoco.mj_name2id
-        self._track = name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, "ee_track")
-        self._mocap = int(m.body_mocapid[name2id(m, mujoco.mjtObj.mjOBJ_BODY, "ee_target")])
-        self._cup_body = name2id(m, mujoco.mjtObj.mjOBJ_BODY, "suction")
-        self._cup_geom = name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "suction_geom")
-        self._ee_site = name2id(m, mujoco.mjtObj.mjOBJ_SITE, "ee_site")
+        self.robot = robot.Robot(m)
+        self._mocap, self._cup_body = self.robot.mocap, self.robot.cup
+        self._cup_geom, self._ee_site = self.robot.cup_geom, self.robot.ee_site
         jids = [name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in robot.ROBOT_JOINTS]
         self._robot_qpos = np.array([m.jnt_qposadr[j] for j in jids])
         self._robot_qvel = np.array([m.jnt_dofadr[j] for j in jids])
-        task_objects = [o for o in self.spec.objects if o.role.value != "clutter"]
+        task_objects = [o for o in self.scene.objects if o.role.value != "clutter"]
         self.task_objects = [o.name for o in task_objects]
         self._obj_bodies = np.array(
             [name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in self.task_objects], dtype=int
@@ -89,10 +95,10 @@ class SceneEnv(gym.Env):
         # Suction: geom -> object body with a suction weld, and that weld's id.
         self._geom_to_eq = np.full(m.ngeom, -1, dtype=int)
         self._eq_rel = {}
-        for name in robot.suction_candidates(m):
+        for name in self.robot.suction_objects:
             eq = name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, robot.SUCTION_PREFIX + name)
             body = name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
-            self._geom_to_eq[robot._subtree_geoms(m, body)] = eq
+            self._geom_to_eq[self.robot.subtree_geoms(body)] = eq
             self._eq_rel[eq] = body
         self._held_eq = -1
 
@@ -127,9 +133,6 @@ class SceneEnv(gym.Env):
         self.observation_space = spaces.Box(-np.inf, np.inf, shape=(start,), dtype=np.float64)
         self.action_space = spaces.Box(-1.0, 1.0, shape=(7,), dtype=np.float32)
         self._cache_views()
-        self._dq = np.zeros(4)
-        self._qtmp = np.zeros(4)
-        self._axis = np.zeros(3)
         self.t = 0
 
     # ------------------------------------------------------------------ gym API
@@ -145,45 +148,19 @@ class SceneEnv(gym.Env):
             )
             mj.mj_forward(m, d)
         # Start the mocap target at the cup's pose and switch on tracking (base held in place).
-        robot.enable_ee_tracking(m, d)
+        self.robot.enable_ee_tracking(d)
         self._held_eq = -1
         self.t = 0
-        return self._observe(), {}
+        return self._observe(), {"is_success": False}
 
     def step(self, action):
-        # Scalar Python maths on 7 numbers beats a dozen tiny numpy/mju calls: this is the hot path.
         d = self.data
         try:
             a = action.tolist()
         except AttributeError:
             a = list(action)
-        dp, dr = self.max_delta_pos, self.max_delta_rot
-        mx, my, mz = self._v_mpos.tolist()
-        cx, cy, cz = self._v_cup.tolist()
-        ax = a[0] if -1.0 <= a[0] <= 1.0 else (1.0 if a[0] > 0 else -1.0)
-        ay = a[1] if -1.0 <= a[1] <= 1.0 else (1.0 if a[1] > 0 else -1.0)
-        az = a[2] if -1.0 <= a[2] <= 1.0 else (1.0 if a[2] > 0 else -1.0)
-        # move the target, but keep it within 8 cm of the cup (no runaway target)
-        mx = min(max(mx + ax * dp, cx - 0.08), cx + 0.08)
-        my = min(max(my + ay * dp, cy - 0.08), cy + 0.08)
-        mz = min(max(mz + az * dp, cz - 0.08), cz + 0.08)
-        self._v_mpos[:] = (mx, my, mz)
-        rx = min(1.0, max(-1.0, a[3])) * dr
-        ry = min(1.0, max(-1.0, a[4])) * dr
-        rz = min(1.0, max(-1.0, a[5])) * dr
-        angle = (rx * rx + ry * ry + rz * rz) ** 0.5
-        if angle > 1e-9:
-            # world-frame rotation: q_new = q(axis, angle) * q_target
-            h = 0.5 * angle
-            sh = math.sin(h) / angle
-            w1, x1, y1, z1 = math.cos(h), rx * sh, ry * sh, rz * sh
-            w2, x2, y2, z2 = self._v_mquat.tolist()
-            w = w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2
-            x = w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2
-            y = w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2
-            z = w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2
-            n = (w * w + x * x + y * y + z * z) ** 0.5
-            self._v_mquat[:] = (w / n, x / n, y / n, z / n)
+        a = [v if -1.0 <= v <= 1.0 else (1.0 if v > 0 else -1.0) for v in a]
+        self.robot.move_target(d, a, dp=self.max_delta_pos, dr=self.max_delta_rot)
         if a[6] > 0.0:
             if self._held_eq < 0:
                 self._try_grab()
@@ -199,8 +176,9 @@ class SceneEnv(gym.Env):
         else:
             obs = self._observe()
         reward = float(self.reward_fn(self)) if self.reward_fn is not None else 0.0
-        terminated = bool(self.success_fn(self)) if self.success_fn is not None else False
-        return obs, reward, terminated, self.t >= self.horizon, {}
+        success = bool(self.success_fn(self)) if self.success_fn is not None else False
+        truncated = self.horizon is not None and self.t >= self.horizon
+        return obs, reward, success, truncated, {"is_success": success}
 
     def render(self):
         if self.render_mode != "rgb_array":
@@ -223,9 +201,6 @@ class SceneEnv(gym.Env):
         self._v_sens = d.sensordata
         self._o_sens = o[:-1]
         self._v_qpos, self._v_qvel, self._v_xpos, self._v_xquat = d.qpos, d.qvel, d.xpos, d.xquat
-        self._v_mpos = d.mocap_pos[self._mocap]
-        self._v_mquat = d.mocap_quat[self._mocap]
-        self._v_cup = d.xpos[self._cup_body]
         self._v_site = d.site_xpos[self._ee_site]
         self._o = {k: o[v] for k, v in L.items()}
         self._o_obj_pos = self._o["object_pos"].reshape(-1, 3)
@@ -288,10 +263,10 @@ class SceneEnv(gym.Env):
         from anomalygen.scene.graph import scene_graph
 
         self._mj.mj_forward(self.model, self.data)
-        return scene_graph(self.model, self.data, self.spec)
+        return scene_graph(self.model, self.data, self.scene)
 
 
-def make_env(scene_dir, frameskip: int = 2, horizon: int = 100, **kwargs) -> SceneEnv:
+def make_env(scene_dir, frameskip: int = 2, horizon: int = HORIZON, **kwargs) -> SceneEnv:
     """The env for a built scene folder, unwrapped (no checker wrappers: they would add step cost)."""
     return SceneEnv(scene_dir, frameskip=frameskip, horizon=horizon, **kwargs)
 
@@ -299,7 +274,7 @@ def make_env(scene_dir, frameskip: int = 2, horizon: int = 100, **kwargs) -> Sce
 def register() -> None:
     """Register ``anomalygen/Scene-v0`` with Gymnasium (idempotent): ``gym.make(ENV_ID, scene_dir=...)``."""
     if ENV_ID not in gym.registry:
-        gym.register(id=ENV_ID, entry_point="anomalygen.scene.env:SceneEnv", kwargs={})
+        gym.register(id=ENV_ID, entry_point="anomalygen.scene.env:SceneEnv", max_episode_steps=HORIZON)
 
 
 register()

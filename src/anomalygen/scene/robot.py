@@ -1,26 +1,22 @@
-"""The robot: a Franka Panda arm with a suction cup, on a mobile base (planar x, y, yaw).
+"""The robot at run time: its element names, the :class:`Robot` that resolves them, suction and lift.
 
-Source of the arm: the Franka Panda MJCF and meshes shipped by the ``gymnasium-robotics`` wheel
-(``gymnasium_robotics/envs/assets/kitchen_franka/franka_assets/``, MIT; itself modified from
-github.com/vikashplus/franka, Apache-2.0). We read its ``assets.xml`` and ``chain.xml`` at build
-time rather than copying them, drop the two parallel fingers (our gripper is a suction cup, as in the
-paper) and rename joints to plain ``panda_joint1..7``.
+A Franka Panda arm with a suction cup, on a mobile base (planar x, y, yaw); the MJCF is built by
+:mod:`anomalygen.scene.robot_model`. Why a mobile base: household hazards lie on the floor, on
+counters and on shelves across a room; a fixed arm reaches none of that. Three joints (``base_x``,
+``base_y`` slide, ``base_yaw`` hinge) move the base on the floor, with position actuators of the same
+names. Why a torso lift (body ``torso`` under the arm, as on Fetch, TIAGo or Stretch): with the arm's
+shoulder at counter height the cup cannot reach, face-down, the lid of a box that stands on a 0.9 m
+counter; raised by up to ``LIFT_MAX`` it can. It rests at 0, where the arm reaches the floor;
+``set_lift`` moves it.
 
-Why a mobile base: household hazards lie on the floor, on counters and on shelves across a room; a
-fixed arm reaches none of that. Three joints (``base_x``, ``base_y`` slide, ``base_yaw`` hinge) move
-the base on the floor, with position actuators of the same names. Why a torso lift (body ``torso``
-under the arm, as on Fetch, TIAGo or Stretch): with the arm's shoulder at counter height the cup
-cannot reach, face-down, the lid of a box that stands on a 0.9 m counter; raised by up to
-``LIFT_MAX`` it can. It rests at 0, where the arm reaches the floor; ``set_lift`` moves it.
-
-Names other stages rely on (see docs/scene.md):
+Names other stages rely on (see docs/scene.md), each a constant below so no module spells them out:
 
 * joints ``base_x base_y base_yaw panda_joint1 .. panda_joint7`` (``ROBOT_JOINTS``), each with a
   position actuator of the same name (``ctrl`` = target joint value);
 * bodies ``base``, ``torso`` (carried by the lift), ``panda_link0 .. panda_link7``, ``suction`` (the cup);
 * sites ``ee_site`` (tool frame, z axis pointing out of the cup) and ``suction_site`` (cup face);
-* mocap body ``ee_target`` and weld ``ee_track`` (inactive unless the Gymnasium env drives the arm
-  by end-effector deltas);
+* mocap body ``ee_target`` and weld ``ee_track`` (inactive unless an env or the Driver drives the
+  arm by end-effector targets);
 * welds ``suction__<object>`` from the cup to each free object, all inactive at build time; toggle
   them with :func:`suction_on` / :func:`suction_off`.
 * ``set_home``: base joints at the scene's base pose, arm at ``HOME_ARM`` (cup pointing down);
@@ -29,9 +25,7 @@ Names other stages rely on (see docs/scene.md):
 
 from __future__ import annotations
 
-import re
-from functools import lru_cache
-from pathlib import Path
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -42,205 +36,28 @@ if TYPE_CHECKING:  # pragma: no cover
 ARM_JOINTS = tuple(f"panda_joint{i}" for i in range(1, 8))
 BASE_JOINTS = ("base_x", "base_y", "base_yaw")
 ROBOT_JOINTS = BASE_JOINTS + ARM_JOINTS
+# Arm position gains (kp, N m force limit) per joint, from the source actuator.xml.
+ARM_GAINS = ((870, 87), (870, 87), (870, 87), (870, 87), (120, 12), (120, 12), (120, 12))
+BASE_BODY = "base"
+TORSO = "torso"  # the body the lift raises
+CUP_BODY = "suction"  # the suction cup at the end of the arm
+CUP_GEOM = "suction_geom"
+CUP_SITE = "suction_site"  # the cup face: where objects are held, "ee" in reward state dicts
+EE_SITE = "ee_site"  # tool frame, z out of the cup
+EE_TARGET = "ee_target"  # mocap body the cup follows in end-effector control
+EE_TRACK = "ee_track"  # weld from the cup to EE_TARGET
 # A tucked arm pose with the cup pointing straight down 0.3 m in front of the base at 1.01 m height
 # (found by forward kinematics; tests check it): tucked and above counter height, so the base can
 # drive up to tables and counters without the arm hitting them.
 HOME_ARM = (0.0, -0.5, 0.0, -1.55, 0.0, -0.55, -0.785)
-BASE_HEIGHT = 0.30  # top of the mobile base, where the arm's link0 stands with the lift down
-LIFT_MAX = 0.30  # metres the torso lift raises the arm
-BASE_RADIUS = 0.22
-SUCTION_RANGE = 0.012  # metres: how far from the cup face an object may be and still be grabbed
+BASE_HEIGHT = 0.30  # m: top of the mobile base, where the arm's link0 stands with the lift down
+LIFT_MAX = 0.30  # m the torso lift raises the arm
+BASE_RADIUS = 0.22  # m
+SUCTION_RANGE = 0.012  # m: how far from the cup face an object may be and still be grabbed
 SUCTION_PREFIX = "suction__"
-ROBOT_BODY_PREFIXES = ("base", "torso", "panda_", "suction", "ee_target")
-# Arm position gains from the source actuator.xml (kp and force limits of each joint).
-_ARM_GAINS = ((870, 87), (870, 87), (870, 87), (870, 87), (120, 12), (120, 12), (120, 12))
-
-
-def franka_assets_dir() -> Path:
-    """The installed gymnasium-robotics Franka folder (MJCF + meshes)."""
-    import importlib.util
-
-    found = importlib.util.find_spec("gymnasium_robotics")  # no import: the package warns on import
-    if found is None or not found.submodule_search_locations:  # pragma: no cover
-        from anomalygen.errors import UserError
-
-        raise UserError("gymnasium-robotics is not installed (it provides the Franka Panda model)")
-    path = (
-        Path(list(found.submodule_search_locations)[0])
-        / "envs"
-        / "assets"
-        / "kitchen_franka"
-        / "franka_assets"
-    )
-    if not (path / "chain.xml").is_file():  # pragma: no cover - broken installation
-        from anomalygen.errors import UserError
-
-        raise UserError(f"Franka assets not found at {path}; reinstall gymnasium-robotics")
-    return path
-
-
-def _strip_include(text: str) -> str:
-    text = re.sub(r"<!--.*?-->", "", text, flags=re.S)
-    text = re.sub(r"</?mujocoinclude>", "", text)
-    return text
-
-
-@lru_cache(maxsize=1)
-def _arm_xml() -> str:
-    """One MJCF string holding the source's defaults, mesh assets and arm chain (fingers removed)."""
-    root = franka_assets_dir()
-    assets = _strip_include((root / "assets.xml").read_text())
-    assets = re.sub(r"<compiler[^>]*/>", "", assets)
-    assets = re.sub(r"<option[^>]*/>", "", assets)
-    assets = re.sub(r"<size[^>]*/>", "", assets)
-    # Render with the collision meshes (120 KB) instead of the 6.5 MB visual ones: software EGL
-    # rendering and mesh upload were 3-5x slower with them, and the scene builder renders 3 views
-    # of every scene within its per-scene budget. The arm still reads clearly as a Panda.
-    assets = re.sub(r'<mesh name="\w+_viz"[^>]*/>', "", assets)
-    chain = _strip_include((root / "chain.xml").read_text())
-    chain = re.sub(r'mesh="(\w+)_viz"', r'mesh="\1_col"', chain)
-    chain = chain.replace("robot:panda0_joint", "panda_joint").replace(
-        'name="panda0_link', 'name="panda_link'
-    )
-    chain = re.sub(r"<body name=\"panda0_(left|right)finger\".*?</body>", "", chain, flags=re.S)
-    chain = re.sub(r"<site name='end_effector'[^>]*/>", "", chain)
-    chain = chain.replace('<body name="panda_link0"', f'<body name="panda_link0" pos="0 0 {BASE_HEIGHT}"', 1)
-    return (
-        f'<mujoco model="panda"><compiler angle="radian" meshdir="{root / "meshes"}"/>'
-        f'{assets}<worldbody><body name="base"><body name="torso">{chain}</body></body></worldbody></mujoco>'
-    )
-
-
-def mesh_files() -> list[Path]:
-    """Mesh files the robot references, relative to the source meshes folder."""
-    files = re.findall(r'file="([^"]+)"', _arm_xml())
-    return sorted(Path(f) for f in set(files))
-
-
-def build_robot_spec(base_xyyaw=(0.0, 0.0, 0.0)) -> mujoco.MjSpec:
-    """A fresh MjSpec holding only the robot (plus nothing else); scenes are built on top of it.
-
-    The scene builder starts from this spec and adds the room and objects, because attaching a
-    mesh-based model into another spec would have to rewrite the mesh paths.
-    """
-    import mujoco
-
-    spec = mujoco.MjSpec.from_string(_arm_xml())
-    spec.compiler.degree = False
-    spec.compiler.autolimits = True
-    # The base body sits at the world origin; its joints carry the world pose (base_x = world x,
-    # base_y = world y, base_yaw about z), so joint values read directly as the base pose.
-    # ``base_xyyaw`` is applied by ``set_home`` (scenes store it in their "init" keyframe).
-    base = spec.body("base")
-    base.gravcomp = 1.0
-    base.add_joint(
-        name="base_x", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0], damping=200.0, armature=1.0
-    )
-    base.add_joint(
-        name="base_y", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 1, 0], damping=200.0, armature=1.0
-    )
-    base.add_joint(
-        name="base_yaw", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], damping=100.0, armature=1.0
-    )
-    base.add_geom(
-        name="base_geom",
-        type=mujoco.mjtGeom.mjGEOM_CYLINDER,
-        size=[BASE_RADIUS, BASE_HEIGHT / 2 - 0.01, 0],
-        pos=[0, 0, BASE_HEIGHT / 2 + 0.005],
-        rgba=[0.25, 0.27, 0.3, 1],
-        mass=40.0,
-    )
-    # The torso the arm stands on. The lift moves it kinematically (``set_lift`` edits its model
-    # position, as the primitives place the base): a lift joint driven by an actuator gave way by
-    # 2 cm under the end-effector weld's forces and changed every Gymnasium env's dynamics.
-    torso = spec.body("torso")
-    torso.add_geom(
-        name="torso_column",
-        type=mujoco.mjtGeom.mjGEOM_CYLINDER,
-        size=[0.075, (LIFT_MAX - 0.02) / 2, 0],
-        pos=[0, 0, BASE_HEIGHT - (LIFT_MAX - 0.02) / 2],
-        rgba=[0.25, 0.27, 0.3, 1],
-        mass=0.0,
-        contype=0,
-        conaffinity=0,
-    )
-    for body in spec.bodies:
-        if body.name.startswith("panda_"):
-            body.gravcomp = 1.0
-    link7 = spec.body("panda_link7")
-    cup = link7.add_body(name="suction", pos=[0, 0, 0.165])
-    cup.gravcomp = 1.0
-    cup.add_geom(
-        name="suction_geom",
-        type=mujoco.mjtGeom.mjGEOM_CYLINDER,
-        size=[0.02, 0.015, 0],
-        pos=[0, 0, 0.015],
-        rgba=[0.15, 0.15, 0.15, 1],
-        mass=0.05,
-    )
-    cup.add_site(name="suction_site", pos=[0, 0, 0.031], size=[0.006, 0, 0], rgba=[1, 0.2, 0.2, 1])
-    cup.add_site(name="ee_site", pos=[0, 0, 0.031], size=[0.004, 0, 0], rgba=[0.2, 1, 0.2, 0])
-    cup.add_camera(name="wrist", pos=[0.05, 0, 0.0], xyaxes=_wrist_xyaxes(), fovy=65.0)
-    # Position actuators: base then arm, in ROBOT_JOINTS order.
-    for name, kp, frc in (("base_x", 4000, 1000), ("base_y", 4000, 1000), ("base_yaw", 2000, 500)):
-        act = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
-        act.set_to_position(kp=kp, kv=2 * np.sqrt(kp * 40))
-        act.forcerange = [-frc, frc]
-        act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
-    for name, (kp, frc) in zip(ARM_JOINTS, _ARM_GAINS, strict=True):
-        act = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
-        act.set_to_position(kp=kp)
-        act.forcerange = [-frc, frc]
-        act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
-        jnt = spec.joint(name)
-        act.ctrlrange = list(jnt.range)
-        act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
-    # End-effector tracking target for delta-pose control (inactive by default).
-    target = spec.worldbody.add_body(name="ee_target", mocap=True, pos=[0, 0, 1])
-    target.add_geom(
-        type=mujoco.mjtGeom.mjGEOM_SPHERE,
-        size=[0.01, 0, 0],
-        contype=0,
-        conaffinity=0,
-        rgba=[0, 1, 0, 0.0],
-        group=4,
-    )
-    eq = spec.add_equality(name="ee_track", type=mujoco.mjtEq.mjEQ_WELD, name1="suction", name2="ee_target")
-    eq.objtype = mujoco.mjtObj.mjOBJ_BODY
-    eq.active = False
-    eq.solref = [0.02, 1.0]
-    return spec
-
-
-def _wrist_xyaxes(tilt: float = 0.3) -> list[float]:
-    """Wrist camera axes in the cup frame: looking out of the cup (+z), tilted ``tilt`` rad towards
-    the cup's +x (away from the base at the home pose), so it sees what lies ahead of the cup."""
-    look = np.array([np.sin(tilt), 0.0, np.cos(tilt)])
-    right = np.cross(look, [0.0, 0.0, -1.0])
-    if np.linalg.norm(right) < 1e-6:
-        right = np.array([0.0, 1.0, 0.0])
-    right /= np.linalg.norm(right)
-    up = np.cross(right, look)
-    return [*right.tolist(), *up.tolist()]
-
-
-def add_suction_welds(spec: mujoco.MjSpec, object_bodies: list[str], held_bodies: list[str] | None = None) -> None:
-    """One inactive weld per free object body, so suction is a toggle at run time (no recompiles).
-
-    The weld is named after the object (``suction__<object>``) but may hold another body of it
-    (``held_bodies``): the body that carries the mass. MuJoCo softens a weld by the inverse weight of
-    the bodies it joins, and an object's massless wrapper body has an enormous one, which left a
-    paper ball trailing 30 cm under the cup.
-    """
-    import mujoco
-
-    for body, held in zip(object_bodies, held_bodies or object_bodies, strict=True):
-        eq = spec.add_equality(
-            name=SUCTION_PREFIX + body, type=mujoco.mjtEq.mjEQ_WELD, name1="suction", name2=held
-        )
-        eq.objtype = mujoco.mjtObj.mjOBJ_BODY
-        eq.active = False
-        eq.solref = [0.01, 1.0]
+ROBOT_BODY_PREFIXES = (BASE_BODY, TORSO, "panda_", CUP_BODY, EE_TARGET)
+# m: the mocap target never runs further than this ahead of the cup, so the weld never yanks the arm
+TARGET_LEASH = 0.08
 
 
 def set_home(model: mujoco.MjModel, data: mujoco.MjData, base_xyyaw=None) -> None:
@@ -258,7 +75,7 @@ def set_home(model: mujoco.MjModel, data: mujoco.MjData, base_xyyaw=None) -> Non
 
 def lift(model: mujoco.MjModel) -> float:
     """How far the torso lift has raised the arm (metres)."""
-    return float(model.body("torso").pos[2])
+    return float(model.body(TORSO).pos[2])
 
 
 def set_lift(model: mujoco.MjModel, data: mujoco.MjData, value: float) -> float:
@@ -269,7 +86,7 @@ def set_lift(model: mujoco.MjModel, data: mujoco.MjData, value: float) -> float:
     import mujoco
 
     value = float(np.clip(value, 0.0, LIFT_MAX))
-    model.body("torso").pos[2] = value
+    model.body(TORSO).pos[2] = value
     mujoco.mj_kinematics(model, data)
     return value
 
@@ -285,13 +102,13 @@ def enable_ee_tracking(model: mujoco.MjModel, data: mujoco.MjData) -> int:
         a = model.actuator(name).id
         model.actuator_gainprm[a, :] = 0.0
         model.actuator_biasprm[a, :] = 0.0
-    eq = model.equality("ee_track").id
+    eq = model.equality(EE_TRACK).id
     model.eq_data[eq, :] = 0.0
     model.eq_data[eq, 6] = 1.0
     model.eq_data[eq, 10] = 1.0
-    mocap = int(model.body_mocapid[model.body("ee_target").id])
+    mocap = int(model.body_mocapid[model.body(EE_TARGET).id])
     mujoco.mj_kinematics(model, data)
-    cup = model.body("suction").id
+    cup = model.body(CUP_BODY).id
     data.mocap_pos[mocap] = data.xpos[cup]
     data.mocap_quat[mocap] = data.xquat[cup]
     for name in BASE_JOINTS:
@@ -312,7 +129,7 @@ def robot_geom_ids(model: mujoco.MjModel) -> np.ndarray:
     return np.asarray(ids, dtype=int)
 
 
-def _suction_eq(model: mujoco.MjModel, object_body: str) -> int:
+def suction_eq(model: mujoco.MjModel, object_body: str) -> int:
     import mujoco
 
     return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_EQUALITY, SUCTION_PREFIX + object_body)
@@ -334,17 +151,17 @@ def object_distance_to_cup(model: mujoco.MjModel, data: mujoco.MjData, object_bo
     """Smallest distance between the cup geom and any geom of the object body (negative: overlap)."""
     import mujoco
 
-    cup = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "suction_geom")
+    cup = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, CUP_GEOM)
     body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, object_body)
     best = np.inf
     fromto = np.zeros(6)
-    for g in np.flatnonzero(_subtree_geoms(model, body)):
+    for g in np.flatnonzero(subtree_geoms(model, body)):
         d = mujoco.mj_geomDistance(model, data, cup, int(g), 0.1, fromto)
         best = min(best, d)
     return float(best)
 
 
-def _subtree_geoms(model: mujoco.MjModel, body: int) -> np.ndarray:
+def subtree_geoms(model: mujoco.MjModel, body: int) -> np.ndarray:
     """Boolean mask of geoms attached to ``body`` or its descendants."""
     mask = np.zeros(model.ngeom, dtype=bool)
     bodies = {body}
@@ -360,7 +177,7 @@ def _subtree_geoms(model: mujoco.MjModel, body: int) -> np.ndarray:
 def held_object(model: mujoco.MjModel, data: mujoco.MjData) -> str | None:
     """The object currently welded to the cup, if any."""
     for name in suction_candidates(model):
-        if data.eq_active[_suction_eq(model, name)]:
+        if data.eq_active[suction_eq(model, name)]:
             return name
     return None
 
@@ -381,15 +198,15 @@ def suction_on(model: mujoco.MjModel, data: mujoco.MjData, object_name: str | No
     names = [object_name] if object_name is not None else suction_candidates(model)
     best, best_d = None, SUCTION_RANGE
     for name in names:
-        if _suction_eq(model, name) < 0:
+        if suction_eq(model, name) < 0:
             continue
         d = object_distance_to_cup(model, data, name)
         if d <= best_d:
             best, best_d = name, d
     if best is None:
         return False
-    eq = _suction_eq(model, best)
-    cup = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "suction")
+    eq = suction_eq(model, best)
+    cup = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, CUP_BODY)
     obj = int(model.eq_obj2id[eq])  # the body the weld holds (the object's massive body)
     relpos, relquat = relative_pose(data.xpos[cup], data.xquat[cup], data.xpos[obj], data.xquat[obj])
     # Weld data layout: anchor(3) in body2's frame, relpos(3) = where that anchor sits in body1's
@@ -412,7 +229,7 @@ def suction_off(model: mujoco.MjModel, data: mujoco.MjData, object_name: str | N
     """Release the held object (or ``object_name``)."""
     names = [object_name] if object_name is not None else suction_candidates(model)
     for name in names:
-        eq = _suction_eq(model, name)
+        eq = suction_eq(model, name)
         if eq >= 0:
             data.eq_active[eq] = 0
 
@@ -428,3 +245,121 @@ def relative_pose(pos1, quat1, pos2, quat2) -> tuple[np.ndarray, np.ndarray]:
     relquat = np.zeros(4)
     mujoco.mju_mulQuat(relquat, neg, np.asarray(quat2, dtype=float))
     return relpos, relquat
+
+
+class Robot:
+    """The robot in one compiled model, as ManiSkill's agents are: element ids resolved once, the held
+    object, subtree geoms, and the one mapping from a 7-D action to the end-effector target.
+
+    Every env and the Driver go through it, so there is one rotation convention (rotations are
+    axis-angle in the cup frame) and one leash (:data:`TARGET_LEASH`).
+    """
+
+    def __init__(self, model: mujoco.MjModel):
+        self.model = model
+        self.cup = int(model.body(CUP_BODY).id)
+        self.cup_geom = int(model.geom(CUP_GEOM).id)
+        self.cup_site = int(model.site(CUP_SITE).id)
+        self.ee_site = int(model.site(EE_SITE).id)
+        self.track = int(model.equality(EE_TRACK).id)
+        self.mocap = int(model.body_mocapid[model.body(EE_TARGET).id])
+        self.geoms = robot_geom_ids(model)
+        self.suction_objects = suction_candidates(model)
+        self._suction_eqs = np.array([suction_eq(model, n) for n in self.suction_objects], dtype=int)
+        self._data = None
+
+    # ------------------------------------------------------------------ state
+    def held(self, data: mujoco.MjData) -> str | None:
+        """The object welded to the cup, if any (the first active suction weld, as ``held_object``)."""
+        if not len(self._suction_eqs):
+            return None
+        on = np.flatnonzero(data.eq_active[self._suction_eqs])
+        return self.suction_objects[int(on[0])] if len(on) else None
+
+    def subtree_geoms(self, body: int | str) -> np.ndarray:
+        """Boolean mask of the geoms of ``body`` (id or name) and its descendants."""
+        return subtree_geoms(self.model, self.model.body(body).id if isinstance(body, str) else int(body))
+
+    def enable_ee_tracking(self, data: mujoco.MjData) -> int:
+        """End-effector control on (see :func:`enable_ee_tracking`); returns the mocap index."""
+        return enable_ee_tracking(self.model, data)
+
+    # ------------------------------------------------------------------ control
+    def leash(self, data: mujoco.MjData, pos) -> None:
+        """Put the end-effector target at ``pos``, but at most TARGET_LEASH from the cup per axis."""
+        cup = data.xpos[self.cup]
+        data.mocap_pos[self.mocap] = cup + np.clip(np.asarray(pos) - cup, -TARGET_LEASH, TARGET_LEASH)
+
+    def target_towards(self, data: mujoco.MjData, want, max_step: float) -> None:
+        """Move the target at most ``max_step`` metres straight towards ``want`` (leashed): the
+        primitives' way of following a line, one control step at a time."""
+        delta = np.asarray(want) - data.mocap_pos[self.mocap]
+        n = np.linalg.norm(delta)
+        if n > max_step:
+            delta *= max_step / n
+        self.leash(data, data.mocap_pos[self.mocap] + delta)
+
+    def move_target(self, data: mujoco.MjData, action, *, dp: float, dr: float) -> None:
+        """Move the target by ``dp * a[:3]`` (leashed) and turn it by the axis-angle ``a[3:6]`` (at most
+        ``dr`` rad) in the cup frame. ``action`` entries must already lie in [-1, 1].
+
+        Scalar Python maths on 7 numbers beats a dozen tiny numpy/mju calls: this is every env's hot
+        path. The translation is the same arithmetic as :meth:`leash`, so both give identical targets.
+        """
+        if data is not self._data:  # cache the views: each MjData attribute access is a pybind call
+            self._data = data
+            self._mpos, self._mquat, self._cpos = data.mocap_pos[self.mocap], data.mocap_quat[self.mocap], data.xpos[self.cup]
+        a0, a1, a2, a3, a4, a5 = (float(v) for v in action[:6])
+        mx, my, mz = self._mpos.tolist()
+        cx, cy, cz = self._cpos.tolist()
+        lim = TARGET_LEASH
+        self._mpos[:] = (cx + min(max(mx + dp * a0 - cx, -lim), lim), cy + min(max(my + dp * a1 - cy, -lim), lim),
+                         cz + min(max(mz + dp * a2 - cz, -lim), lim))
+        n = math.sqrt(a3 * a3 + a4 * a4 + a5 * a5)
+        if n > 1e-9:
+            h = 0.5 * dr * min(1.0, n)
+            s = math.sin(h)
+            w2, x2, y2, z2 = math.cos(h), a3 / n * s, a4 / n * s, a5 / n * s
+            w1, x1, y1, z1 = self._mquat.tolist()
+            w = w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2  # q_target * dq: a turn about the cup's own axes
+            x = w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2
+            y = w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2
+            z = w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2
+            k = math.sqrt(w * w + x * x + y * y + z * z)
+            self._mquat[:] = (w / k, x / k, y / k, z / k)
+
+    def apply_action(self, data: mujoco.MjData, action, *, dp: float, dr: float) -> np.ndarray:
+        """Map one 7-D action onto the target and the suction toggle (no physics step).
+
+        ``a[:6]`` as in :meth:`move_target`; ``a[6] > 0`` grabs the nearest suction candidate within
+        SUCTION_RANGE (:meth:`grab_nearest`), ``<= 0`` releases. Returns the clipped action (reward
+        action penalties read it).
+        """
+        a = np.clip(np.asarray(action, dtype=float).reshape(7), -1.0, 1.0)
+        self.move_target(data, a, dp=dp, dr=dr)
+        if len(self._suction_eqs):
+            held = self.held(data)
+            if a[6] > 0 and held is None:
+                self.grab_nearest(data)
+            elif a[6] <= 0 and held is not None:
+                suction_off(self.model, data)
+        return a
+
+    def grab_nearest(self, data: mujoco.MjData) -> bool:
+        """Suction on the nearest candidate within range; a part (door, lid, drawer: a body on a hinge
+        or slide) is held by position only (torque scale 0), as the part skills do, so it can turn
+        under the cup as it swings; a free object is held rigidly."""
+        import mujoco
+
+        m = self.model
+        mujoco.mj_kinematics(m, data)
+        best, best_d = None, SUCTION_RANGE
+        for name in self.suction_objects:
+            dist = object_distance_to_cup(m, data, name)
+            if dist <= best_d:
+                best, best_d = name, dist
+        if best is None:
+            return False
+        j = int(m.body_jntadr[m.body(best).id])
+        part = j >= 0 and m.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE
+        return suction_on(m, data, best, torquescale=0.0 if part else 1.0)
