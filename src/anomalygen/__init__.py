@@ -1,11 +1,6 @@
 """anomalygen: household hazard scenarios that a robot detects and resolves in simulation."""
 
-from importlib.metadata import PackageNotFoundError, version
-
-try:
-    __version__ = version("anomalygen")
-except PackageNotFoundError:  # running from a source tree without installation
-    __version__ = "0.0.0+local"
+from anomalygen.version import __version__
 
 __all__ = ["__version__", "make_env"]
 

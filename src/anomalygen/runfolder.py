@@ -156,7 +156,7 @@ class RunFolder:
         return removed
 
     def _new_manifest(self, settings) -> RunManifest:
-        from anomalygen import __version__
+        from anomalygen.version import __version__
 
         return RunManifest(
             name=self.root.name,
