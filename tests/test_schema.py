@@ -101,3 +101,17 @@ def test_usage_adds_up_including_cost():
     a = S.LLMUsage(requests=1, prompt_tokens=10, cost_usd=0.5)
     a.add(S.LLMUsage(requests=2, completion_tokens=5, cache_hits=1, cost_usd=0.25))
     assert (a.requests, a.prompt_tokens, a.completion_tokens, a.cache_hits, a.cost_usd) == (3, 10, 5, 1, 0.75)
+
+
+def test_joint_state_is_closed_is_the_one_closed_test():
+    from anomalygen.schema import CLOSED_TOL, JointState
+
+    door = JointState(name="d", label="door", value=0.07, range=(0.0, 1.6), closed_value=0.0)
+    assert door.open_fraction == pytest.approx(0.07 / 1.6)
+    assert door.is_closed() and CLOSED_TOL == 0.05  # 4.4 % open: closed for joint_closed
+    assert not door.is_closed(value=0.1)  # 6.25 % open at a live reading
+    assert door.is_closed(0.1, value=0.1)  # but shut enough to enclose (scene graph's tolerance)
+    # the fraction is of the travel towards the far end, whichever side of closed it is
+    flap = JointState(name="f", label="flap", value=-1.0, range=(-2.0, 0.0), closed_value=0.0)
+    assert flap.open_fraction_at(-0.1) == pytest.approx(0.05) and flap.is_closed(value=-0.1)
+    assert not flap.is_closed()

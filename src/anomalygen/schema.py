@@ -179,6 +179,15 @@ class AssetRef(Artefact):
     path: str | None = Field(None, description="file path for imported assets")
 
 
+# One definition of the closure concepts, shared by the scene builder, the scene graph, the
+# predicates, the planners and the skills.
+CLOSURE_LABELS = ("door", "drawer", "lid", "window", "sash")  # joint labels of parts that shut something
+ENCLOSING_LABELS = ("door", "drawer", "lid")  # closures behind which an object is out of reach
+SWINGING_CLOSURES = ("door", "lid", "window", "sash")  # closures on a hinge: they sweep out when open
+CLOSED_TOL = 0.05  # open fraction at or below which a joint counts as closed (``joint_closed``'s default)
+CHILD_REACH = 1.0  # m: the highest a small child reaches (``child_reachable``, the detectors' checks)
+
+
 class JointState(Artefact):
     name: str
     label: str = Field(description="semantic label: door, drawer, lid, knob, handle, button, blade, wheel, ...")
@@ -190,10 +199,18 @@ class JointState(Artefact):
     @property
     def open_fraction(self) -> float:
         """0 when at the closed value, 1 at the far end of the range."""
+        return self.open_fraction_at(self.value)
+
+    def open_fraction_at(self, value: float) -> float:
+        """``open_fraction`` if the joint stood at ``value`` (a live simulation reading)."""
         lo, hi = self.range
         far = hi if abs(hi - self.closed_value) >= abs(lo - self.closed_value) else lo
         span = abs(far - self.closed_value)
-        return 0.0 if span == 0 else min(1.0, abs(self.value - self.closed_value) / span)
+        return 0.0 if span == 0 else min(1.0, abs(value - self.closed_value) / span)
+
+    def is_closed(self, tol: float = CLOSED_TOL, value: float | None = None) -> bool:
+        """At most ``tol`` of its travel away from closed (at ``value`` if given, else its own)."""
+        return self.open_fraction_at(self.value if value is None else value) <= tol
 
 
 class PlacedObject(Artefact):

@@ -13,12 +13,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from anomalygen.schema import GraphObject, JointState, Relation, SceneGraph
+from anomalygen.schema import CHILD_REACH, GraphObject, JointState, Relation, SceneGraph
 
 #: Top-surface heights (m) per placement, inside the knowledge base's SUPPORT_HEIGHTS ranges.
 SURFACE_TOP = {"table": 0.75, "table_edge": 0.75, "counter": 0.9, "counter_edge": 0.9, "shelf": 1.4, "low_table": 0.42}
 EDGE_GAP = 0.04  # distance to the edge for *_edge placements (m)
-CHILD_REACH = 1.0
 
 
 def _obj(name: str, category: str, props: list[str], *, pos, size, height: float, on_floor: bool,

@@ -18,7 +18,7 @@ from collections.abc import Callable
 from pydantic import BaseModel, ConfigDict
 
 from anomalygen.knowledge.models import PredicateSpec
-from anomalygen.schema import GraphObject, PredicateCall, PredicateResult, SceneGraph
+from anomalygen.schema import CLOSED_TOL, GraphObject, PredicateCall, PredicateResult, SceneGraph
 
 #: Horizontal clearance (m) from furniture/appliances beyond which a floor object is "in the walkway".
 WALKWAY_CLEARANCE = 0.3
@@ -250,12 +250,12 @@ def _joint_open(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
 def _joint_closed(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
     obj = ctx.obj(call)
     wanted = _alternatives(call.args.get("label", "*"))
-    limit = ctx.num(call, "max_fraction", 0.05)
+    limit = ctx.num(call, "max_fraction", CLOSED_TOL)
     joints = [j for j in obj.joints if _label_matches(j.label, wanted)]
     if not joints:
         return False, f"{obj.name} has no {'/'.join(wanted)} joint"
     worst = max(joints, key=lambda j: j.open_fraction)
-    return worst.open_fraction <= limit, f"{obj.name} {worst.label} is {worst.open_fraction:.0%} open"
+    return worst.is_closed(limit), f"{obj.name} {worst.label} is {worst.open_fraction:.0%} open"
 
 
 @_predicate(

@@ -17,7 +17,18 @@ from pathlib import Path
 
 from anomalygen.control.driver import PrimitiveResult
 from anomalygen.control.geometry import surface_centre_of
-from anomalygen.schema import Plan, PredicateResult, SkillMethod, SkillResult, SubTask, SubTaskResult
+from anomalygen.schema import (
+    ENCLOSING_LABELS,
+    Plan,
+    PredicateResult,
+    SkillMethod,
+    SkillResult,
+    SubTask,
+    SubTaskResult,
+)
+
+ACCESS_LABELS = (*ENCLOSING_LABELS, "flap")  # parts that open a way into a container
+NEARLY_CLOSED_TOL = 0.1  # open fraction under which a part still blocks the way in
 
 
 def _joint_for(spec, obj: str, part: str | None) -> tuple[str | None, float | None]:
@@ -86,10 +97,8 @@ def _closed_parts(drv, name: str) -> list[str]:
     for o in drv.spec.objects:
         if o.name == name:
             for js in o.joint_states:
-                if js.label in ("lid", "door", "flap", "drawer"):
-                    span = max(abs(js.range[1] - js.range[0]), 1e-6)
-                    if abs(float(drv.data.joint(js.name).qpos[0]) - js.closed_value) / span < 0.1:
-                        out.append(js.label)
+                if js.label in ACCESS_LABELS and js.is_closed(NEARLY_CLOSED_TOL, float(drv.data.joint(js.name).qpos[0])):
+                    out.append(js.label)
     return sorted(set(out))
 
 

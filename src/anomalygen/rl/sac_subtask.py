@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from anomalygen.control.driver import PrimitiveResult
-from anomalygen.schema import Plan, SubTask
+from anomalygen.schema import CLOSED_TOL, Plan, SubTask
 
 STANDOFF = 0.06  # m behind the part point, as push_part approaches
 PULL_STANDOFF = 0.04  # m in front of the part point (about 3 cm off a door face) for a pull
@@ -54,8 +54,6 @@ def retarget_joints(drv, st: SubTask) -> tuple[SubTask, str]:
     target is its joint's closed value and whose joint is already closed moves to the most open joint
     of the same object whose label the step's predicates (or ``part`` param) name.
     """
-    from anomalygen.rl.subtask_env import JOINT_TOL_FRACTION
-
     if st.reward is None:
         return st, ""
     labels = {str(st.params["part"])} if st.params.get("part") else set()
@@ -64,8 +62,7 @@ def retarget_joints(drv, st: SubTask) -> tuple[SubTask, str]:
             labels |= {v.strip() for v in str(call.args["label"]).split("|")}
 
     def gap(js) -> float:
-        q = float(drv.data.joint(js.name).qpos[0])
-        return abs(q - js.closed_value) / max(abs(js.range[1] - js.range[0]), 1e-6)
+        return js.open_fraction_at(float(drv.data.joint(js.name).qpos[0]))
 
     terms, notes = [], []
     for t in st.reward.terms:
@@ -73,12 +70,12 @@ def retarget_joints(drv, st: SubTask) -> tuple[SubTask, str]:
         owner = next((o for o in drv.spec.objects if any(j.name == name for j in o.joint_states)), None) \
             if t.kind == "joint" else None
         js = next((j for j in owner.joint_states if j.name == name), None) if owner else None
-        if js is None or float(t.target) != js.closed_value or gap(js) > JOINT_TOL_FRACTION:
+        if js is None or float(t.target) != js.closed_value or gap(js) > CLOSED_TOL:
             terms.append(t)
             continue
         cands = [j for j in owner.joint_states if not labels or "*" in labels or j.label in labels]
         best = max(cands, key=gap, default=None)
-        if best is None or best.name == name or gap(best) <= JOINT_TOL_FRACTION:
+        if best is None or best.name == name or gap(best) <= CLOSED_TOL:
             terms.append(t)
             continue
         terms.append(t.model_copy(update={"joint": best.name, "a": None, "target": best.closed_value}))

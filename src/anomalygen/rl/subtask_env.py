@@ -39,14 +39,13 @@ from gymnasium import spaces
 
 from anomalygen.rl.reward import evaluate_spec
 from anomalygen.scene.robot import Robot, subtree_geoms
-from anomalygen.schema import RewardSpec, SceneSpec, SubTask
+from anomalygen.schema import CLOSED_TOL, RewardSpec, SceneSpec, SubTask
 
 HORIZON = 100
 FRAMESKIP = 2
 MAX_DELTA_POS = 0.03  # m per control step
 MAX_DELTA_ROT = 0.1  # rad per control step
 START_NOISE = 0.02  # m: +- noise on the end-effector target at reset
-JOINT_TOL_FRACTION = 0.05  # of the joint's range: the default of the joint_closed predicate
 SUCCESS_EVERY = 4
 POS_SCALE = 10.0  # positions in the observation are in dm (~unit scale for the networks)
 
@@ -108,7 +107,7 @@ class SubTaskReadout:
         self.joint_tol = {}
         for j in self.joints:
             lo, hi = model.joint(j).range
-            self.joint_tol[j] = JOINT_TOL_FRACTION * max(float(hi - lo), 1e-6) if hi > lo else 0.05
+            self.joint_tol[j] = CLOSED_TOL * max(float(hi - lo), 1e-6) if hi > lo else 0.05
 
     def resolved(self, ref: str) -> str:
         """The scene name a reward reference stands for (role variables resolved)."""

@@ -35,6 +35,9 @@ from anomalygen.scene.graph import FLOOR_GEOM
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.sensors import add_observation_sensors
 from anomalygen.schema import (
+    CLOSURE_LABELS,
+    ENCLOSING_LABELS,
+    SWINGING_CLOSURES,
     AssetRef,
     AssetSource,
     JointState,
@@ -97,7 +100,7 @@ def _parse_placement(placement: str) -> tuple[str, str | None]:
 
 def _front(asset) -> np.ndarray | None:
     """Local direction the asset's doors/drawers open to (the catalogue convention is -y)."""
-    if any(j.label in ("door", "drawer", "window", "sash", "lid") for j in asset.joints) or asset.cavities:
+    if any(j.label in CLOSURE_LABELS for j in asset.joints) or asset.cavities:
         return np.array([0.0, -1.0])
     return None
 
@@ -112,7 +115,7 @@ def _sweep(asset, values: dict[str, float]) -> float:
             continue
         if j.type == "slide":
             out = max(out, abs(v - j.closed_value) + 0.02)
-        elif j.label in ("door", "lid", "window", "sash"):
+        elif j.label in SWINGING_CLOSURES:
             out = max(out, min(float(max(ext[0], ext[2] if abs(j.axis[2]) < 0.5 else ext[0])), 1.0))
     return out
 
@@ -317,7 +320,7 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
     if kind == "inside" and parent is not None:
         cav = max(parent.asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
         if cav.joint is not None and not any(
-            p in ("door", "drawer", "lid") and s == "closed" for p, s in uses.get(parent.catalogue, [])
+            p in ENCLOSING_LABELS and s == "closed" for p, s in uses.get(parent.catalogue, [])
         ):
             label = parent.asset.joint(cav.joint).label
             uses.setdefault(parent.catalogue, []).append((label, "open"))

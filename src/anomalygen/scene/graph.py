@@ -18,7 +18,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from anomalygen.schema import GraphObject, JointState, Relation, SceneGraph, SceneSpec
+from anomalygen.schema import (
+    CHILD_REACH,
+    ENCLOSING_LABELS,
+    GraphObject,
+    JointState,
+    Relation,
+    SceneGraph,
+    SceneSpec,
+)
 
 if TYPE_CHECKING:  # pragma: no cover
     import mujoco
@@ -26,9 +34,9 @@ if TYPE_CHECKING:  # pragma: no cover
 FLOOR_GEOM = "floor"
 ON_FLOOR_TOL = 0.01  # m: bottom this close to z=0 counts as on the floor
 NEAR_DIST = 0.15  # m: bounding-box gap below which two objects are "near"
-CHILD_REACH = 1.0  # m: a small child's reach (knowledge base uses the same figure)
-CLOSED_FRACTION = 0.1  # an articulation within 10 % of its travel from closed counts as closed
-ENCLOSING_LABELS = ("door", "drawer", "lid")
+# A door left ajar by under 10 % of its travel still shuts a child out: looser than joint_closed's
+# CLOSED_TOL, which asks whether the robot finished closing it.
+ENCLOSED_TOL = 0.1
 
 
 @dataclass(frozen=True)
@@ -116,7 +124,7 @@ def _joint_states(model, data, obj, jids) -> list[JointState]:
 def _is_closed_enclosure(joints: list[JointState]) -> bool:
     """True when every door/drawer/lid of the object is (nearly) closed; False if it has none."""
     enclosing = [j for j in joints if any(lbl in j.label for lbl in ENCLOSING_LABELS)]
-    return bool(enclosing) and all(j.open_fraction < CLOSED_FRACTION for j in enclosing)
+    return bool(enclosing) and all(j.is_closed(ENCLOSED_TOL) for j in enclosing)
 
 
 def _support_contacts(model, data, owner: np.ndarray, floor: int, n: int):
