@@ -87,9 +87,11 @@ class LearnConfig(Section):
     retries: int = Field(
         1, ge=0, description="times a primitive sub-task whose success check fails right after it is run again"
     )
-    cem_iterations: int = Field(5, ge=1)
     video: bool = True
-    reward_mode: Literal["spec", "code"] = "spec"
+    reward_mode: Literal["spec", "code"] = Field(
+        "spec", description="code: SAC sub-tasks learn from reward code run in the sandbox (rl/sandbox.py), "
+        "the plan's own or its reward terms rendered as code; spec: the terms evaluated in-process"
+    )
 
 
 class EvaluateConfig(Section):

@@ -151,7 +151,7 @@ def _evaluate(calls, model, data, spec, bindings) -> list[PredicateResult]:
 
 def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: str | Path | None = None,
                  max_wall_s: float = 600.0, sac_steps: int = 0, isolate: bool = True,
-                 retries: int = 1) -> SkillResult:
+                 retries: int = 1, reward_mode: str = "spec") -> SkillResult:
     """Load the scene, run the plan's sub-tasks in order, check success, optionally record a video.
 
     Execution is closed-loop: a primitive sub-task whose success check fails on the scene right after
@@ -163,6 +163,9 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
     process-global and seeded once, so a path planned in a process that has planned before depends on
     that history. In a fresh process the first seed is the item's, and the result is a function of
     (scene, plan, seed) alone, whichever worker or test runs it. Costs about a second.
+
+    ``reward_mode`` is ``learn.reward_mode``: "code" trains SAC sub-tasks on sandboxed reward code
+    (:func:`~anomalygen.rl.sac_subtask.run_sac_subtask`).
     """
     if isolate:
         from concurrent.futures import ProcessPoolExecutor
@@ -170,12 +173,12 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
 
         with ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn")) as pool:
             return pool.submit(_execute_here, str(scene_dir), plan, seed, None if video_path is None else
-                               str(video_path), max_wall_s, sac_steps, retries).result()
-    return _execute_here(scene_dir, plan, seed, video_path, max_wall_s, sac_steps, retries)
+                               str(video_path), max_wall_s, sac_steps, retries, reward_mode).result()
+    return _execute_here(scene_dir, plan, seed, video_path, max_wall_s, sac_steps, retries, reward_mode)
 
 
 def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float, sac_steps: int,
-                  retries: int = 1) -> SkillResult:
+                  retries: int = 1, reward_mode: str = "spec") -> SkillResult:
     from anomalygen.control.driver import Driver
     from anomalygen.rng import item_rng
     from anomalygen.scene.graph import load_scene
@@ -207,7 +210,7 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
             if st.method == SkillMethod.SAC:
                 from anomalygen.rl.sac_subtask import run_sac_subtask
 
-                res = run_sac_subtask(drv, st, plan, steps=sac_steps, seed=seed)
+                res = run_sac_subtask(drv, st, plan, steps=sac_steps, seed=seed, reward_mode=reward_mode)
             else:
                 res = run_subtask(drv, st, plan)
             drv.settle(10)

@@ -38,7 +38,8 @@ def learn_item(item_id: str, payload: dict, ctx: StageContext) -> dict:
     out = run.skill_dir(task_id, seed)
     video = out / "video.mp4" if settings.learn.video else None
     result = execute_plan(run.scene_dir(task_id), plan, seed=seed, video_path=video,
-                          sac_steps=settings.learn.sac_steps, retries=settings.learn.retries)
+                          sac_steps=settings.learn.sac_steps, retries=settings.learn.retries,
+                          reward_mode=settings.learn.reward_mode)
     if result.video:
         result = result.model_copy(update={"video": "video.mp4"})
     write_model(out / "result.json", result)

@@ -126,8 +126,12 @@ def pre_position(drv, st: SubTask, plan: Plan, readout) -> str:
 
 def run_sac_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, threads: int = 1,
                     eval_every: int | None = None, eval_episodes: int = 5, learning_starts: int = 500,
-                    approach: bool = True, log=None) -> PrimitiveResult:
+                    approach: bool = True, log=None, reward_mode: str = "spec") -> PrimitiveResult:
     """Train SAC for ``st`` from the Driver's current state and execute the best policy on the Driver.
+
+    ``reward_mode="code"`` (``learn.reward_mode``) trains on reward code run in the sandbox: the
+    sub-task's own code when its RewardSpec has mode "code", else its terms rendered as code
+    (``reward.spec_to_code``, the same values).
 
     ``result.steps`` counts the Driver's control steps (pre-positioning plus the rollout); the
     detail says the training budget, best evaluation success and what the rollout did.
@@ -139,6 +143,10 @@ def run_sac_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, thre
         return PrimitiveResult(False, 0, "not executed: sac_steps is 0")
     s0 = drv.steps
     st, moved = retarget_joints(drv, st)
+    if reward_mode == "code" and st.reward is not None and st.reward.mode == "spec" and st.reward.terms:
+        from anomalygen.rl.reward import spec_to_code
+
+        st = st.model_copy(update={"reward": st.reward.model_copy(update={"mode": "code", "code": spec_to_code(st.reward)})})
     try:
         readout = SubTaskReadout(drv.model, drv.spec, st, plan.bindings)
     except ValueError as exc:
@@ -165,6 +173,7 @@ def run_sac_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, thre
             state, _, ok, why = control_step(readout, drv.model, drv.data, act, t, drv.step)
     finally:
         drv.frameskip = fs
+        readout.close()
     joints = readout.joint_summary(state)
     detail = (("" if not moved else moved + "; ") + f"{pre}; SAC {res.steps} steps: best eval success {res.best_success:.2f} at {res.best_step} steps; "
               f"rollout {'succeeded' if ok else 'failed'} in {t} steps"

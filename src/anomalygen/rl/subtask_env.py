@@ -67,10 +67,17 @@ class SubTaskReadout:
     def __init__(self, model, spec: SceneSpec, sub_task: SubTask, bindings: dict[str, str]):
         import mujoco
 
-        if sub_task.reward is None or sub_task.reward.mode != "spec":
-            raise ValueError(f"sub-task {sub_task.id} has no RewardSpec in mode 'spec' to learn from")
+        reward = sub_task.reward
+        if reward is None or (reward.mode == "spec" and not reward.terms) or (reward.mode == "code" and not reward.code):
+            raise ValueError(f"sub-task {sub_task.id} has no reward terms or reward code to learn from")
         self.spec, self.sub_task, self.bindings = spec, sub_task, dict(bindings)
-        self.reward: RewardSpec = sub_task.reward
+        self.reward: RewardSpec = reward
+        # Reward code (mode "code") is untrusted: it runs in the sandbox's limited subprocess.
+        self._code = None
+        if reward.mode == "code":
+            from anomalygen.rl.sandbox import SandboxedReward
+
+            self._code = SandboxedReward(reward.code)
         self.robot = Robot(model)
         self._mj = mujoco
         # every spec object: (name, root body, geom ids); referenced links and sites added below
@@ -108,6 +115,14 @@ class SubTaskReadout:
         for j in self.joints:
             lo, hi = model.joint(j).range
             self.joint_tol[j] = CLOSED_TOL * max(float(hi - lo), 1e-6) if hi > lo else 0.05
+
+    def reward_of(self, state: dict) -> float:
+        """The sub-task's reward for a state: its RewardSpec, or its reward code in the sandbox."""
+        return self._code(state) if self._code is not None else evaluate_spec(self.reward, state)
+
+    def close(self) -> None:
+        if self._code is not None:
+            self._code.close()
 
     def resolved(self, ref: str) -> str:
         """The scene name a reward reference stands for (role variables resolved)."""
@@ -244,6 +259,10 @@ class SubTaskEnv(gym.Env):
         self._ee0 = self.data.site_xpos[self.readout.robot.cup_site].copy()
         self._t = 0
         self._state = self.readout.state(self.model, self.data)
+        self.readout.reward_of(self._state)  # dry run: bad reward code fails here, before any training
+
+    def close(self) -> None:
+        self.readout.close()
 
     def _restore(self) -> None:
         mj = self._mj
@@ -284,7 +303,7 @@ def control_step(readout: SubTaskReadout, model, data, action, t: int, advance, 
     a = readout.robot.apply_action(data, action, dp=MAX_DELTA_POS, dr=MAX_DELTA_ROT)
     advance()
     state = readout.state(model, data, a)
-    reward = evaluate_spec(readout.reward, state)
+    reward = readout.reward_of(state)
     ok, why = False, ""
     if t >= horizon or t % success_every == 0 or not readout.has_predicates():
         ok, why = readout.success(model, data, state)
