@@ -11,12 +11,15 @@ import json
 import os
 import sys
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
 
 from anomalygen.errors import AnomalygenError, UserError
+
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
 
 app = typer.Typer(
     name="anomalygen",
@@ -72,7 +75,7 @@ def _common(
     return _settings(config, **overrides)
 
 
-def _run_stage(name: str, run, settings, **kwargs):
+def _run_stage(name: str, run, settings: Settings, **kwargs):
     """Run a registered stage (``anomalygen.stages``, the list ``anomalygen run`` also follows)."""
     from anomalygen.stages import stage
 
@@ -101,7 +104,7 @@ def _finish(summary, as_json: bool) -> None:
         raise typer.Exit(1)
 
 
-def _open_run(path: Path, *, create: bool = False, settings=None):
+def _open_run(path: Path, *, create: bool = False, settings: Settings | None = None):
     from anomalygen.runfolder import RunFolder
 
     return RunFolder.create(path, settings=settings) if create else RunFolder.open(path)

@@ -22,12 +22,15 @@ import tempfile
 import threading
 from collections.abc import Iterable, Iterator
 from pathlib import Path
-from typing import TypeVar
+from typing import TYPE_CHECKING, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
 from anomalygen.errors import UserError
 from anomalygen.schema import ItemError, RunManifest, StageRecord, format_validation_error
+
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
 
 M = TypeVar("M", bound=BaseModel)
 
@@ -124,7 +127,7 @@ class RunFolder:
 
     # -- opening
     @classmethod
-    def create(cls, root: str | Path, *, settings=None) -> RunFolder:
+    def create(cls, root: str | Path, *, settings: Settings | None = None) -> RunFolder:
         run = cls(root)
         run.root.mkdir(parents=True, exist_ok=True)
         run.sweep_temp_files()
@@ -155,7 +158,7 @@ class RunFolder:
                 removed += 1
         return removed
 
-    def _new_manifest(self, settings) -> RunManifest:
+    def _new_manifest(self, settings: Settings) -> RunManifest:
         from anomalygen.version import __version__
 
         return RunManifest(

@@ -16,11 +16,14 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from multiprocessing import get_context
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from anomalygen.errors import AnomalygenError
 from anomalygen.runfolder import RunFolder, now_iso
 from anomalygen.schema import StageRecord
+
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
 
 ItemFn = Callable[[str, Any, "StageContext"], Any]
 
@@ -34,7 +37,7 @@ class StageContext:
     """
 
     run_root: str
-    settings: Any
+    settings: Settings
     stage: str
 
     @property
@@ -69,7 +72,7 @@ def run_items(
     items: Sequence[tuple[str, Any]],
     fn: ItemFn,
     *,
-    settings,
+    settings: Settings,
     is_done: Callable[[str], bool] | None = None,
     force: bool = False,
     workers: int | None = None,
@@ -151,7 +154,7 @@ def _run_pool(todo, fn, ctx, workers, advance) -> dict[str, tuple[bool, Any]]:
     return outcomes
 
 
-def _run_ray(todo, fn, ctx, settings, advance) -> dict[str, tuple[bool, Any]]:
+def _run_ray(todo, fn, ctx, settings: Settings, advance) -> dict[str, tuple[bool, Any]]:
     try:
         import ray
     except ImportError as exc:  # pragma: no cover - depends on the optional extra

@@ -10,11 +10,15 @@ from __future__ import annotations
 import time
 from collections import Counter
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from anomalygen.errors import UserError
 from anomalygen.runfolder import RunFolder, now_iso, read_jsonl, write_jsonl
 from anomalygen.runner import StageSummary
 from anomalygen.schema import Engine, StageRecord, TaskProposal
+
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
 
 STAGE = "brainstorm"
 
@@ -44,7 +48,7 @@ def load_user_tasks(path: str | Path) -> list[TaskProposal]:
     return tasks
 
 
-def generate(settings, run: RunFolder | None = None) -> tuple[list[TaskProposal], dict[str, str]]:
+def generate(settings: Settings, run: RunFolder | None = None) -> tuple[list[TaskProposal], dict[str, str]]:
     """Proposals from the configured engine, and per-item errors (LLM engine only)."""
     cfg = settings.brainstorm
     engine = settings.engine_for("brainstorm")
@@ -66,7 +70,7 @@ def generate(settings, run: RunFolder | None = None) -> tuple[list[TaskProposal]
     return eng.run(cfg.n), {}
 
 
-def run_stage(run: RunFolder, settings, *, force: bool = False) -> StageSummary:
+def run_stage(run: RunFolder, settings: Settings, *, force: bool = False) -> StageSummary:
     started = time.perf_counter()
     record = StageRecord(started=now_iso())
     summary = StageSummary(STAGE)

@@ -10,12 +10,15 @@ print the hit@k table.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from anomalygen.errors import ItemFailed, UserError
 from anomalygen.runfolder import RunFolder, try_read_model, write_jsonl, write_model
 from anomalygen.runner import StageContext, StageSummary, run_items
 from anomalygen.schema import Detection, SceneGraph, SceneSpec, TaskProposal
+
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
 
 STAGE = "detect"
 
@@ -35,7 +38,7 @@ def _client(llm):
     return shared_client(llm)
 
 
-def make_detector(settings):
+def make_detector(settings: Settings):
     """The configured detector; 'llm' and 'hybrid' need an LLM and say so clearly when there is none."""
     from anomalygen.detect.rules import RuleDetector
 
@@ -54,7 +57,7 @@ def make_detector(settings):
     return HybridDetector(client)
 
 
-def make_judge(settings):
+def make_judge(settings: Settings):
     from anomalygen.detect.judge import Judge
 
     client = None
@@ -65,7 +68,7 @@ def make_judge(settings):
     return Judge(threshold=settings.detect.judge_threshold, llm_client=client, structured_decisive=decisive)
 
 
-def detect_scene(task: TaskProposal, graph: SceneGraph, spec: SceneSpec | None, settings, *, detector=None, judge=None) -> Detection:
+def detect_scene(task: TaskProposal, graph: SceneGraph, spec: SceneSpec | None, settings: Settings, *, detector=None, judge=None) -> Detection:
     """Detect and judge one scene (pure apart from LLM calls): what the item function writes."""
     from anomalygen.detect.judge import first_hit, miss_reason
     from anomalygen.detect.truth import ground_truth
@@ -125,7 +128,7 @@ def _item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str,
     }
 
 
-def _is_done_for(run: RunFolder, settings):
+def _is_done_for(run: RunFolder, settings: Settings):
     def is_done(task_id: str) -> bool:
         det = try_read_model(detection_path(run, task_id), Detection)
         return (det is not None and det.error is None and det.detector == settings.detect.detector
@@ -133,7 +136,7 @@ def _is_done_for(run: RunFolder, settings):
     return is_done
 
 
-def run_stage(run: RunFolder, settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
+def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
     from anomalygen.detect.report import print_report, summarise
 
     tasks = run.load_tasks()

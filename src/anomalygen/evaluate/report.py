@@ -13,6 +13,7 @@ import html
 import shutil
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from pydantic import Field
 
@@ -23,6 +24,9 @@ from anomalygen.evaluate.results import Evaluation
 from anomalygen.runfolder import RunFolder, atomic_write_text, now_iso, write_model
 from anomalygen.runner import StageSummary
 from anomalygen.schema import Artefact, StageRecord, Strict
+
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
 
 SECTIONS = ("overview", "diversity", "categories", "detection", "success", "gallery", "timings", "llm")
 NOT_RUN = "not run"
@@ -309,14 +313,14 @@ def render_markdown(report: Report) -> str:
 # --------------------------------------------------------------------------- stage
 
 
-def build_report(run: RunFolder, settings) -> Report:
+def build_report(run: RunFolder, settings: Settings) -> Report:
     from anomalygen.evaluate.stage import evaluate_run, load_evaluation
 
     evaluation = load_evaluation(run) or evaluate_run(run, settings)
     return Report(generated=now_iso(), evaluation=evaluation, gallery=collect_gallery(run))
 
 
-def run_stage(run: RunFolder, settings) -> StageSummary:
+def run_stage(run: RunFolder, settings: Settings) -> StageSummary:
     started, record = time.perf_counter(), StageRecord(started=now_iso())
     report = build_report(run, settings)
     run.report_dir.mkdir(parents=True, exist_ok=True)

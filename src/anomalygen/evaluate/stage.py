@@ -6,6 +6,7 @@ Works on whatever the run holds: a missing stage leaves its section empty and is
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING
 
 from anomalygen.evaluate import run_metrics as rm
 from anomalygen.evaluate.diversity import diversity_table, rich_table
@@ -14,6 +15,9 @@ from anomalygen.evaluate.text_metrics import task_text
 from anomalygen.runfolder import RunFolder, now_iso, read_model, write_model
 from anomalygen.runner import StageSummary
 from anomalygen.schema import StageRecord
+
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
 
 EVALUATION_FILE = "evaluation.json"
 
@@ -27,7 +31,7 @@ def load_evaluation(run: RunFolder) -> Evaluation | None:
     return read_model(path, Evaluation) if path.is_file() else None
 
 
-def evaluate_run(run: RunFolder, settings) -> Evaluation:
+def evaluate_run(run: RunFolder, settings: Settings) -> Evaluation:
     """All metrics of one run, as a typed record (no printing, no writing)."""
     cfg = settings.evaluate
     tasks = rm.load_tasks(run)
@@ -75,7 +79,7 @@ def evaluate_run(run: RunFolder, settings) -> Evaluation:
     )
 
 
-def run_stage(run: RunFolder, settings) -> StageSummary:
+def run_stage(run: RunFolder, settings: Settings) -> StageSummary:
     started, record = time.perf_counter(), StageRecord(started=now_iso())
     evaluation = evaluate_run(run, settings)
     write_model(evaluation_path(run), evaluation)

@@ -9,11 +9,15 @@ At the end a success table by hazard class goes to stderr and into ``summary.res
 from __future__ import annotations
 
 from collections import defaultdict
+from typing import TYPE_CHECKING
 
 from anomalygen.errors import ItemFailed
 from anomalygen.runfolder import RunFolder, try_read_model, write_model
 from anomalygen.runner import StageContext, StageSummary, run_items
 from anomalygen.schema import Plan, SkillResult
+
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
 
 STAGE = "learn"
 
@@ -73,7 +77,7 @@ def _print_table(table: dict[str, dict[str, float]]) -> None:
     Console(stderr=True).print(t)
 
 
-def run_stage(run: RunFolder, settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
+def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
     items: list[tuple[str, dict]] = []
     for t in run.load_tasks():
         if only and t.id not in only:

@@ -11,10 +11,15 @@ The learn engine picks the planner: ``knowledge`` turns the class's recipe into 
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from anomalygen.errors import ItemFailed, UserError
 from anomalygen.runfolder import RunFolder, read_jsonl, try_read_model, write_model
 from anomalygen.runner import StageContext, StageSummary, run_items
 from anomalygen.schema import Detection, Plan, SceneSpec, TaskProposal
+
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
 
 STAGE = "plan"
 
@@ -72,7 +77,7 @@ def _plan_with_llm(task_id: str, payload: dict, ctx: StageContext, hazard_class:
             record_usage(ctx.run, usage)
 
 
-def run_stage(run: RunFolder, settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
+def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
     engine = settings.engine_for("learn")
     if engine.value == "llm" and not settings.llm.configured:
         raise UserError("the llm learn engine needs an LLM: pass --backend openai|anthropic|llamacpp "

@@ -24,6 +24,7 @@ import shutil
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -48,6 +49,9 @@ from anomalygen.schema import (
     ValidationCheck,
     ValidationReport,
 )
+
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
 
 log = logging.getLogger(__name__)
 SURFACE_PLACEMENTS = {"table", "low_table", "table_edge", "counter", "counter_edge", "shelf"}
@@ -215,7 +219,7 @@ def _clutter_names(kb, exclude: set[str], rng, n: int) -> list[str]:
     return [names[i] for i in sorted(idx)]
 
 
-def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], dict[str, Placed]]:
+def _plan(task: TaskProposal, settings: Settings, rng) -> tuple[Layout, dict[str, str], dict[str, Placed]]:
     """Choose and place every object; returns the layout, bindings and instances by role variable."""
     kb = _kb()
     hc = kb.hazard_classes.get(task.hazard_class)
@@ -491,7 +495,7 @@ def _look_at_xyaxes(eye, target) -> list[float]:
     return [*right.tolist(), *up.tolist()]
 
 
-def _compose(lay: Layout, placed: dict[str, Placed], settings, rng):
+def _compose(lay: Layout, placed: dict[str, Placed], settings: Settings, rng):
     import mujoco
 
     spec = robot_model.build_robot_spec(tuple(lay.base))
@@ -688,7 +692,7 @@ def _set_joints(model, data, placed: dict[str, Placed]) -> None:
 # ============================================================================ attempt
 
 
-def _attempt(task: TaskProposal, seed: int, settings, attempt: int) -> Built:
+def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int) -> Built:
     import mujoco
 
     from anomalygen.scene import validate as val
@@ -782,7 +786,7 @@ def scene_id_for(task_id: str) -> str:
 # ============================================================================ public entry
 
 
-def build_scene(task: TaskProposal, *, seed: int, settings, out_dir: Path) -> SceneSpec:
+def build_scene(task: TaskProposal, *, seed: int, settings: Settings, out_dir: Path) -> SceneSpec:
     """Build, settle, validate, repair and write one scene; raises ItemFailed with a one-line reason."""
     attempts = settings.build.repair_attempts + 1
     reason = "no attempt made"
@@ -811,7 +815,7 @@ def build_scene(task: TaskProposal, *, seed: int, settings, out_dir: Path) -> Sc
     return write_outputs(built, settings, Path(out_dir))
 
 
-def _vlm_check(task, built: Built, settings) -> None:
+def _vlm_check(task, built: Built, settings: Settings) -> None:
     from anomalygen.scene.render import SceneRenderer, png_bytes
     from anomalygen.scene.verify import verify_with_vlm
 
@@ -823,7 +827,7 @@ def _vlm_check(task, built: Built, settings) -> None:
     )
 
 
-def write_outputs(built: Built, settings, out_dir: Path) -> SceneSpec:
+def write_outputs(built: Built, settings: Settings, out_dir: Path) -> SceneSpec:
     from anomalygen.scene.render import SceneRenderer, png_bytes
 
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -9,10 +9,14 @@ is module-level so the process pool and Ray can pickle it. After the batch, a co
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from anomalygen.runfolder import RunFolder, atomic_write_bytes, try_read_model
 from anomalygen.runner import StageContext, StageSummary, run_items
 from anomalygen.schema import SceneSpec, TaskProposal
+
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
 
 STAGE = "build"
 SHEET_N = 10
@@ -106,7 +110,7 @@ def write_contact_sheet(run: RunFolder, *, seed: int = 0, n: int = SHEET_N) -> P
     return out
 
 
-def revalidate_run(run: RunFolder, settings=None) -> dict[str, str | None]:
+def revalidate_run(run: RunFolder, settings: Settings | None = None) -> dict[str, str | None]:
     """Re-check every built scene from its files alone: load scene.xml at its settled keyframe,
     rebuild the scene graph and evaluate the hazard class's preconditions (and penetration) again.
     Returns task id -> None when valid, else the reason. Used by tests and the acceptance run."""
