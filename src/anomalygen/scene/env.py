@@ -155,11 +155,7 @@ class SceneEnv(gym.Env):
 
     def step(self, action):
         d = self.data
-        try:
-            a = action.tolist()
-        except AttributeError:
-            a = list(action)
-        a = [v if -1.0 <= v <= 1.0 else (1.0 if v > 0 else -1.0) for v in a]
+        a = np.clip(np.asarray(action, dtype=float), -1.0, 1.0)
         self.robot.move_target(d, a, dp=self.max_delta_pos, dr=self.max_delta_rot)
         if a[6] > 0.0:
             if self._held_eq < 0:

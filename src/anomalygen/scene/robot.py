@@ -25,7 +25,6 @@ Names other stages rely on (see docs/scene.md), each a constant below so no modu
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -303,30 +302,22 @@ class Robot:
         """Move the target by ``dp * a[:3]`` (leashed) and turn it by the axis-angle ``a[3:6]`` (at most
         ``dr`` rad) in the cup frame. ``action`` entries must already lie in [-1, 1].
 
-        Scalar Python maths on 7 numbers beats a dozen tiny numpy/mju calls: this is every env's hot
-        path. The translation is the same arithmetic as :meth:`leash`, so both give identical targets.
+        The arithmetic is exactly that of the SAC door benchmark's env, so its learning curves (and
+        the tests that pin them) are unchanged: the axis is ``a / (|a| + 1e-9)``, and the target
+        quaternion is renormalised every step.
         """
+        import mujoco
+
         if data is not self._data:  # cache the views: each MjData attribute access is a pybind call
             self._data = data
-            self._mpos, self._mquat, self._cpos = data.mocap_pos[self.mocap], data.mocap_quat[self.mocap], data.xpos[self.cup]
-        a0, a1, a2, a3, a4, a5 = (float(v) for v in action[:6])
-        mx, my, mz = self._mpos.tolist()
-        cx, cy, cz = self._cpos.tolist()
-        lim = TARGET_LEASH
-        self._mpos[:] = (cx + min(max(mx + dp * a0 - cx, -lim), lim), cy + min(max(my + dp * a1 - cy, -lim), lim),
-                         cz + min(max(mz + dp * a2 - cz, -lim), lim))
-        n = math.sqrt(a3 * a3 + a4 * a4 + a5 * a5)
-        if n > 1e-9:
-            h = 0.5 * dr * min(1.0, n)
-            s = math.sin(h)
-            w2, x2, y2, z2 = math.cos(h), a3 / n * s, a4 / n * s, a5 / n * s
-            w1, x1, y1, z1 = self._mquat.tolist()
-            w = w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2  # q_target * dq: a turn about the cup's own axes
-            x = w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2
-            y = w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2
-            z = w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2
-            k = math.sqrt(w * w + x * x + y * y + z * z)
-            self._mquat[:] = (w / k, x / k, y / k, z / k)
+            self._mpos, self._mquat = data.mocap_pos[self.mocap], data.mocap_quat[self.mocap]
+            self._dq, self._q = np.zeros(4), np.zeros(4)
+        a = np.asarray(action, dtype=float)
+        self.leash(data, self._mpos + dp * a[:3])
+        n = np.linalg.norm(a[3:6])
+        mujoco.mju_axisAngle2Quat(self._dq, a[3:6] / (n + 1e-9), dr * min(1.0, n))
+        mujoco.mju_mulQuat(self._q, self._mquat, self._dq)  # q_target * dq: a turn about the cup's own axes
+        self._mquat[:] = self._q / np.linalg.norm(self._q)
 
     def apply_action(self, data: mujoco.MjData, action, *, dp: float, dr: float) -> np.ndarray:
         """Map one 7-D action onto the target and the suction toggle (no physics step).
