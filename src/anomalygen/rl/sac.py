@@ -49,50 +49,79 @@ def evaluate_policy(model, env, episodes: int, seed: int) -> tuple[float, float]
     return float(np.mean(succ)), float(np.mean(rets))
 
 
-def train_sac(make_env, steps: int, *, seed: int = 0, eval_every: int = 1000, eval_episodes: int = 5,
-              learning_starts: int = 500, threads: int = 1, stop_at: float | None = None, ent_coef: str = "auto_0.1",
-              log=None) -> tuple[object, SACResult]:
-    """Train SAC for ``steps`` env steps; return the model loaded with the best-success checkpoint.
+def success_eval_callback(eval_env, *, eval_every: int, episodes: int, seed: int, result: SACResult,
+                          stop_at: float | None, log=None):
+    """SB3's ``EvalCallback``, keeping the best model by success rate instead of by return.
 
-    With ``stop_at``, training ends at the first evaluation whose success rate reaches it
-    (``result.steps`` is then the steps actually taken).
+    Built inside a function because stable-baselines3 is imported lazily. Evaluation episodes are
+    seeded (``seed + k``) on the unwrapped env, so every evaluation of a run sees the same starts
+    and two checkpoints are compared on equal terms; SB3's own bookkeeping (``evaluations_*``,
+    ``best_mean_reward``, the ``eval/`` log keys) is filled as usual.
     """
-    import torch
-    from stable_baselines3 import SAC
-    from stable_baselines3.common.callbacks import BaseCallback
+    from stable_baselines3.common.callbacks import EvalCallback
 
-    torch.set_num_threads(threads)
-    env, eval_env = make_env(), make_env()
-    model = SAC("MlpPolicy", env, learning_rate=3e-4, policy_kwargs={"net_arch": [256, 256, 256]},
-                learning_starts=min(learning_starts, max(1, steps // 4)), batch_size=256, train_freq=1, gradient_steps=1, ent_coef=ent_coef, seed=seed, verbose=0,
-                device="cpu")
-    t0 = time.perf_counter()
-    result = SACResult(best_success=-1.0, best_return=-np.inf, best_step=0, steps=steps, wall_s=0.0)
+    class SuccessEvalCallback(EvalCallback):
+        def __init__(self):
+            super().__init__(eval_env, n_eval_episodes=episodes, eval_freq=eval_every, deterministic=True,
+                             verbose=0, warn=False)
+            self.raw_eval_env, self.best_success, self.t0 = eval_env, -1.0, time.perf_counter()
 
-    def _evaluate(step: int) -> None:
-        s, r = evaluate_policy(model, eval_env, eval_episodes, seed=10_000 + seed * 100)
-        result.curve.append({"step": step, "success": s, "return": r, "wall_s": time.perf_counter() - t0})
-        if log:
-            log(f"step {step}: success {s:.2f} return {r:.1f}")
-        if (s, r) > (result.best_success, result.best_return):
-            result.best_success, result.best_return, result.best_step = s, r, step
-            result.policy_state = copy.deepcopy(model.policy.state_dict())
+        def evaluate(self, step: int) -> None:
+            s, r = evaluate_policy(self.model, self.raw_eval_env, episodes, seed=seed)
+            self.evaluations_timesteps.append(step)
+            self.evaluations_results.append([r])
+            self.evaluations_successes.append([s])
+            self.last_mean_reward = r
+            self.logger.record("eval/mean_reward", r)
+            self.logger.record("eval/success_rate", s)
+            result.curve.append({"step": step, "success": s, "return": r, "wall_s": time.perf_counter() - self.t0})
+            if log:
+                log(f"step {step}: success {s:.2f} return {r:.1f}")
+            if (s, r) > (self.best_success, self.best_mean_reward):
+                self.best_success, self.best_mean_reward = s, r
+                result.best_success, result.best_return, result.best_step = s, r, step
+                result.policy_state = copy.deepcopy(self.model.policy.state_dict())
 
-    class _Eval(BaseCallback):
         def _on_step(self) -> bool:
-            if self.num_timesteps % eval_every == 0:
-                _evaluate(self.num_timesteps)
+            if self.eval_freq > 0 and self.num_timesteps % self.eval_freq == 0:
+                self.evaluate(self.num_timesteps)
                 if stop_at is not None and result.curve[-1]["success"] >= stop_at:
                     result.steps = self.num_timesteps
                     return False
             return True
 
-    _evaluate(0)
+    return SuccessEvalCallback()
+
+
+def train_sac(make_env, steps: int, *, seed: int = 0, eval_every: int = 1000, eval_episodes: int = 5,
+              learning_starts: int = 500, threads: int = 1, stop_at: float | None = None, ent_coef: str = "auto_0.1",
+              learning_rate: float = 3e-4, net_arch: tuple[int, ...] = (256, 256, 256), batch_size: int = 256,
+              train_freq: int = 1, gradient_steps: int = 1, log=None) -> tuple[object, SACResult]:
+    """Train SAC for ``steps`` env steps; return the model loaded with the best-success checkpoint.
+
+    The defaults are the paper's settings (module docstring). With ``stop_at``, training ends at the
+    first evaluation whose success rate reaches it (``result.steps`` is then the steps actually taken).
+    """
+    import torch
+    from stable_baselines3 import SAC
+    from stable_baselines3.common.utils import configure_logger
+
+    torch.set_num_threads(threads)
+    env, eval_env = make_env(), make_env()
+    model = SAC("MlpPolicy", env, learning_rate=learning_rate, policy_kwargs={"net_arch": list(net_arch)},
+                learning_starts=min(learning_starts, max(1, steps // 4)), batch_size=batch_size, train_freq=train_freq,
+                gradient_steps=gradient_steps, ent_coef=ent_coef, seed=seed, verbose=0, device="cpu")
+    model.set_logger(configure_logger(verbose=0))  # the logger learn() would make, ready for the step-0 evaluation
+    result = SACResult(best_success=-1.0, best_return=-np.inf, best_step=0, steps=steps, wall_s=0.0)
+    callback = success_eval_callback(eval_env, eval_every=eval_every, episodes=eval_episodes,
+                                     seed=10_000 + seed * 100, result=result, stop_at=stop_at, log=log)
+    callback.init_callback(model)
+    callback.evaluate(0)
     if steps > 0:
-        model.learn(total_timesteps=steps, callback=_Eval())
+        model.learn(total_timesteps=steps, callback=callback)
     if result.curve[-1]["step"] != result.steps:
-        _evaluate(result.steps)
+        callback.evaluate(result.steps)
     if result.policy_state is not None:
         model.policy.load_state_dict(result.policy_state)
-    result.wall_s = time.perf_counter() - t0
+    result.wall_s = time.perf_counter() - callback.t0
     return model, result
