@@ -12,6 +12,7 @@ import pytest
 
 from anomalygen.config import load_settings
 from anomalygen.llm import get_client
+from anomalygen.plan import llm_prompt as Prompt
 from anomalygen.plan import plan_llm as P
 from anomalygen.plan.stage import run_stage
 from anomalygen.runfolder import RunFolder, read_model, write_jsonl, write_model
@@ -112,7 +113,7 @@ def _repairing(req) -> bool:
 
 def _scene_question(req) -> str:
     users = [m["content"] for m in req["messages"] if m["role"] == "user"]
-    return users[len(P.load_examples())]  # the examples' questions come first
+    return users[len(Prompt.load_examples())]  # the examples' questions come first
 
 
 # --------------------------------------------------------------------------- the engine
@@ -216,11 +217,11 @@ def test_the_schema_advertises_this_scenes_names():
     params = schema["$defs"]["ReplyParams"]["properties"]
     assert params["object"]["anyOf"][0]["enum"] == ["$hazard", "cabinet_0", "counter_0", "knife_0", "mug_0"]
     assert params["joint"]["anyOf"][0]["enum"] == ["cabinet_0/drawer_slide"]
-    assert schema["$defs"]["ReplySubTask"]["properties"]["primitive"]["anyOf"][0]["enum"] == sorted(P.PRIMITIVES)
+    assert schema["$defs"]["ReplySubTask"]["properties"]["primitive"]["anyOf"][0]["enum"] == sorted(Prompt.PRIMITIVES)
 
 
 def test_every_in_context_example_is_a_valid_plan_of_its_own_scene():
-    examples = P.load_examples()
+    examples = Prompt.load_examples()
     assert len(examples) == 3
     methods = set()
     for ex in examples:

@@ -56,7 +56,8 @@ def _plan_with_llm(task_id: str, payload: dict, ctx: StageContext, hazard_class:
                    spec: SceneSpec | None, hypothesis: dict | None) -> Plan:
     """The LLM engine for one item; its usage goes to the manifest whether or not the item succeeds."""
     from anomalygen.llm import record_usage, shared_client
-    from anomalygen.plan.plan_llm import hazard_text_from_hypothesis, hazard_text_from_task, plan_from_llm
+    from anomalygen.plan.llm_prompt import hazard_text_from_hypothesis, hazard_text_from_task
+    from anomalygen.plan.plan_llm import plan_from_llm
 
     settings = ctx.settings
     if spec is None:
