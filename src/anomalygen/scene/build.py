@@ -21,7 +21,7 @@ import logging
 import math
 import os
 import shutil
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -57,6 +57,10 @@ log = logging.getLogger(__name__)
 SURFACE_PLACEMENTS = {"table", "low_table", "table_edge", "counter", "counter_edge", "shelf"}
 CAMERAS = ("front", "top", "wrist")
 MAX_AUX = 3
+CONTAINER_REDRAWS = 4  # other container sizes drawn before a smaller hazard is tried
+INWARD = 0.13  # m kept from a support's edge by things that are not the edge hazard
+HAZARD_NEAR_SIDE = 0.4  # m: the hazard's centre at most this far from the robot-facing edge (arm's reach)
+LOOSE_ON_SUPPORT_MAX = 0.35  # m: a loose task object smaller than this goes on the support, not the floor
 CLUTTER_MAX_SIZE = 0.3
 
 
@@ -219,96 +223,131 @@ def _clutter_names(kb, exclude: set[str], rng, n: int) -> list[str]:
     return [names[i] for i in sorted(idx)]
 
 
-def _plan(task: TaskProposal, settings: Settings, rng) -> tuple[Layout, dict[str, str], dict[str, Placed]]:
-    """Choose and place every object; returns the layout, bindings and instances by role variable."""
-    kb = _kb()
-    hc = kb.hazard_classes.get(task.hazard_class)
-    sc = task.scenario
-    kind, parent_raw = _parse_placement(sc.placement)
-    used: set[str] = set()
-    by_catalogue: dict[str, select.Chosen] = {}
+@dataclass
+class Selection:
+    """The objects chosen for one task, by role, before anything is placed (``select_objects``)."""
 
-    def choose(raw: str, role: ObjectRole, *, cap=None, rank=False) -> select.Chosen:
+    task: TaskProposal
+    rng: np.random.Generator
+    kb: object
+    hc: object  # the task's HazardClass, or None
+    kind: str  # placement kind: floor, walkway, a surface, inside, on
+    parent_raw: str | None
+    used: set[str] = field(default_factory=set)
+    by_catalogue: dict[str, select.Chosen] = field(default_factory=dict)
+    target: select.Chosen | None = None
+    parent: select.Chosen | None = None
+    hazard: select.Chosen | None = None
+    hazard_var: select.Chosen | None = None  # the object bound to $hazard
+    container: select.Chosen | None = None
+    support_var: select.Chosen | None = None
+    aux: list[select.Chosen] = field(default_factory=list)
+    hazard_is_target: bool = False
+
+    @property
+    def variables(self) -> set[str]:
+        return set(self.hc.variables) if self.hc is not None else set()
+
+    def choose(self, raw: str, role: ObjectRole, *, cap=None, rank=False) -> select.Chosen:
+        """The asset for a name (one per catalogue category: a second mention reuses it)."""
         cat = select.resolve_name(raw)
-        if cat in by_catalogue:
-            return by_catalogue[cat]
-        asset = select.pick_asset(cat, role=role, kb=kb, task=task, hc=hc, rng=rng, cap=cap, rank=rank)
-        ch = select.Chosen(_instance_name(cat, used), cat, role, asset)
-        by_catalogue[cat] = ch
+        if cat in self.by_catalogue:
+            return self.by_catalogue[cat]
+        asset = select.pick_asset(cat, role=role, kb=self.kb, task=self.task, hc=self.hc, rng=self.rng, cap=cap,
+                                  rank=rank)
+        ch = select.Chosen(_instance_name(cat, self.used), cat, role, asset)
+        self.by_catalogue[cat] = ch
         return ch
 
-    hazard_is_target = select.resolve_name(sc.hazard_object) == select.resolve_name(task.target_asset)
-    # Big things first: they bound what fits in/on them.
-    target = choose(
-        task.target_asset, ObjectRole.HAZARD if hazard_is_target else ObjectRole.TARGET, rank=True
-    )
-    parent = choose(parent_raw, ObjectRole.AUXILIARY) if parent_raw else None
+    def forget(self, ch: select.Chosen) -> None:
+        """Drop a choice so the next ``choose`` of its category draws again."""
+        self.by_catalogue.pop(ch.catalogue, None)
+        self.used.discard(ch.name)
 
-    support_kind = kind if kind in SURFACE_PLACEMENTS else None
+
+def select_objects(task: TaskProposal, rng) -> Selection:
+    """Choose an asset for every role the task needs (target, hazard, container, supports, co-objects)."""
+    kb = _kb()
+    sc = task.scenario
+    kind, parent_raw = _parse_placement(sc.placement)
+    sel = Selection(task, rng, kb, kb.hazard_classes.get(task.hazard_class), kind, parent_raw)
+    hc, variables = sel.hc, sel.variables
+    sel.hazard_is_target = select.resolve_name(sc.hazard_object) == select.resolve_name(task.target_asset)
+    # Big things first: they bound what fits in/on them.
+    target = sel.target = sel.choose(
+        task.target_asset, ObjectRole.HAZARD if sel.hazard_is_target else ObjectRole.TARGET, rank=True
+    )
+    parent = sel.parent = sel.choose(parent_raw, ObjectRole.AUXILIARY) if parent_raw else None
     cap = None
     if kind == "inside" and parent is not None:
         if not parent.asset.cavities:
             raise ItemFailed(f"placement inside:{parent_raw} but {parent.catalogue} has no interior")
         cap = _cavity_cap(parent.asset)
-    hazard = choose(sc.hazard_object, ObjectRole.HAZARD, cap=cap)
+    hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=cap)
     if hazard is target:
         target.role = ObjectRole.HAZARD
 
     container = None
-    variables = set(hc.variables) if hc is not None else set()
     container_name = sc.container or (
         _first_known(hc.default_containers) if "$container" in variables else None
     )
     if container_name:
-        container = choose(container_name, ObjectRole.CONTAINER)
+        container = sel.choose(container_name, ObjectRole.CONTAINER)
         if container is not hazard and container.asset.cavities:
             # The hazard must be able to go in: a 0.5 m plastic bag does not fit a 0.3 m bucket.
             # Draw the container again (other sizes), then a smaller hazard, before giving up.
             # A container that is also the scene's target keeps its draw (other steps refer to it).
-            for _ in range(4 if container is not target else 0):
+            for _ in range(CONTAINER_REDRAWS if container is not target else 0):
                 if hazard.size <= _container_room(container.asset):
                     break
-                by_catalogue.pop(container.catalogue, None)
-                used.discard(container.name)
-                container = choose(container_name, ObjectRole.CONTAINER)
+                sel.forget(container)
+                container = sel.choose(container_name, ObjectRole.CONTAINER)
             room = _container_room(container.asset)
             if hazard.size > room and hazard is not target:
-                by_catalogue.pop(hazard.catalogue, None)
-                used.discard(hazard.name)
-                hazard = choose(sc.hazard_object, ObjectRole.HAZARD, cap=min(cap or room, room))
+                sel.forget(hazard)
+                hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=min(cap or room, room))
             if hazard.size > room:
                 raise ItemFailed(f"{hazard.catalogue} ({hazard.size:.2f} m) does not fit {container.catalogue} "
                                  f"(room for {room:.2f} m)")
-    support_var = None
+    sel.hazard, sel.container = hazard, container
     if "$support" in variables:
         sname = _first_known(hc.default_supports)
         if sname:
-            support_var = choose(sname, ObjectRole.SUPPORT)
+            sel.support_var = sel.choose(sname, ObjectRole.SUPPORT)
 
-    aux: list[select.Chosen] = []
     extra = list(sc.co_objects) + [a.name for a in task.auxiliary_items if a.relevant]
     for raw in extra:
-        if len(aux) >= MAX_AUX:
+        if len(sel.aux) >= MAX_AUX:
             break
         try:
             cat = select.resolve_name(raw)
         except ItemFailed:
             continue  # an unknown co-object is decoration, not the hazard: leave it out
-        if cat in by_catalogue:
+        if cat in sel.by_catalogue:
             continue
-        aux.append(choose(cat, ObjectRole.AUXILIARY))
+        sel.aux.append(sel.choose(cat, ObjectRole.AUXILIARY))
+    bind_hazard(sel)
+    return sel
 
-    # Classes with both $target and $hazard (a closed window and a hot source) when the scenario
-    # names the target as its hazard object: $hazard is the co-object with the class's properties.
-    hazard_var = hazard
-    if hc is not None and hazard is target and {"$hazard", "$target"} <= variables:
-        hazard_var = _co_object_for(hc, kb, aux)
-        if hazard_var is None:
+
+def bind_hazard(sel: Selection) -> None:
+    """Which object plays $hazard. Classes with both $target and $hazard (a closed window and a hot
+    source) whose scenario names the target as its hazard object: the co-object with the class's
+    properties."""
+    sel.hazard_var = sel.hazard
+    hc, target = sel.hc, sel.target
+    if hc is not None and sel.hazard is target and {"$hazard", "$target"} <= sel.variables:
+        sel.hazard_var = _co_object_for(hc, sel.kb, sel.aux)
+        if sel.hazard_var is None:
             raise ItemFailed(f"no co-object can play $hazard for a {hc.id} scene")
-        hazard_var.role = ObjectRole.HAZARD
+        sel.hazard_var.role = ObjectRole.HAZARD
         target.role = ObjectRole.TARGET
 
-    # Initial joint states: the task's articulations and the class template.
+
+def set_initial_joints(sel: Selection) -> None:
+    """Initial joint states: the task's articulations and the class template (and an interior the
+    hazard sits in is opened unless the task says it is closed)."""
+    task, hc, parent = sel.task, sel.hc, sel.parent
     uses: dict[str, list[tuple[str, str]]] = {}
     for a in task.articulations:
         try:
@@ -316,12 +355,12 @@ def _plan(task: TaskProposal, settings: Settings, rng) -> tuple[Layout, dict[str
         except ItemFailed:
             continue
     if hc is not None and hc.articulation is not None:
-        var_obj = {"$target": target, "$hazard": hazard}.get(hc.articulation.variable)
+        var_obj = {"$target": sel.target, "$hazard": sel.hazard}.get(hc.articulation.variable)
         if var_obj is not None:
             uses.setdefault(var_obj.catalogue, []).append(
                 (hc.articulation.part, hc.articulation.initial_state)
             )
-    if kind == "inside" and parent is not None:
+    if sel.kind == "inside" and parent is not None:
         cav = max(parent.asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
         if cav.joint is not None and not any(
             p in ENCLOSING_LABELS and s == "closed" for p, s in uses.get(parent.catalogue, [])
@@ -329,11 +368,17 @@ def _plan(task: TaskProposal, settings: Settings, rng) -> tuple[Layout, dict[str
             label = parent.asset.joint(cav.joint).label
             uses.setdefault(parent.catalogue, []).append((label, "open"))
     for cat, pairs in uses.items():
-        if cat in by_catalogue:
-            select.set_articulations(by_catalogue[cat], pairs, rng)
-    _check_articulations(task, hc, by_catalogue, target)
+        if cat in sel.by_catalogue:
+            select.set_articulations(sel.by_catalogue[cat], pairs, sel.rng)
+    _check_articulations(task, hc, sel.by_catalogue, sel.target)
 
-    # ------------------------------------------------------------------ placement
+
+def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed], Placed | None]:
+    """Place every chosen object (and the clutter) in the room; returns the layout, the placed
+    objects by name and the support the hazard stands on (if any)."""
+    rng, kind, used = sel.rng, sel.kind, sel.used
+    target, parent, hazard = sel.target, sel.parent, sel.hazard
+    support_kind = kind if kind in SURFACE_PLACEMENTS else None
     lay = Layout(rng, relevant_in_cube=settings.build.relevant_in_unit_cube)
     placed: dict[str, Placed] = {}
     support: Placed | None = None
@@ -342,7 +387,7 @@ def _plan(task: TaskProposal, settings: Settings, rng) -> tuple[Layout, dict[str
         if (
             target.catalogue == "Table"
             and base_kind == "table"
-            and not hazard_is_target
+            and not sel.hazard_is_target
             and _table_height_ok(target.asset)
         ):
             support = placed.setdefault(target.name, _placed(target))
@@ -351,14 +396,15 @@ def _plan(task: TaskProposal, settings: Settings, rng) -> tuple[Layout, dict[str
         lay.place_on_floor(support, relevant=True, face=True)
         placed[support.name] = support
     side: Placed | None = None
-    clutter = _clutter_names(kb, set(by_catalogue), rng, settings.build.clutter)
+    clutter = _clutter_names(sel.kb, set(sel.by_catalogue), rng, settings.build.clutter)
     if clutter:
         side = _support_placed("table", _instance_name("Table", used), rng)
         lay.place_on_floor(side, relevant=False, face=True)
         placed[side.name] = side
+    task_objects = [target, parent, sel.container, sel.support_var, *sel.aux]
 
     # Fixed (furniture-sized) objects stand on the floor facing the robot.
-    for ch in [target, parent, container, support_var, *aux]:
+    for ch in task_objects:
         if ch is None or ch.name in placed or not ch.fixed or ch is hazard:
             continue
         p = placed[ch.name] = _placed(ch)
@@ -367,43 +413,17 @@ def _plan(task: TaskProposal, settings: Settings, rng) -> tuple[Layout, dict[str
         p = placed[hazard.name] = _placed(hazard)
         lay.place_on_floor(p, relevant=True, face=True)
 
-    # The hazard object, where the scenario says.
     if hazard.name not in placed:
-        hp = placed[hazard.name] = _placed(hazard)
-        if kind == "floor":
-            lay.place_on_floor(hp, relevant=True, face=False)
-        elif kind == "walkway":
-            fixtures = [p for p in lay.items if p.fixed]
-            lay.place_on_floor(hp, relevant=True, face=False, clear_of=fixtures)
-        elif support is not None:
-            edge = support_kind.endswith("_edge")
-            lay.place_on_surface(
-                hp, support, _surface_of(support), edge=edge, inward=0.0 if edge else 0.13, near_side=0.4
-            )
-        elif kind == "inside" and parent is not None:
-            ppl = placed.get(parent.name)
-            if ppl is None:
-                ppl = placed[parent.name] = _placed(parent)
-                lay.place_on_floor(ppl, relevant=True, face=True)
-            lo, hi, _ = _cavity_world(ppl)
-            lay.place_in_cavity(hp, ppl, (lo, hi))
-        elif kind == "on" and parent is not None:
-            ppl = placed.get(parent.name)
-            if ppl is None:
-                ppl = placed[parent.name] = _placed(parent)
-                lay.place_on_floor(ppl, relevant=True, face=True)
-            lay.place_on_surface(hp, ppl, _surface_of(ppl), inward=0.0)
-        else:
-            raise ItemFailed(f"unsupported placement {sc.placement!r}")
+        _place_hazard(sel, lay, placed, support, support_kind)
 
     # Remaining loose task objects: on the support (away from its edge) or on the floor.
-    for ch in [target, parent, container, support_var, *aux]:
+    for ch in task_objects:
         if ch is None or ch.name in placed:
             continue
         p = placed[ch.name] = _placed(ch)
-        if support is not None and ch.size < 0.35:
+        if support is not None and ch.size < LOOSE_ON_SUPPORT_MAX:
             try:
-                lay.place_on_surface(p, support, _surface_of(support), inward=0.13)
+                lay.place_on_surface(p, support, _surface_of(support), inward=INWARD)
                 continue
             except ItemFailed:
                 pass
@@ -412,29 +432,72 @@ def _plan(task: TaskProposal, settings: Settings, rng) -> tuple[Layout, dict[str
     # Clutter on the side table, away from its edges; an item that does not fit is left out.
     if side is not None:
         for cat in clutter:
-            asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=kb, task=task, hc=None, rng=rng)
+            asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng)
             ch = select.Chosen(_instance_name(cat, used), cat, ObjectRole.CLUTTER, asset)
             p = _placed(ch)
             try:
-                lay.place_on_surface(p, side, _surface_of(side), inward=0.13)
+                lay.place_on_surface(p, side, _surface_of(side), inward=INWARD)
             except ItemFailed:
                 continue
             placed[p.name] = p
 
     focus = placed[hazard.name]
     lay.fit_base(focus, holder=placed.get(focus.inside) if focus.inside else None)
-    bindings = {"$hazard": hazard_var.name, "$target": target.name}
-    if container is not None:
-        bindings["$container"] = container.name
-    if support_var is not None:
-        bindings["$support"] = support_var.name
+    return lay, placed, support
+
+
+def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None,
+                  support_kind: str | None) -> None:
+    """The hazard object, where the scenario says."""
+    kind, parent, hazard = sel.kind, sel.parent, sel.hazard
+    hp = placed[hazard.name] = _placed(hazard)
+    if kind == "floor":
+        lay.place_on_floor(hp, relevant=True, face=False)
+    elif kind == "walkway":
+        fixtures = [p for p in lay.items if p.fixed]
+        lay.place_on_floor(hp, relevant=True, face=False, clear_of=fixtures)
+    elif support is not None:
+        edge = support_kind.endswith("_edge")
+        lay.place_on_surface(
+            hp, support, _surface_of(support), edge=edge, inward=0.0 if edge else INWARD, near_side=HAZARD_NEAR_SIDE
+        )
+    elif kind in ("inside", "on") and parent is not None:
+        ppl = placed.get(parent.name)
+        if ppl is None:
+            ppl = placed[parent.name] = _placed(parent)
+            lay.place_on_floor(ppl, relevant=True, face=True)
+        if kind == "inside":
+            lo, hi, _ = _cavity_world(ppl)
+            lay.place_in_cavity(hp, ppl, (lo, hi))
+        else:
+            lay.place_on_surface(hp, ppl, _surface_of(ppl), inward=0.0)
+    else:
+        raise ItemFailed(f"unsupported placement {sel.task.scenario.placement!r}")
+
+
+def bind_roles(sel: Selection, support: Placed | None) -> dict[str, str]:
+    """The role variables ($hazard, $target, $container, $support) bound to instance names."""
+    kind, parent = sel.kind, sel.parent
+    bindings = {"$hazard": sel.hazard_var.name, "$target": sel.target.name}
+    if sel.container is not None:
+        bindings["$container"] = sel.container.name
+    if sel.support_var is not None:
+        bindings["$support"] = sel.support_var.name
     elif support is not None:
         bindings["$support"] = support.name
     elif kind == "on" and parent is not None:
         bindings["$support"] = parent.name
-    if kind == "inside" and parent is not None and container is None:
+    if kind == "inside" and parent is not None and sel.container is None:
         bindings["$container"] = parent.name
-    return lay, bindings, placed
+    return bindings
+
+
+def _plan(task: TaskProposal, settings: Settings, rng) -> tuple[Layout, dict[str, str], dict[str, Placed]]:
+    """Choose and place every object; returns the layout, bindings and instances by name."""
+    sel = select_objects(task, rng)
+    set_initial_joints(sel)
+    lay, placed, support = place(sel, settings)
+    return lay, bind_roles(sel, support), placed
 
 
 def _co_object_for(hc, kb, candidates) -> select.Chosen | None:
