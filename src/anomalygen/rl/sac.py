@@ -5,9 +5,8 @@ handle scores well without ever closing the door). We evaluate deterministic epi
 and keep the policy whose success rate is highest (ties broken by return).
 Settings: 3x256 MLPs for actor and critics, learning rate 3e-4 for actor, critic and entropy
 coefficient (SB3 uses the same rate for all three), one gradient step per env step after a short
-(500-step) random warm-up. Torch threads default to ONE: on the shared, loaded 2-core machine two
-OpenMP threads spin against each other and 40 SAC updates took > 100 s instead of 2.5 s with one
-thread (measured 2026-11-21); pass ``threads=2`` on a quiet machine. The entropy coefficient is
+(500-step) random warm-up. Torch threads default to ONE: on a loaded 2-core machine two OpenMP
+threads spin against each other (figures in docs/learn.md); pass ``threads=2`` on a quiet machine. The entropy coefficient is
 auto-tuned (lr 3e-4, as in the paper) but starts at 0.1 instead of SB3's 1.0: at lr 3e-4 log(alpha)
 moves ~3e-4 per update, so from 1.0 the entropy bonus (7-D action) drowned the ~2/step shaped reward
 for the first several thousand steps of a small budget.

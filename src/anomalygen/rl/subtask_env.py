@@ -21,12 +21,9 @@ containers). The observation is built from the same readout, only for the names 
 Success is the sub-task's SuccessSpec on ``scene_graph`` when it has predicates, else the goal terms
 of its reward (joint within 5 % of its range of the target, as ``joint_closed`` counts closed; object
 above a ``lifted`` height; point inside an ``inside`` box), checked every step (microseconds).
-Measured 2026-11-21 on the shared 2-core machine: scene_graph + evaluate_all takes 0.5 ms on the test
-scene (5 objects) and 0.75 / 1.2 ms on built fridge / litter scenes (53 / 86 geoms; the graph's
-pairwise passes grow with n^2), against 0.6 / 1.7-1.9 ms for the rest of an env step and ~10-40 ms
-for the SAC update that goes with each step. So the predicates are checked every
-``success_every`` = 4 steps and on the last one: a few % of training time even on bigger scenes,
-and an episode runs at most 3 steps past success (pressing on a closed door does no harm).
+Checking the predicates builds a scene graph, which costs about as much as the rest of a step, so
+they are checked every ``success_every`` = 4 steps and on the last one: a few % of training time,
+and an episode runs at most 3 steps past success (the figures are in docs/learn.md).
 """
 
 from __future__ import annotations
