@@ -77,7 +77,12 @@ class DetectConfig(Section):
 
 class LearnConfig(Section):
     engine: Engine | None = None
-    plan_source: Literal["ground_truth", "detected"] = "ground_truth"
+    plan_source: Literal["ground_truth", "detected"] = Field(
+        "detected", description="detected: plan from the detections and the perceived scene alone; "
+        "ground_truth: the oracle ablation (the builder's class and bindings)"
+    )
+    max_fixes: int = Field(3, ge=1, description="detected hazards fixed per scene, most severe first")
+    min_score: float = Field(0.0, description="hypotheses scoring below this are not acted on")
     seeds: int = Field(1, ge=1)
     sac_steps: int = Field(2000, ge=0, description="SAC environment steps per SAC sub-task (paper: 1M)")
     sac_actions: list[str] = Field(

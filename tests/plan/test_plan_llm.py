@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 
 import pytest
+from support.perceived import graph_of
 
 from anomalygen.config import load_settings
 from anomalygen.llm import get_client
@@ -245,13 +246,16 @@ def _run(tmp_path) -> RunFolder:
     run = RunFolder.create(tmp_path / "run")
     write_jsonl(run.tasks_path, [task("t-knife", "store_sharp_objects", "Knife on the counter"),
                                  task("t-fridge", "close_open_refrigerator", "Fridge left open")])
-    write_model(run.scene_dir("t-knife") / "scene.json", knife_scene())
-    write_model(run.scene_dir("t-fridge") / "scene.json", fridge_scene())
+    for tid, spec in (("t-knife", knife_scene()), ("t-fridge", fridge_scene())):
+        write_model(run.scene_dir(tid) / "scene.json", spec)
+        write_model(run.scene_dir(tid) / "scene_graph.json", graph_of(spec))
     return run
 
 
 def _settings(srv, tmp_path, **over):
-    s = load_settings(None, {"quiet": True, "workers": 1, "learn.engine": "llm", **over})
+    # the oracle unless a test asks otherwise: these tests exercise the LLM planner on the task's own class
+    s = load_settings(None, {"quiet": True, "workers": 1, "learn.engine": "llm", "learn.plan_source": "ground_truth",
+                             **over})
     s.llm = llm_config_for(srv, tmp_path, cache=False)
     return s
 
@@ -294,7 +298,7 @@ def test_plan_stage_detected_source_shows_the_detection_not_the_task(scripted_se
     summary = run_stage(run, _settings(srv, tmp_path, **{"learn.plan_source": "detected"}), only=["t-fridge"])
     assert summary.done == 1
     plan = read_model(run.plan_path("t-fridge"), Plan)
-    assert plan.source == "detected" and plan.bindings["$hazard"] == "refrigerator_0"
+    assert plan.source == "detected" and plan.bindings == {"$target": "refrigerator_0"}
     question = _scene_question(srv.requests[0])
     assert "The fridge door hangs open." in question and "Fridge left open" not in question
 
@@ -316,7 +320,8 @@ def test_plan_stage_on_the_bundled_gguf_ends_each_item_cleanly(tmp_path):
     from anomalygen.config import LLMConfig
 
     run = _run(tmp_path)
-    settings = load_settings(None, {"quiet": True, "workers": 1, "learn.engine": "llm"})
+    settings = load_settings(None, {"quiet": True, "workers": 1, "learn.engine": "llm",
+                                    "learn.plan_source": "ground_truth"})
     settings.llm = LLMConfig(backend="llamacpp", cache=False, max_tokens=300, repair_retries=0)
     summary = run_stage(run, settings, only=["t-fridge"])
     assert summary.done + summary.failed == 1

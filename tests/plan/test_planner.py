@@ -42,28 +42,101 @@ def test_plan_stage_writes_plans_and_fails_one_item(tmp_path):
 
     run = RunFolder.create(tmp_path / "r")
     write_jsonl(run.tasks_path, [_task("a", "store_sharp_objects"), _task("b", "no_such_class")])
-    summary = run_stage(run, Settings(quiet=True))
+    oracle = Settings(quiet=True, learn={"plan_source": "ground_truth"})
+    summary = run_stage(run, oracle)
     assert summary.done == 1 and summary.failed == 1 and "b" in summary.errors
     plan = read_model(run.plan_path("a"), Plan)
     assert plan.source == "ground_truth" and len(plan.subtasks) == 2
-    again = run_stage(run, Settings(quiet=True))
+    again = run_stage(run, oracle)
     assert again.skipped == 1
 
 
-def test_detected_source_plans_the_top_hypothesis(tmp_path):
+def _scene_with_a_drawer_and_two_sharp_things(run, tid):
+    """A kitchen: scissors and a knife on the counter, a cabinet with a shut drawer, a bin."""
+    from support.perceived import graph_of
+
+    from anomalygen.runfolder import write_model
+    from anomalygen.schema import AssetRef, JointState, ObjectRole, PlacedObject, SceneSpec
+
+    def placed(name, category, pos, size, role, joints=(), fixed=False):
+        return PlacedObject(name=name, asset=AssetRef(asset_id=f"{category}-0", category=category, source="procedural"),
+                            role=role, size=size, pos=list(pos), quat=[1, 0, 0, 0], joint_states=list(joints), fixed=fixed)
+
+    drawer = JointState(name="storagefurniture_0/drawer", label="drawer", type="slide", value=0.0, range=(0.0, 0.35),
+                        closed_value=0.0)
+    spec = SceneSpec(scene_id="s", task_id=tid, room="kitchen", seed=0, bindings={"$hazard": "knife_0",
+                     "$container": "storagefurniture_0"}, objects=[
+        placed("counter_0", "counter", (0.5, 1.6, 0.45), 0.9, ObjectRole.SUPPORT, fixed=True),
+        placed("knife_0", "kitchen_knife", (0.6, 1.35, 0.92), 0.25, ObjectRole.HAZARD),
+        placed("scissors_0", "scissors", (0.9, 1.5, 0.92), 0.18, ObjectRole.CLUTTER),
+        placed("storagefurniture_0", "StorageFurniture", (1.8, 1.6, 0.45), 0.9, ObjectRole.CONTAINER, [drawer], True),
+        placed("trashcan_0", "TrashCan", (0.0, 0.0, 0.2), 0.4, ObjectRole.AUXILIARY, fixed=True),
+    ])
+    write_model(run.scene_dir(tid) / "scene.json", spec)
+    write_model(run.scene_dir(tid) / "scene_graph.json", graph_of(spec))
+    return spec
+
+
+def test_detected_plans_fix_every_hazard_most_severe_first_with_roles_chosen_from_the_scene(tmp_path):
     from anomalygen.config import Settings
     from anomalygen.plan.stage import run_stage
     from anomalygen.runfolder import RunFolder, read_model, write_jsonl
     from anomalygen.schema import Detection, Hypothesis
 
     run = RunFolder.create(tmp_path / "r")
-    write_jsonl(run.tasks_path, [_task("a", "store_sharp_objects")])
-    hyps = [Hypothesis(rank=2, problem="p", solution="s", target_object="cup_0", hazard_class="store_sharp_objects"),
-            Hypothesis(rank=1, problem="p", solution="s", target_object="scissors_0", hazard_class="store_sharp_objects")]
-    write_jsonl(run.detections_path, [Detection(task_id="a", scene_id="a", detector="rules", hypotheses=hyps)])
-    settings = Settings(quiet=True)
-    settings.learn.plan_source = "detected"
-    assert run_stage(run, settings).done == 1
+    write_jsonl(run.tasks_path, [_task("a", "store_sharp_objects"), _task("quiet", "store_sharp_objects")])
+    _scene_with_a_drawer_and_two_sharp_things(run, "a")
+    _scene_with_a_drawer_and_two_sharp_things(run, "quiet")
+    hyps = [Hypothesis(rank=1, problem="p", solution="s", target_object="scissors_0", hazard_class="store_sharp_objects",
+                       score=0.75),
+            Hypothesis(rank=2, problem="p", solution="s", target_object="knife_0", hazard_class="keep_sharp_away_from_children",
+                       score=0.95),
+            Hypothesis(rank=3, problem="p", solution="s", target_object="knife_0", hazard_class="store_sharp_objects",
+                       score=0.75),  # same object again: not a second fix
+            Hypothesis(rank=4, problem="p", solution="s", target_object="trashcan_0", hazard_class=None)]
+    write_jsonl(run.detections_path, [Detection(task_id="a", scene_id="s", detector="rules", hypotheses=hyps),
+                                      Detection(task_id="quiet", scene_id="s", detector="rules", hypotheses=[])])
+    assert run_stage(run, Settings(quiet=True)).done == 2  # detected is the default
     plan = read_model(run.plan_path("a"), Plan)
-    assert plan.source == "detected" and plan.bindings["$hazard"] == "scissors_0"
-    assert plan.subtasks[0].params["object"] == "scissors_0"
+    assert plan.source == "detected"
+    # the more severe class first; the drawer is opened, used and shut for each; no $variables are left
+    picks = [s.params["object"] for s in plan.subtasks if s.primitive == "grasp"]
+    assert picks == ["knife_0", "scissors_0"]
+    assert {s.params["region"] for s in plan.subtasks if s.primitive == "move_to"} == {"storagefurniture_0"}
+    assert [s.id for s in plan.subtasks if "container" in s.id] == [
+        "h1_s0_open_container", "h1_s9_close_container", "h2_s0_open_container", "h2_s9_close_container"]
+    for call in plan.success.predicates + [c for s in plan.subtasks for c in s.success.predicates]:
+        assert not any(str(v).startswith("$") for v in call.args.values()), call
+    assert read_model(run.plan_path("quiet"), Plan).subtasks == []  # nothing detected: leave the scene alone
+
+
+def test_the_perceived_spec_carries_no_answer_key(tmp_path):
+    from anomalygen.perception import load_perceived_spec
+    from anomalygen.runfolder import RunFolder
+    from anomalygen.schema import ObjectRole
+
+    run = RunFolder.create(tmp_path / "r")
+    spec = _scene_with_a_drawer_and_two_sharp_things(run, "a")
+    seen = load_perceived_spec(run.scene_dir("a"))
+    assert spec.bindings and seen.bindings == {} and seen.task_id == ""
+    assert {o.role for o in seen.objects} == {ObjectRole.AUXILIARY}
+    assert [o.pos for o in seen.objects] == [o.pos for o in spec.objects]
+
+
+def test_a_fix_with_no_container_in_the_scene_fails_with_the_reason(tmp_path):
+    from anomalygen.errors import ItemFailed
+    from anomalygen.knowledge import load_kb
+    from anomalygen.perception import load_scene_graph
+    from anomalygen.plan.bind import bind_fix
+    from anomalygen.runfolder import RunFolder
+
+    run = RunFolder.create(tmp_path / "r")
+    _scene_with_a_drawer_and_two_sharp_things(run, "a")
+    graph = load_scene_graph(run.scene_dir("a"))
+    kb = load_kb()
+    assert bind_fix(kb.hazard_classes["dispose_spoiled_food"], "knife_0", graph, kb)["$container"] == "trashcan_0"
+    graph.objects = [o for o in graph.objects if o.name != "trashcan_0"]
+    import pytest
+
+    with pytest.raises(ItemFailed, match="no reachable container for knife_0"):
+        bind_fix(kb.hazard_classes["dispose_spoiled_food"], "knife_0", graph, kb)

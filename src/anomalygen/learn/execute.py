@@ -184,7 +184,10 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
     from anomalygen.scene.graph import load_scene
 
     t0 = time.perf_counter()
+    from anomalygen.perception import perceived_spec
+
     model, data, spec = load_scene(scene_dir)
+    spec = perceived_spec(spec)  # the robot acts on what it perceives: no bindings, no roles
     timings = {"load_s": round(time.perf_counter() - t0, 3)}
     rec = None
     if video_path is not None:
@@ -238,6 +241,7 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
         rec.close()
         video = str(saved) if saved else None
         timings["video_s"] = round(time.perf_counter() - tv, 3)
-    success = bool(final) and all(p.holds for p in final)
+    # an empty plan (nothing detected) is done by leaving the scene alone
+    success = all(p.holds for p in final) if final else not plan.subtasks
     return SkillResult(task_id=plan.task_id, seed=seed, success=success, subtasks=results,
                        final_predicates=final, video=video, timings=timings)

@@ -146,3 +146,26 @@ def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, s
             break
     return Plan(task_id=task_id, source=source, engine=Engine.KNOWLEDGE, subtasks=subtasks,
                 success=SuccessSpec(predicates=list(cls.success)), bindings=dict(bindings))
+
+
+def _bound(call: PredicateCall, bindings: dict[str, str]) -> PredicateCall:
+    args = {k: _resolve(v, bindings) if isinstance(v, str) else v for k, v in call.args.items()}
+    return call.model_copy(update={"args": args})
+
+
+def merge_plans(plans: list[Plan]) -> Plan:
+    """Several fixes in one plan, run in order. Each fix's variables are resolved to instance names
+    first (two fixes bind ``$hazard`` to different objects); the merged plan keeps the first fix's
+    bindings for display and succeeds when every fix's final condition holds."""
+    if len(plans) == 1:
+        return plans[0]
+    subtasks: list[SubTask] = []
+    success: list[PredicateCall] = []
+    for i, plan in enumerate(plans, start=1):
+        for st in plan.subtasks:
+            spec = SuccessSpec(predicates=[_bound(c, plan.bindings) for c in st.success.predicates])
+            subtasks.append(st.model_copy(update={"id": f"h{i}_{st.id}", "success": spec}))
+        success += [_bound(c, plan.bindings) for c in plan.success.predicates]
+    first = plans[0]
+    return Plan(task_id=first.task_id, source=first.source, engine=first.engine, subtasks=subtasks,
+                success=SuccessSpec(predicates=success), bindings=dict(first.bindings))

@@ -1,8 +1,14 @@
-"""Stage 4a: one ``plans/<task_id>.json`` per task, from ground truth or from the detection.
+"""Stage 4a: one ``plans/<task_id>.json`` per scene, from the detection (default) or from the oracle.
 
-With ``plan_source = ground_truth`` the hazard class and role bindings come from the task and its
-built scene; with ``detected`` the top hypothesis names the hazard class and the object at fault
-(bound to ``$hazard``), so a wrong detection gives a wrong plan, as it should.
+With ``plan_source = detected`` (the default) the robot plans from what it perceived: every
+hypothesis worth acting on (a known class, score at least ``learn.min_score``, one per object, most
+severe first, up to ``learn.max_fixes``) becomes a fix whose roles (container, support, ...) are
+chosen from the perceived scene graph (``plan.bind``); the scene spec it reads has the answer key
+removed (``anomalygen.perception``). A scene where nothing was detected gets an empty plan: acting
+there would be an unnecessary intervention. A wrong detection gives a wrong plan, as it should.
+
+With ``plan_source = ground_truth`` the task's class and the builder's bindings are used: the oracle
+ablation, for comparison only.
 
 The learn engine picks the planner: ``knowledge`` turns the class's recipe into sub-tasks
 (``planner.plan_from_kb``); ``llm`` asks the configured LLM for the decomposition
@@ -16,7 +22,7 @@ from typing import TYPE_CHECKING
 from anomalygen.errors import ItemFailed, UserError
 from anomalygen.runfolder import RunFolder, read_jsonl, try_read_model, write_model
 from anomalygen.runner import StageContext, StageSummary, run_items
-from anomalygen.schema import Detection, Plan, SceneSpec, TaskProposal
+from anomalygen.schema import Detection, Plan, SceneSpec, SuccessSpec, TaskProposal
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
@@ -25,31 +31,82 @@ STAGE = "plan"
 
 
 def plan_item(task_id: str, payload: dict, ctx: StageContext) -> str:
-    from anomalygen.plan.planner import plan_from_kb
-
     run, settings = ctx.run, ctx.settings
-    spec = try_read_model(run.scene_dir(task_id) / "scene.json", SceneSpec)
-    bindings = dict(spec.bindings) if spec is not None else {}
-    hazard_class = payload["hazard_class"]
-    source = settings.learn.plan_source
-    hypothesis = None
-    if source == "detected":
-        det = payload.get("detection")
-        if det is None or not det["hypotheses"]:
-            raise ItemFailed("no detection for this task")
-        top = min(det["hypotheses"], key=lambda h: h["rank"])
-        if not top.get("hazard_class"):
-            raise ItemFailed("top hypothesis names no hazard class")
-        hazard_class = top["hazard_class"]
-        bindings["$hazard"] = top["target_object"]
-        hypothesis = top
-    if settings.engine_for("learn").value == "llm":
-        plan = _plan_with_llm(task_id, payload, ctx, hazard_class, bindings, spec, hypothesis)
+    if settings.learn.plan_source == "detected":
+        plan = _plan_from_perception(task_id, payload, ctx)
     else:
-        plan = plan_from_kb(task_id, hazard_class, bindings, spec=spec, source=source,
-                            sac_actions=settings.learn.sac_actions)
+        plan = _plan_from_oracle(task_id, payload, ctx)
     write_model(run.plan_path(task_id), plan)
     return str(run.plan_path(task_id))
+
+
+def _plan_from_oracle(task_id: str, payload: dict, ctx: StageContext) -> Plan:
+    """The oracle ablation: the task's class and the builder's bindings (the answer key)."""
+    from anomalygen.plan.planner import plan_from_kb
+
+    settings = ctx.settings
+    spec = try_read_model(ctx.run.scene_dir(task_id) / "scene.json", SceneSpec)
+    bindings = dict(spec.bindings) if spec is not None else {}
+    hazard_class = payload["hazard_class"]
+    if settings.engine_for("learn").value == "llm":
+        return _plan_with_llm(task_id, payload, ctx, hazard_class, bindings, spec, None)
+    return plan_from_kb(task_id, hazard_class, bindings, spec=spec, source="ground_truth",
+                        sac_actions=settings.learn.sac_actions)
+
+
+def _plan_from_perception(task_id: str, payload: dict, ctx: StageContext) -> Plan:
+    """Fix what was detected, most severe first, with every role chosen from the perceived scene."""
+    from anomalygen.knowledge import load_kb
+    from anomalygen.perception import load_perceived_spec, load_scene_graph
+    from anomalygen.plan.bind import bind_fix
+    from anomalygen.plan.planner import merge_plans, plan_from_kb
+
+    settings = ctx.settings
+    det = payload.get("detection")
+    if det is None:
+        raise ItemFailed("no detection for this scene (run 'anomalygen detect' first)")
+    spec = load_perceived_spec(ctx.run.scene_dir(task_id))
+    graph = load_scene_graph(ctx.run.scene_dir(task_id))
+    if spec is None or graph is None:
+        raise ItemFailed(f"no built scene in {ctx.run.scene_dir(task_id)}")
+    kb = load_kb()
+    chosen = fixes_to_make(det["hypotheses"], kb, max_fixes=settings.learn.max_fixes,
+                           min_score=settings.learn.min_score)
+    if not chosen:  # nothing detected worth acting on: the right plan is to leave the scene alone
+        return Plan(task_id=task_id, source="detected", engine=settings.engine_for("learn"), subtasks=[],
+                    success=SuccessSpec(predicates=[]), bindings={})
+    if settings.engine_for("learn").value == "llm":
+        top = chosen[0]
+        bindings = bind_fix(kb.hazard_classes[top["hazard_class"]], top["target_object"], graph, kb)
+        return _plan_with_llm(task_id, payload, ctx, top["hazard_class"], bindings, spec, top)
+    plans, problems = [], []
+    for hyp in chosen:
+        hc = kb.hazard_classes[hyp["hazard_class"]]
+        try:
+            bindings = bind_fix(hc, hyp["target_object"], graph, kb)
+        except ItemFailed as exc:
+            problems.append(f"{hc.id} on {hyp['target_object']}: {exc}")
+            continue
+        plans.append(plan_from_kb(task_id, hc.id, bindings, spec=spec, source="detected",
+                                  sac_actions=settings.learn.sac_actions))
+    if not plans:
+        raise ItemFailed("; ".join(problems))
+    return merge_plans(plans)
+
+
+def fixes_to_make(hypotheses: list[dict], kb, *, max_fixes: int, min_score: float) -> list[dict]:
+    """Hypotheses worth acting on: a known class, a score at or above ``min_score``, one per object,
+    most severe class first (ties by detector rank), at most ``max_fixes``."""
+    seen: set[str] = set()
+    out = []
+    usable = [h for h in hypotheses if h.get("hazard_class") in kb.hazard_classes
+              and float(h.get("score") or 0.0) >= min_score]
+    for h in sorted(usable, key=lambda h: (-kb.hazard_classes[h["hazard_class"]].severity, h["rank"])):
+        if h["target_object"] in seen:
+            continue
+        seen.add(h["target_object"])
+        out.append(h)
+    return out[:max_fixes]
 
 
 def _plan_with_llm(task_id: str, payload: dict, ctx: StageContext, hazard_class: str, bindings: dict[str, str],
@@ -63,7 +120,7 @@ def _plan_with_llm(task_id: str, payload: dict, ctx: StageContext, hazard_class:
     if spec is None:
         raise ItemFailed(f"no valid scene.json in {ctx.run.scene_dir(task_id)}; the LLM planner plans against "
                          "the built scene (run 'anomalygen build' first)")
-    if hypothesis is not None:  # the task's own words would leak the ground truth into a detected plan
+    if hypothesis is not None:  # the task's own words would leak the answer key into a detected plan
         hazard = hazard_text_from_hypothesis(hypothesis)
     else:
         hazard = hazard_text_from_task(TaskProposal.model_validate(payload["task"])) if payload.get("task") else ""
@@ -71,7 +128,7 @@ def _plan_with_llm(task_id: str, payload: dict, ctx: StageContext, hazard_class:
     client.reset_usage()  # this item's requests only (the client is shared per process)
     try:
         return plan_from_llm(task_id, hazard_class, bindings, spec=spec, client=client, hazard=hazard,
-                             source=settings.learn.plan_source, seed=settings.seed)
+                             source="detected" if hypothesis is not None else "ground_truth", seed=settings.seed)
     finally:
         usage = client.reset_usage()
         if usage.requests or usage.cache_hits:
@@ -92,8 +149,10 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
         if only and t.id not in only:
             continue
         det = detections.get(t.id)
-        items.append((t.id, {"hazard_class": t.hazard_class, "detection": det.model_dump(mode="json") if det else None,
-                             "task": t.model_dump(mode="json")}))
+        if settings.learn.plan_source == "detected":  # the robot's side: its detection, never the task
+            items.append((t.id, {"detection": det.model_dump(mode="json") if det else None}))
+        else:
+            items.append((t.id, {"hazard_class": t.hazard_class, "task": t.model_dump(mode="json")}))
 
     def done(task_id: str) -> bool:
         plan = try_read_model(run.plan_path(task_id), Plan)

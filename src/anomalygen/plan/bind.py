@@ -1,0 +1,85 @@
+"""Bind a fix's role variables from what the robot perceives, not from the builder's bindings.
+
+A detection names the object at fault and a hazard class. The recipe of that class also needs a
+container (put the knife away), a support (lay the cable on a shelf) or the object a precondition
+relates to (the window of a stuffy room). The robot chooses them itself, here, from the scene graph:
+
+- variables in the class's preconditions come from matching the class on the perceived graph with
+  the object at fault fixed (the same reading of the scene that made the detection);
+- ``$container``: the nearest object of a kind the class puts such things in (the knowledge base's
+  containers for the class and object) that the object fits and the arm can reach;
+- ``$support``: the nearest surface of a kind the class lays things on.
+"""
+
+from __future__ import annotations
+
+import math
+
+from anomalygen.errors import ItemFailed
+from anomalygen.schema import GraphObject, SceneGraph
+
+REACH_TOP_M = 1.6  # a container whose top is higher than this is out of the arm's comfortable reach
+
+
+def recipe_variables(hc) -> list[str]:
+    """Role variables the class's recipe refers to, in first-use order."""
+    seen: list[str] = []
+    for step in hc.recipe:
+        for value in step.args.values():
+            if isinstance(value, str) and value.startswith("$") and value not in seen:
+                seen.append(value)
+    return seen
+
+
+def bind_fix(hc, fault: str, graph: SceneGraph, kb) -> dict[str, str]:
+    """Every role variable of ``hc``'s recipe bound to a perceived object; ItemFailed when one cannot be."""
+    from anomalygen.knowledge.predicates import PredicateError, match_class
+
+    names = {o.name: o for o in graph.objects}
+    if fault not in names:
+        raise ItemFailed(f"the detected object {fault!r} is not in the scene")
+    bindings = {hc.hazard_variable: fault}
+    try:
+        matches = match_class(hc, graph, fixed=dict(bindings))
+    except PredicateError:
+        matches = []
+    if matches:
+        bindings.update(sorted(matches[0].bindings.items()))
+    for var in recipe_variables(hc):
+        if var in bindings:
+            continue
+        if var == "$container":
+            bindings[var] = choose_container(hc, names[fault], graph, kb)
+        elif var == "$support":
+            bindings[var] = choose_support(hc, names[fault], graph)
+        elif var == "$target":
+            bindings[var] = fault
+        else:
+            raise ItemFailed(f"{hc.id}: nothing in the scene can play {var}")
+    return bindings
+
+
+def choose_container(hc, obj: GraphObject, graph: SceneGraph, kb) -> str:
+    kinds = kb.containers_for(hc, obj.category)
+    fits = [o for o in graph.objects if o.name != obj.name and o.category in kinds and _fits(obj, o)
+            and o.position[2] + o.size[2] / 2 <= REACH_TOP_M]
+    if not fits:
+        raise ItemFailed(f"no reachable container for {obj.name} in the scene (wanted: {', '.join(kinds) or 'none'})")
+    return _nearest(obj, fits)
+
+
+def choose_support(hc, obj: GraphObject, graph: SceneGraph) -> str:
+    kinds = set(hc.default_supports)
+    cands = [o for o in graph.objects if o.name != obj.name and o.category in kinds]
+    if not cands:
+        raise ItemFailed(f"no surface for {obj.name} in the scene (wanted: {', '.join(sorted(kinds)) or 'none'})")
+    return _nearest(obj, cands)
+
+
+def _fits(obj: GraphObject, container: GraphObject) -> bool:
+    """Loose test on bounding boxes: the object's longest side within the container's longest side."""
+    return max(obj.size) < max(container.size)
+
+
+def _nearest(obj: GraphObject, cands: list[GraphObject]) -> str:
+    return min(cands, key=lambda o: (math.dist(obj.position[:2], o.position[:2]), o.name)).name
