@@ -9,7 +9,6 @@ from __future__ import annotations
 import json
 
 import pytest
-from support.perceived import graph_of
 
 from anomalygen.config import load_settings
 from anomalygen.llm import get_client
@@ -36,6 +35,7 @@ from anomalygen.schema import (
 )
 from support.fixtures import llm_config_for, scripted_server  # noqa: F401
 from support.openai_server import text
+from support.perceived import graph_of
 
 # --------------------------------------------------------------------------- scenes and tasks
 

@@ -53,10 +53,9 @@ def test_plan_stage_writes_plans_and_fails_one_item(tmp_path):
 
 def _scene_with_a_drawer_and_two_sharp_things(run, tid):
     """A kitchen: scissors and a knife on the counter, a cabinet with a shut drawer, a bin."""
-    from support.perceived import graph_of
-
     from anomalygen.runfolder import write_model
     from anomalygen.schema import AssetRef, JointState, ObjectRole, PlacedObject, SceneSpec
+    from support.perceived import graph_of
 
     def placed(name, category, pos, size, role, joints=(), fixed=False):
         return PlacedObject(name=name, asset=AssetRef(asset_id=f"{category}-0", category=category, source="procedural"),
