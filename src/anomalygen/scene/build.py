@@ -31,7 +31,7 @@ import numpy as np
 from anomalygen.errors import ItemFailed
 from anomalygen.rng import item_rng, stable_hash
 from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
-from anomalygen.scene import furniture, layout, robot, robot_model, select
+from anomalygen.scene import furniture, layout, mix, robot, robot_model, select
 from anomalygen.scene.graph import FLOOR_GEOM
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.sensors import add_observation_sensors
@@ -441,9 +441,36 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
                 continue
             placed[p.name] = p
 
+    items = mix.choose_judgement_items(sel.task.id, sel.task.hazard_class, set(sel.by_catalogue) | set(clutter),
+                                       sel.kb, settings)
+    _place_judgement_items(sel, lay, placed, [s for s in (side, support) if s is not None], items)
+
     focus = placed[hazard.name]
     lay.fit_base(focus, holder=placed.get(focus.inside) if focus.inside else None)
     return lay, placed, support
+
+
+def _place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed], surfaces: list[Placed],
+                           items: mix.JudgementItems) -> None:
+    """Near-misses well inside a table top (any that find no room are left out); the second hazard
+    on the floor, with its bin when the scene has none."""
+    rng = items.rng
+    for cat in items.near_misses if surfaces else []:
+        asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng)
+        p = _placed(select.Chosen(_instance_name(cat, sel.used), cat, ObjectRole.CLUTTER, asset))
+        holder = surfaces[int(rng.integers(len(surfaces)))]
+        try:
+            lay.place_on_surface(p, holder, _surface_of(holder), inward=INWARD)
+        except ItemFailed:
+            continue
+        placed[p.name] = p
+    for cat, role, face in ((items.second_hazard, ObjectRole.HAZARD, False), (items.bin, ObjectRole.CONTAINER, True)):
+        if cat is None:
+            continue
+        asset = select.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng)
+        p = _placed(select.Chosen(_instance_name(cat, sel.used), cat, role, asset))
+        lay.place_on_floor(p, relevant=True, face=face)
+        placed[p.name] = p
 
 
 def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None,

@@ -67,6 +67,11 @@ def _catalogue() -> tuple[str, ...]:
     return tuple(available_names())
 
 
+def catalogue_names() -> tuple[str, ...]:
+    """Every catalogue name the builder can instantiate."""
+    return _catalogue()
+
+
 def resolve_name(name: str) -> str:
     """A catalogue name for ``name``: itself, a case-insensitive match, or the SBERT nearest entry."""
     names = _catalogue()
