@@ -17,9 +17,12 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from anomalygen.brainstorm.idea import task_id
+from anomalygen.brainstorm.ground_names import ground_llm_names
 from anomalygen.brainstorm.knowledge_engine import agent_roles, split_quota
 from anomalygen.brainstorm.validate import proposal_problems
 from anomalygen.knowledge import PLACEMENTS, ROOMS, KnowledgeBase, load_kb
+from anomalygen.knowledge.grounding import NameGrounder
+from anomalygen.llm.schema_tools import reply_token_budget
 from anomalygen.rng import item_rng
 from anomalygen.schema import (
     ArticulationUse,
@@ -32,6 +35,9 @@ from anomalygen.schema import (
     TaskProposal,
     format_validation_error,
 )
+
+#: Aspects of another agent's idea a proposal may borrow (the paper's brainstorming rounds).
+BORROWABLE = ("mechanism", "location", "co_objects", "person_at_risk")
 
 ROBOT_LIMITS = (
     "The robot is a Franka Panda arm on a mobile base with a suction gripper. It can pick up and place "
@@ -67,12 +73,6 @@ class LLMProposal(BaseModel):
     borrowed: list[str] = Field(default_factory=list, description="what was borrowed: mechanism, location, co_objects, person_at_risk")
 
 
-class AgentReply(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-    proposals: list[LLMProposal] = Field(min_length=1)
-
-
 @dataclass
 class Shown:
     """A proposal as the other agents see it in the next round."""
@@ -94,6 +94,11 @@ class LLMEngine:
     repair_retries: int = 2
     errors: dict[str, str] = field(default_factory=dict)
     accepted: list[TaskProposal] = field(default_factory=list)
+    grounder: NameGrounder | None = None
+
+    def __post_init__(self) -> None:
+        if self.grounder is None:
+            self.grounder = NameGrounder(self.kb)
 
     @classmethod
     def from_settings(cls, settings) -> LLMEngine:
@@ -112,24 +117,27 @@ class LLMEngine:
 
     # ------------------------------------------------------------------ run
     def run(self, n: int) -> list[TaskProposal]:
+        """``n`` proposals, one request each; rounds still show every agent the others' last round."""
         mode = BrainstormMode(self.mode)
         n_agents = 1 if mode == BrainstormMode.PLAIN else self.agents
         rounds = self.rounds if mode == BrainstormMode.BRAINSTORM else 1
         roles: list[str | None] = [None] if mode == BrainstormMode.PLAIN else agent_roles(self.kb, n_agents)
         previous: list[tuple[int, Shown]] = []
+        budget = reply_token_budget(LLMProposal)
         for r, quota in enumerate(split_quota(n, rounds), start=1):
             shares = split_quota(quota, n_agents, offset=r - 1)
-            jobs = [(i, share) for i, share in enumerate(shares) if share > 0]
-            convs = [self.messages(r, i, roles[i], share, previous) for i, share in jobs]
-            replies = self.client.complete_many(convs, schema=AgentReply)
+            jobs = [(i, k, share) for i, share in enumerate(shares) for k in range(share)]
+            convs = [self.messages(r, i, roles[i], previous, k=k, share=share) for i, k, share in jobs]
+            replies = self.client.complete_many(convs, schema=LLMProposal, max_tokens=budget)
             this_round: list[tuple[int, Shown]] = []
-            for (i, share), conv, reply in zip(jobs, convs, replies, strict=True):
-                item = f"r{r}-agent{i}"
+            for (i, k, share), conv, reply in zip(jobs, convs, replies, strict=True):
+                item = f"r{r}-agent{i}" + (f"-p{k + 1}" if share > 1 else "")
                 if isinstance(reply, Exception):
                     self.errors[item] = str(reply)
                     continue
                 shown_ids = {s.id for a, s in previous if a != i}
-                for p in self._accept(reply, conv, r, i, roles[i], share, shown_ids, item):
+                p = self._accept(reply, conv, r, roles[i], shown_ids, item, budget)
+                if p is not None:
                     this_round.append((i, Shown(p.id, roles[i], p.name, p.description)))
             previous = this_round
         return list(self.accepted)
@@ -159,90 +167,86 @@ class LLMEngine:
         ]
         return "\n\n".join(parts)
 
-    def messages(self, r: int, i: int, role: str | None, share: int, previous: list[tuple[int, Shown]]) -> list[dict]:
+    def messages(
+        self, r: int, i: int, role: str | None, previous: list[tuple[int, Shown]], *, k: int = 0, share: int = 1
+    ) -> list[dict]:
+        """The request for an agent's ``k``-th proposal of round ``r`` (one proposal per request)."""
         others = [s for a, s in previous if a != i]
         if r == 1 or not others:
-            rng = item_rng(self.seed, "llm-brainstorm", r, i)
+            rng = item_rng(self.seed, "llm-brainstorm", r, i, k)
             target = self.kb.targets[int(rng.integers(len(self.kb.targets)))]
             ask = (
-                f"Round {r}. Your target object is {target}. Propose {share} distinct hazard scenario(s) in a "
-                f"home that involve the {target} (as the hazard, the place to store it, or the setting)."
+                f"Round {r}. Your target object is {target}. Propose one hazard scenario in a home that "
+                f"involves the {target} (as the hazard, the place to store it, or the setting)."
             )
         else:
             listing = "\n".join(f"- [{s.id}] ({s.role or 'participant'}) {s.name}: {s.description}" for s in others)
+            aspect = BORROWABLE[(i + k) % len(BORROWABLE)]
             ask = (
                 f"Round {r} of the brainstorming session. These are the other participants' proposals from "
-                f"round {r - 1}:\n{listing}\n\nBuild on them: combine a hazard mechanism, a location, objects "
-                "or the person at risk from their ideas with your own perspective, and propose "
-                f"{share} new scenario(s) that are different from all of the above. Put the ids you build on "
-                "in builds_on and what you borrowed in borrowed."
+                f"round {r - 1}:\n{listing}\n\nBuild on them: take the {aspect.replace('_', ' ')} of one of "
+                "their ideas, combine it with your own perspective, and propose one new scenario that is "
+                "different from all of the above. Put the ids you build on in builds_on and what you "
+                "borrowed in borrowed."
             )
+        if share > 1:
+            ask += f" This is idea {k + 1} of {share} you write this round; give each its own angle."
         return [{"role": "system", "content": self.system_prompt(role)}, {"role": "user", "content": ask}]
 
     # ------------------------------------------------------------------ validation and repair
-    def _accept(self, reply: AgentReply, conv, r, i, role, share, shown_ids, item) -> list[TaskProposal]:
-        problems_by_idx: dict[int, list[str]] = {}
-        kept: list[TaskProposal] = []
-        for attempt in range(self.repair_retries + 1):
-            kept, problems_by_idx = [], {}
-            for k, raw in enumerate(reply.proposals[:share]):
-                proposal, problems = self._convert(raw, r, role, shown_ids)
-                if problems:
-                    problems_by_idx[k] = problems
-                else:
-                    kept.append(proposal)
-            if not problems_by_idx or attempt == self.repair_retries:
+    def _accept(self, raw: LLMProposal, conv, r, role, shown_ids, item, budget) -> TaskProposal | None:
+        """Ground and validate one proposal; only names that even retrieval cannot place go back."""
+        proposal, problems = self._convert(raw, r, role, shown_ids)
+        for _ in range(self.repair_retries):
+            if not problems:
                 break
-            fixed = self._repair(conv, reply, problems_by_idx)
+            fixed = self._repair(conv, raw, problems, budget)
             if fixed is None:
                 break
-            reply = fixed
-        for k, problems in problems_by_idx.items():
-            self.errors[f"{item}-p{k + 1}"] = "; ".join(problems)[:500]
-        out = []
-        names = {p.name.lower() for p in self.accepted}
-        for p in kept:
-            if p.name.lower() in names:
-                continue
-            names.add(p.name.lower())
-            index = len(self.accepted) + 1
-            p = p.model_copy(update={"id": task_id(index, p.name)})
-            self.accepted.append(p)
-            out.append(p)
-        return out
+            raw = fixed
+            proposal, problems = self._convert(raw, r, role, shown_ids)
+        if problems or proposal is None:
+            self.errors[item] = "; ".join(problems)[:500]
+            return None
+        if proposal.name.lower() in {p.name.lower() for p in self.accepted}:
+            self.errors[item] = f"duplicate of an accepted proposal named '{proposal.name}'"
+            return None
+        proposal = proposal.model_copy(update={"id": task_id(len(self.accepted) + 1, proposal.name)})
+        self.accepted.append(proposal)
+        return proposal
 
-    def _repair(self, conv, reply: AgentReply, problems_by_idx: dict[int, list[str]]) -> AgentReply | None:
-        listing = "\n".join(f"proposal {k + 1}: " + "; ".join(ps) for k, ps in problems_by_idx.items())
+    def _repair(self, conv, raw: LLMProposal, problems: list[str], budget: int) -> LLMProposal | None:
         follow = conv + [
-            {"role": "assistant", "content": reply.model_dump_json()},
+            {"role": "assistant", "content": raw.model_dump_json()},
             {
                 "role": "user",
-                "content": "Some proposals cannot be built:\n" + listing + "\nUse only the catalogue names, rooms, "
-                "placements and class ids listed above. Reply with the corrected proposals.",
+                "content": "This proposal cannot be built:\n- " + "\n- ".join(problems) + "\nUse only the catalogue "
+                "names, rooms, placements and class ids listed above. Reply with the corrected proposal.",
             },
         ]
         try:
-            out = self.client.complete(follow, schema=AgentReply)
-        except Exception as exc:  # noqa: BLE001 - a failed repair keeps the proposals that were valid
-            self.errors.setdefault("repair", str(exc)[:300])
+            out = self.client.complete(follow, schema=LLMProposal, max_tokens=budget)
+        except Exception as exc:  # noqa: BLE001 - a failed repair fails this one proposal only
+            problems.append(f"repair failed: {str(exc)[:200]}")
             return None
-        return out if isinstance(out, AgentReply) else None
+        return out if isinstance(out, LLMProposal) else None
 
     def _convert(self, raw: LLMProposal, r: int, role: str | None, shown_ids: set[str]) -> tuple[TaskProposal | None, list[str]]:
         kb = self.kb
-        hc = kb.hazard_classes.get(raw.hazard_class)
+        g = ground_llm_names(raw, self.grounder)
+        hc = kb.hazard_classes.get(g.hazard_class)
         category = hc.category if hc is not None else raw.category
         articulations = []
         if raw.articulated_part:
-            obj = raw.hazard_object if raw.hazard_object in kb.objects else raw.target_asset
+            obj = g.hazard_object if g.hazard_object in kb.objects else g.target_asset
             initial = raw.part_initial_state or (hc.articulation.initial_state if hc and hc.articulation else "open")
             target_state = hc.articulation.target_state if hc and hc.articulation else "closed"
             articulations.append(ArticulationUse(object=obj, part=raw.articulated_part, initial_state=initial, target_state=target_state))
         aux = [
             AuxiliaryItem(name=n, description=kb.objects[n].description if n in kb.objects else "", purpose=purpose)
-            for n, purpose in [(raw.hazard_object, "the hazard itself"), (raw.container, "where the robot puts it")]
-            + [(c, "part of the setting") for c in raw.co_objects]
-            if n and n != raw.target_asset
+            for n, purpose in [(g.hazard_object, "the hazard itself"), (g.container, "where the robot puts it")]
+            + [(c, "part of the setting") for c in g.co_objects]
+            if n and n != g.target_asset
         ]
         try:
             proposal = TaskProposal(
@@ -251,16 +255,16 @@ class LLMEngine:
                 explanation=raw.explanation,
                 description=raw.description,
                 category=category,
-                hazard_class=raw.hazard_class,
-                hazard_other=raw.hazard_other,
-                target_asset=raw.target_asset,
+                hazard_class=g.hazard_class,
+                hazard_other=g.hazard_other,
+                target_asset=g.target_asset,
                 scenario=Scenario(
-                    hazard_object=raw.hazard_object,
-                    room=raw.room,
-                    placement=raw.placement,
+                    hazard_object=g.hazard_object,
+                    room=g.room,
+                    placement=g.placement,
                     person_at_risk=raw.person_at_risk,
-                    container=raw.container,
-                    co_objects=list(raw.co_objects),
+                    container=g.container,
+                    co_objects=g.co_objects,
                 ),
                 auxiliary_items=aux,
                 articulations=articulations,
@@ -272,16 +276,19 @@ class LLMEngine:
                     agent_role=role,
                     round=r,
                     builds_on=[b for b in raw.builds_on if b in shown_ids],
-                    borrowed=[b for b in raw.borrowed if b in ("mechanism", "location", "co_objects", "person_at_risk")],
+                    borrowed=[b for b in raw.borrowed if b in BORROWABLE],
                     seed=self.seed,
                     model=getattr(self.client, "model", None),
                 ),
+                grounding=g.matches,
             )
         except ValidationError as exc:
             return None, [format_validation_error(exc)]
-        return proposal, proposal_problems(proposal, kb)
+        unresolved = {m.written for m in g.matches if m.grounded is None and m.method != "dropped"}
+        rest = [p for p in proposal_problems(proposal, kb) if not any(f"'{w}'" in p for w in unresolved)]
+        return proposal, g.problems + rest
 
 
-def reply_json(proposals: list[dict]) -> str:
-    """Serialise scripted replies (tests, examples)."""
-    return json.dumps({"proposals": proposals})
+def reply_json(proposal: dict) -> str:
+    """Serialise a scripted reply (tests, examples)."""
+    return json.dumps(proposal)
