@@ -72,7 +72,7 @@ def ground_llm_names(raw: LooseProposal, g: NameGrounder) -> GroundedNames:
     category = getattr(raw.category, "value", raw.category)
     target = keep(g.target(raw.target_asset))
     hazard = keep(g.object(raw.hazard_object, "scenario.hazard_object"))
-    cls = g.hazard_class(raw.hazard_class, context, category=str(category), hazard_object=hazard if hazard in kb.objects else None)
+    cls = g.hazard_class(raw.hazard_class, context, category=str(category), hazard_objects=[hazard] if hazard in kb.objects else [])
     matches.insert(0, cls)
     hazard_class = cls.grounded or "other"
     hazard_other = raw.hazard_other

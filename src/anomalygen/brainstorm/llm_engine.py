@@ -16,7 +16,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from anomalygen.brainstorm.idea import task_id
+from anomalygen.brainstorm.idea import ASPECTS, task_id
 from anomalygen.brainstorm.ground_names import ground_llm_names
 from anomalygen.brainstorm.knowledge_engine import agent_roles, split_quota
 from anomalygen.brainstorm.validate import proposal_problems
@@ -35,9 +35,6 @@ from anomalygen.schema import (
     TaskProposal,
     format_validation_error,
 )
-
-#: Aspects of another agent's idea a proposal may borrow (the paper's brainstorming rounds).
-BORROWABLE = ("mechanism", "location", "co_objects", "person_at_risk")
 
 ROBOT_LIMITS = (
     "The robot is a Franka Panda arm on a mobile base with a suction gripper. It can pick up and place "
@@ -142,6 +139,26 @@ class LLMEngine:
             previous = this_round
         return list(self.accepted)
 
+    def from_texts(self, lines: list[str]) -> list[TaskProposal]:
+        """One proposal per plain description (``--tasks-text``): the model structures the line, the
+        grounder resolves its names; a line that stays invalid fails alone (``line<N>``)."""
+        budget = reply_token_budget(LLMProposal)
+        convs = [
+            [
+                {"role": "system", "content": self.system_prompt(None)},
+                {"role": "user", "content": "Write this household hazard as one structured scenario, keeping its "
+                 f"objects, place and people:\n{line}"},
+            ]
+            for line in lines
+        ]
+        replies = self.client.complete_many(convs, schema=LLMProposal, max_tokens=budget)
+        for n, (conv, reply) in enumerate(zip(convs, replies, strict=True), start=1):
+            if isinstance(reply, Exception):
+                self.errors[f"line{n}"] = str(reply)
+                continue
+            self._accept(reply.model_copy(update={"description": lines[n - 1]}), conv, 1, None, set(), f"line{n}", budget)
+        return list(self.accepted)
+
     # ------------------------------------------------------------------ prompts
     def system_prompt(self, role: str | None) -> str:
         kb = self.kb
@@ -181,7 +198,7 @@ class LLMEngine:
             )
         else:
             listing = "\n".join(f"- [{s.id}] ({s.role or 'participant'}) {s.name}: {s.description}" for s in others)
-            aspect = BORROWABLE[(i + k) % len(BORROWABLE)]
+            aspect = ASPECTS[(i + k) % len(ASPECTS)]
             ask = (
                 f"Round {r} of the brainstorming session. These are the other participants' proposals from "
                 f"round {r - 1}:\n{listing}\n\nBuild on them: take the {aspect.replace('_', ' ')} of one of "
@@ -276,7 +293,7 @@ class LLMEngine:
                     agent_role=role,
                     round=r,
                     builds_on=[b for b in raw.builds_on if b in shown_ids],
-                    borrowed=[b for b in raw.borrowed if b in BORROWABLE],
+                    borrowed=[b for b in raw.borrowed if b in ASPECTS],
                     seed=self.seed,
                     model=getattr(self.client, "model", None),
                 ),

@@ -49,6 +49,7 @@ PLACEMENT_TEXTS: dict[str, str] = {
 
 _SPLIT_CAMEL = re.compile(r"(?<=[a-z0-9])(?=[A-Z])")
 _NON_WORD = re.compile(r"[^a-z0-9]+")
+_WORD = re.compile(r"[a-z0-9]+(?:'[a-z]+)?")
 
 
 def normalise(text: str) -> str:
@@ -121,6 +122,26 @@ class Vocabulary:
         if name in among:
             return name, "alias"
         return None
+
+    def mentions(self, text: str, among: Iterable[str] | None = None, *, longest: int = 3) -> list[str]:
+        """Names the text mentions by spelling or alias, in order, longest phrase first where they overlap.
+
+        "A chef's knife on the kitchen counter" mentions ``kitchen_knife`` and ``counter``: the scan
+        reads word n-grams (possessives dropped), so free text needs no model to find its objects.
+        """
+        pool = set(self.names) if among is None else set(among)
+        words = [w.removesuffix("'s") for w in _WORD.findall(text.lower())]
+        taken = [False] * len(words)
+        found: list[tuple[int, str]] = []
+        for n in range(longest, 0, -1):
+            for i in range(len(words) - n + 1):
+                if any(taken[i : i + n]):
+                    continue
+                hit = self.spelled(" ".join(words[i : i + n]), pool)
+                if hit is not None:
+                    found.append((i, hit[0]))
+                    taken[i : i + n] = [True] * n
+        return list(dict.fromkeys(name for _, name in sorted(found)))
 
     def ranked(self, query: str, among: set[str], k: int) -> list[tuple[str, float]]:
         """The Sentence-BERT top-k of ``among`` for ``query``: the paper's retrieval step."""
@@ -205,13 +226,14 @@ class NameGrounder:
         return {hc.id for hc in self.kb.hazard_classes.values() if obj in self.kb.hazard_candidates(hc)}
 
     def hazard_class(
-        self, written: str, context: str, *, category: str | None = None, hazard_object: str | None = None, where: str = "hazard_class"
+        self, written: str, context: str, *, category: str | None = None, hazard_objects: Iterable[str] = (), where: str = "hazard_class"
     ) -> GroundingMatch:
         """A class id; a generic word or a category name is read from ``context`` (the proposal's text).
 
-        With a grounded ``hazard_object`` retrieval only considers classes that object can be the hazard
-        of, when there are any. Returns ``method="other"`` (grounded ``"other"``) when nothing fits well
-        enough: the caller keeps the model's own words as ``hazard_other``.
+        With grounded ``hazard_objects`` retrieval only considers the classes they can be the hazard
+        of, when there are any, and takes the best of those even below the threshold: a named object
+        is stronger evidence than the wording. Returns ``method="other"`` (grounded ``"other"``) when
+        nothing fits well enough: the caller keeps the model's own words as ``hazard_other``.
         """
         all_ids = set(self.kb.hazard_classes)
         hit = self.classes.spelled(written, all_ids)
@@ -223,10 +245,12 @@ class NameGrounder:
         if key in categories or (category in categories and key in GENERIC_CLASS_WORDS):
             cat = key if key in categories else category
             among = {hc.id for hc in self.kb.classes_in(cat)}
-        fitting = self.classes_with_hazard(hazard_object) if hazard_object else set()
+        fitting = {c for obj in hazard_objects for c in self.classes_with_hazard(obj)}
         among = (among & fitting) or fitting or among
         query = context if key in GENERIC_CLASS_WORDS or key in categories else f"{written.replace('_', ' ')}. {context}"
         match = self.classes.ground(written, where, among=among, query=query)
+        if match.grounded is None and fitting and match.similarity > 0:
+            match = match.model_copy(update={"grounded": self.classes.ranked(query, among, 1)[0][0]})
         if match.grounded is None:
             return match.model_copy(update={"grounded": "other", "method": "other"})
         return match
