@@ -16,8 +16,8 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from anomalygen.brainstorm.idea import ASPECTS, task_id
 from anomalygen.brainstorm.ground_names import ground_llm_names
+from anomalygen.brainstorm.idea import ASPECTS, task_id
 from anomalygen.brainstorm.knowledge_engine import agent_roles, split_quota
 from anomalygen.brainstorm.validate import proposal_problems
 from anomalygen.knowledge import PLACEMENTS, ROOMS, KnowledgeBase, load_kb
