@@ -152,6 +152,7 @@ def build(
     only: OnlyOpt = None,
     workers: WorkersOpt = None,
     clutter: Annotated[int | None, typer.Option(help="Unrelated objects added per scene.")] = None,
+    engine: Annotated[str | None, typer.Option(help="Scene engine: knowledge (default) or llm.")] = None,
     config: ConfigOpt = None,
     seed: SeedOpt = None,
     force: ForceOpt = False,
@@ -159,9 +160,12 @@ def build(
     as_json: JsonOpt = False,
     executor: ExecutorOpt = None,
     address: AddressOpt = None,
+    backend: BackendOpt = None,
+    model: ModelOpt = None,
 ):
     """Stage 2: build each task as a validated MuJoCo scene (writes scenes/<task_id>/)."""
-    settings = _common(config, seed, quiet, workers, executor, address, **{"build.clutter": clutter})
+    settings = _common(config, seed, quiet, workers, executor, address, backend=backend, model=model,
+                       **{"build.clutter": clutter, "build.engine": engine})
     folder = _open_run(run)
     fn = _stage("anomalygen.scene.stage")
     _finish(fn(folder, settings, force=force, only=only), as_json)

@@ -254,3 +254,11 @@ class NameGrounder:
         if match.grounded is None:
             return match.model_copy(update={"grounded": "other", "method": "other"})
         return match
+
+
+@functools.cache
+def shared_grounder() -> NameGrounder:
+    """One grounder per process over the packaged knowledge base (its embeddings are computed once)."""
+    from anomalygen.knowledge.base import load_kb
+
+    return NameGrounder(load_kb())
