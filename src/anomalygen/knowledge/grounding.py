@@ -202,6 +202,21 @@ class NameGrounder:
     def object(self, written: str, where: str, *, among: Sequence[str] | None = None, query: str | None = None) -> GroundingMatch:
         return self.objects.ground(written, where, among=among, query=query)
 
+    def instances(self, objects: Sequence[tuple[str, str]]) -> Vocabulary:
+        """A vocabulary of one scene's instances ``(name, category)``: "kettle", "the fridge" or
+        "electric kettle" find ``kettle_0`` through its category, the alias table or retrieval."""
+        aliases: dict[str, str] = {}
+        for name, category in objects:
+            aliases.setdefault(normalise(category), name)
+            for key, target in self.objects.aliases.items():
+                if target == category:
+                    aliases.setdefault(key, name)
+        texts = [
+            f"{words_of(category)}: {self.kb.objects[category].description if category in self.kb.objects else ''}"
+            for _, category in objects
+        ]
+        return Vocabulary("scene object", [n for n, _ in objects], texts, aliases, self.objects.threshold)
+
     def target(self, written: str, where: str = "target_asset") -> GroundingMatch:
         return self.objects.ground(written, where, among=self.kb.targets)
 
