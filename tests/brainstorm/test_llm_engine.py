@@ -161,6 +161,8 @@ def test_tiny_gguf_mechanics(tmp_path):
     assert summary.done == len(tasks) <= 1
     if not tasks:
         assert summary.failed >= 1 and run.errors("brainstorm")
+    for task in tasks:  # a proposal that survived was grounded, and says how
+        assert {"hazard_class", "target_asset", "scenario.hazard_object"} <= {m.field for m in task.grounding}
     manifest = json.loads(run.manifest_path.read_text())
     assert manifest["llm_usage"]["requests"] >= 1
 

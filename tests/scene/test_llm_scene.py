@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 
 from anomalygen.config import Settings
 from anomalygen.runfolder import RunFolder, read_model, write_jsonl
@@ -79,3 +80,31 @@ def test_llm_scene_engine_builds_from_the_replies_and_records_repairs(scripted_s
     assert "left out" in checks["auxiliary:time machine"].detail
     assert any(m.written == "tissues" and m.grounded == "tissue_box" and m.method == "retrieval" for m in hints.grounding)
     assert spec.validation.ok
+
+
+@pytest.mark.slow
+@pytest.mark.gguf
+def test_tiny_gguf_runs_the_llm_scene_engine(tmp_path):
+    """The bundled 135M model proves the mechanics: the scene is built from its (checked) numbers, or
+    the one item fails with a one-line reason; either way nothing else breaks."""
+    settings = Settings(
+        quiet=True, workers=1, build={"engine": "llm", "clutter": 1},
+        llm={"backend": "llamacpp", "cache_path": str(tmp_path / "c.sqlite"), "repair_retries": 1, "max_tokens": 160},
+    )
+    run = RunFolder.create(tmp_path / "run", settings=settings)
+    task = TASKS["floor"]
+    write_jsonl(run.tasks_path, [task])
+    summary = run_stage(run, settings)
+    assert summary.done + summary.failed == 1
+    folder = run.scene_dir(task.id)
+    if summary.done:
+        hints = read_model(folder / "llm_layout.json", SceneHints)
+        spec = read_model(folder / "scene.json", SceneSpec)
+        assert spec.validation.ok and hints.model
+        names = {c.name for c in spec.validation.checks}
+        # every task object's size and position is either the model's or a recorded correction
+        for cat in ("Safe", "button_battery"):
+            assert cat in hints.sizes or f"layout:{cat}" in names
+    else:
+        [reason] = summary.errors.values()
+        assert "\n" not in reason and reason

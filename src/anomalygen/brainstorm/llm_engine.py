@@ -97,6 +97,11 @@ class LLMEngine:
         if self.grounder is None:
             self.grounder = NameGrounder(self.kb)
 
+    @property
+    def token_cap(self) -> int | None:
+        """The configured ``llm.max_tokens``: an upper bound on the schema-sized budget."""
+        return getattr(getattr(self.client, "config", None), "max_tokens", None)
+
     @classmethod
     def from_settings(cls, settings) -> LLMEngine:
         from anomalygen.llm import get_client
@@ -120,7 +125,7 @@ class LLMEngine:
         rounds = self.rounds if mode == BrainstormMode.BRAINSTORM else 1
         roles: list[str | None] = [None] if mode == BrainstormMode.PLAIN else agent_roles(self.kb, n_agents)
         previous: list[tuple[int, Shown]] = []
-        budget = reply_token_budget(LLMProposal)
+        budget = reply_token_budget(LLMProposal, cap=self.token_cap)
         for r, quota in enumerate(split_quota(n, rounds), start=1):
             shares = split_quota(quota, n_agents, offset=r - 1)
             jobs = [(i, k, share) for i, share in enumerate(shares) for k in range(share)]
@@ -142,7 +147,7 @@ class LLMEngine:
     def from_texts(self, lines: list[str]) -> list[TaskProposal]:
         """One proposal per plain description (``--tasks-text``): the model structures the line, the
         grounder resolves its names; a line that stays invalid fails alone (``line<N>``)."""
-        budget = reply_token_budget(LLMProposal)
+        budget = reply_token_budget(LLMProposal, cap=self.token_cap)
         convs = [
             [
                 {"role": "system", "content": self.system_prompt(None)},

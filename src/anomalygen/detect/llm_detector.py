@@ -38,7 +38,8 @@ def reply_schema(graph: SceneGraph, grounder, k: int, notes: list[str] | None = 
     ``notes`` collects one line per name that was not written exactly (kept in the hypotheses'
     explanations, so a detection says how its names were resolved)."""
     vocab = grounder.instances([(o.name, o.category) for o in graph.objects])
-    names = sorted(o.name for o in graph.objects)
+    names = sorted({o.name for o in graph.objects} | {o.category for o in graph.objects})
+    class_ids = sorted(grounder.kb.hazard_classes)
     notes = notes if notes is not None else []
 
     def ground(model):
@@ -65,8 +66,13 @@ def reply_schema(graph: SceneGraph, grounder, k: int, notes: list[str] | None = 
         __validators__={"ground": model_validator(mode="after")(ground)},
         problem=(str, Field(min_length=3, max_length=400, description="what is wrong and who could be hurt")),
         solution=(str, Field(min_length=3, max_length=400, description="what the robot should do about it")),
-        target_object=(str, Field(description="name of the scene object at fault, as written in the observation")),
-        hazard_class=(str | None, Field(None, description="id of the matching hazard class, or null")),
+        # The names stay in the JSON schema as enums, so a backend with grammar-constrained decoding
+        # (llama.cpp) still writes an exact name; servers that ignore them get grounded instead.
+        target_object=(str, Field(description="name of the scene object at fault, as written in the observation",
+                                  json_schema_extra={"enum": names})),
+        hazard_class=(str | None, Field(None, description="id of the matching hazard class, or null",
+                                        json_schema_extra=lambda js: js.update(anyOf=[{"type": "string", "enum": class_ids},
+                                                                                      {"type": "null"}]))),
     )
     return create_model(
         "SceneHazards",

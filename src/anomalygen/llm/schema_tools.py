@@ -102,13 +102,14 @@ TOKENS_PER_LIST_FIELD = 48
 TEXT_FIELD_HINTS = ("sentence", "why", "situation", "explanation", "description", "how", "words")
 
 
-def reply_token_budget(schema: type[BaseModel], *, floor: int = 128) -> int:
+def reply_token_budget(schema: type[BaseModel], *, floor: int = 128, cap: int | None = None) -> int:
     """``max_tokens`` for one reply of ``schema``, sized from its fields rather than one global value.
 
     Why: a fixed budget either truncates a long object (the reply is then invalid JSON) or, when
     several objects are asked for at once, hides how many were cut off. Free-text fields (named like
     description or documented as sentences) get a paragraph's worth, names a few words, lists a few
-    names; 25 % on top covers JSON syntax and the field names.
+    names; 25 % on top covers JSON syntax and the field names. ``cap`` (the configured
+    ``llm.max_tokens``) stays an upper bound the user can set.
     """
     total = 0
     for name, info in schema.model_fields.items():
@@ -120,4 +121,5 @@ def reply_token_budget(schema: type[BaseModel], *, floor: int = 128) -> int:
             total += TOKENS_PER_TEXT_FIELD
         else:
             total += TOKENS_PER_NAME_FIELD
-    return max(floor, int(total * 1.25))
+    budget = max(floor, int(total * 1.25))
+    return budget if cap is None else min(budget, int(cap))

@@ -96,6 +96,8 @@ class LLMSceneEngine:
         self.client = client
         self.kb = kb
         self.g = grounder or NameGrounder(kb)
+        #: The configured ``llm.max_tokens`` bounds the schema-sized budgets.
+        self.token_cap = int(getattr(getattr(client, "config", None), "max_tokens", None) or 4096)
 
     def plan(self, task: TaskProposal) -> SceneHints:
         hints = SceneHints(model=getattr(self.client, "model", None))
@@ -114,7 +116,7 @@ class LLMSceneEngine:
         reply = self.client.complete(
             [{"role": "system", "content": SYSTEM}, {"role": "user", "content": ask}],
             schema=LLMAuxiliaries,
-            max_tokens=reply_token_budget(LLMAuxiliaries) + 64 * MAX_AUXILIARIES,
+            max_tokens=min(reply_token_budget(LLMAuxiliaries) + 64 * MAX_AUXILIARIES, self.token_cap),
         )
         out: list[str] = []
         for aux in reply.objects[:MAX_AUXILIARIES]:
@@ -143,7 +145,7 @@ class LLMSceneEngine:
         reply = self.client.complete(
             [{"role": "system", "content": SYSTEM}, {"role": "user", "content": ask}],
             schema=LLMLayout,
-            max_tokens=reply_token_budget(LLMObjectLayout) * (len(objects) + len(hints.auxiliaries)),
+            max_tokens=min(reply_token_budget(LLMObjectLayout) * (len(objects) + len(hints.auxiliaries)), self.token_cap),
         )
         wanted = objects + hints.auxiliaries
         seen: set[str] = set()
