@@ -10,27 +10,13 @@ class becomes ``other`` with the model's own words kept.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import TYPE_CHECKING
 
 from anomalygen.knowledge.grounding import NameGrounder
 from anomalygen.schema import GroundingMatch
 
-
-class LooseProposal(Protocol):
-    """The free-form fields an LLM proposal carries (``llm_engine.LLMProposal``)."""
-
-    name: str
-    description: str
-    explanation: str
-    hazard_class: str
-    hazard_other: str | None
-    category: object
-    target_asset: str
-    hazard_object: str
-    room: str
-    placement: str
-    container: str | None
-    co_objects: list[str]
+if TYPE_CHECKING:
+    from anomalygen.brainstorm.llm_engine import LLMProposal
 
 
 @dataclass
@@ -52,7 +38,7 @@ def _closest(m: GroundingMatch) -> str:
     return f" (closest: {', '.join(shown)})" if shown else ""
 
 
-def ground_llm_names(raw: LooseProposal, g: NameGrounder) -> GroundedNames:
+def ground_llm_names(raw: LLMProposal, g: NameGrounder) -> GroundedNames:
     """Every name of ``raw`` grounded; unresolved ones keep their written form and add a problem."""
     kb = g.kb
     matches: list[GroundingMatch] = []
