@@ -2,10 +2,13 @@
 
 Round 1: each agent is given a random target asset and proposes scenarios around it from its role's
 point of view. Round r >= 2: each agent is shown every *other* agent's round r-1 proposals, told it
-is in a collaborative session, and asked to build on them (citing what it builds on). Replies are
-structured (``AgentReply``), validated against the catalogue and the knowledge base; a reply naming
-unknown objects goes back to the model with the problems listed. A failure costs one agent-round,
-never the batch.
+is in a collaborative session, and asked to build on them (citing what it builds on).
+
+Each request asks for one proposal (``LLMProposal``), with ``max_tokens`` sized from that schema:
+several proposals per reply truncated on real models. Every name in a reply is grounded first
+(``knowledge/grounding.py``: spelling, aliases, Sentence-BERT retrieval), and only what even retrieval
+cannot place goes back to the model with the problems listed. A failure costs one proposal, never the
+batch.
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ from anomalygen.brainstorm.idea import ASPECTS, task_id
 from anomalygen.brainstorm.knowledge_engine import agent_roles, split_quota
 from anomalygen.brainstorm.validate import proposal_problems
 from anomalygen.knowledge import PLACEMENTS, ROOMS, KnowledgeBase, load_kb
-from anomalygen.knowledge.grounding import NameGrounder
+from anomalygen.knowledge.grounding import NameGrounder, shared_grounder
 from anomalygen.llm.schema_tools import reply_token_budget
 from anomalygen.rng import item_rng
 from anomalygen.schema import (
@@ -115,6 +118,7 @@ class LLMEngine:
             agents=cfg.agents,
             rounds=cfg.rounds,
             repair_retries=settings.llm.repair_retries,
+            grounder=shared_grounder(),
         )
 
     # ------------------------------------------------------------------ run
