@@ -146,6 +146,22 @@ class Scenario(Strict):
     co_objects: list[str] = Field(default_factory=list, description="other catalogue objects in the story")
 
 
+class GroundingMatch(Strict):
+    """How one name an LLM (or a user's free text) wrote was resolved to a knowledge-base name.
+
+    Kept in the artefact so a reader can audit every loose name: what was written, what it became,
+    by which step (exact, normalised spelling, alias, Sentence-BERT retrieval, a class default, or
+    dropped) and how similar the retrieved match was (1.0 for the deterministic steps).
+    """
+
+    field: str = Field(description="where the name was written, e.g. 'scenario.container'")
+    written: str
+    grounded: str | None = Field(None, description="the knowledge-base name; None when the name was dropped")
+    method: Literal["exact", "normalised", "alias", "retrieval", "class_default", "other", "dropped"]
+    similarity: float = 1.0
+    alternatives: list[str] = Field(default_factory=list, description="the next retrieval candidates, best first")
+
+
 class TaskProposal(Artefact):
     """One anomaly scenario (the paper's task format plus the grounding our later stages need)."""
 
@@ -163,6 +179,7 @@ class TaskProposal(Artefact):
     solution: str = Field("", description="how the hazard is resolved, in words")
     success_condition: str = Field("", description="the safe end state, in words")
     provenance: Provenance
+    grounding: list[GroundingMatch] = Field(default_factory=list, description="loose names resolved to catalogue names")
 
 
 # --------------------------------------------------------------------------- stage 2: scenes
@@ -391,10 +408,11 @@ class LLMUsage(Strict):
     cache_hits: int = 0
     cache_misses: int = 0
     retries: int = 0
+    truncated: int = Field(0, description="replies that used the whole max_tokens budget (likely cut off)")
     cost_usd: float | None = None
 
     def add(self, other: LLMUsage) -> None:
-        for field in ("requests", "prompt_tokens", "completion_tokens", "cache_hits", "cache_misses", "retries"):
+        for field in ("requests", "prompt_tokens", "completion_tokens", "cache_hits", "cache_misses", "retries", "truncated"):
             setattr(self, field, getattr(self, field) + getattr(other, field))
         if other.cost_usd is not None:
             self.cost_usd = (self.cost_usd or 0.0) + other.cost_usd

@@ -30,7 +30,8 @@ class Miss(Strict):
 
 
 class DetectionReport(Artefact):
-    detector: str
+    detector: str = Field(description="the one detector of every scene, or 'mixed (...)' with counts")
+    detectors: dict[str, int] = Field(default_factory=dict, description="detector -> scenes it produced")
     k: int
     scenes: int
     errors: int = 0
@@ -41,6 +42,14 @@ class DetectionReport(Artefact):
     misses: list[Miss]
     judge_methods: dict[str, int] = Field(default_factory=dict, description="how the first hits were judged")
     missing_scenes: list[str] = Field(default_factory=list, description="tasks without a detection record")
+
+
+def detector_label(counts: dict[str, int]) -> str:
+    """'rules', 'llm', or 'mixed (llm 6, rules 14)': a run that fell back on another detector for some
+    scenes is never labelled by the one it only partly used."""
+    if len(counts) == 1:
+        return next(iter(counts))
+    return "mixed (" + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) + ")" if counts else "none"
 
 
 def _rates(dets: Sequence[Detection], k: int) -> HitRates:
@@ -80,8 +89,10 @@ def summarise(detections: Sequence[Detection], tasks: Sequence[TaskProposal], k:
                     reason=reason,
                 )
             )
+    used = Counter(d.detector for d in dets)
     return DetectionReport(
-        detector=dets[0].detector if dets else "rules",
+        detector=detector_label(used),
+        detectors=dict(sorted(used.items())),
         k=k,
         scenes=len(dets),
         errors=sum(1 for d in dets if d.error),

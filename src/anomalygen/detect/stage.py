@@ -84,7 +84,8 @@ def detect_scene(task: TaskProposal, graph: SceneGraph, spec: SceneSpec | None, 
     return Detection(
         task_id=task.id,
         scene_id=graph.scene_id,
-        detector=settings.detect.detector,
+        # A hybrid that fell back on the rule order produced a rule detection: say so per scene.
+        detector="rules" if getattr(detector, "fell_back", None) else settings.detect.detector,
         hypotheses=hyps,
         judgements=judgements,
         hit_rank=hit,

@@ -42,6 +42,14 @@ class DetectionSummary(Strict):
     hit_at_k: dict[int, float] = Field(description="k -> fraction of scenes whose first hit has rank <= k")
     errors: int = 0
     by_category: dict[str, dict[int, float]] = Field(default_factory=dict)
+    detectors: dict[str, int] = Field(default_factory=dict, description="detector -> scenes it produced")
+    by_detector: dict[str, dict[int, float]] = Field(default_factory=dict, description="detector -> hit@k of its scenes")
+
+    @property
+    def detector_label(self) -> str:
+        from anomalygen.detect.report import detector_label
+
+        return detector_label(self.detectors)
 
 
 class SuccessSummary(Strict):
@@ -54,10 +62,22 @@ class SuccessSummary(Strict):
     errors: int = 0
 
 
+class AblationRow(Strict):
+    """Our measured diversity of one (engine, brainstorm mode) group of this run's proposals."""
+
+    engine: str
+    mode: str
+    tasks: int
+    self_bleu: float | None = None
+    sbert: float | None = None
+    wmd: float | None = None
+
+
 class Evaluation(Artefact):
     run: str
     tasks: int
     diversity: list[DiversityRow] = Field(default_factory=list)
+    ablation: list[AblationRow] = Field(default_factory=list, description="measured diversity per engine and mode")
     categories: dict[str, int] = Field(default_factory=dict)
     classes: dict[str, int] = Field(default_factory=dict)
     target_assets: dict[str, int] = Field(default_factory=dict)

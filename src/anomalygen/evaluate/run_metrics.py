@@ -39,14 +39,18 @@ def detection_summary(detections: Sequence[Detection], tasks: Sequence[TaskPropo
     k = max([k, *(len(d.hypotheses) for d in detections)]) if detections else k
     category = {t.id: str(t.category) for t in tasks}
     groups: dict[str, list[Detection]] = {}
+    by_detector: dict[str, list[Detection]] = {}
     for d in detections:
         groups.setdefault(category.get(d.task_id, "unknown"), []).append(d)
+        by_detector.setdefault(d.detector, []).append(d)
     return DetectionSummary(
         scenes=len(detections),
         k=k,
         hit_at_k=hit_at_k(detections, k),
         errors=sum(1 for d in detections if d.error),
         by_category={c: hit_at_k(ds, k) for c, ds in sorted(groups.items())},
+        detectors={name: len(ds) for name, ds in sorted(by_detector.items())},
+        by_detector={name: hit_at_k(ds, k) for name, ds in sorted(by_detector.items())},
     )
 
 

@@ -192,27 +192,32 @@ def _cavity_cap(asset) -> float:
     return 0.8 * 2 * float(min(cav.half_extents))
 
 
-def _clutter_names(kb, exclude: set[str], rng, n: int) -> list[str]:
+def is_dressing(kb, name: str) -> bool:
+    """Can ``name`` dress a scene as clutter? Small household things with no hazard property, so a
+    decoration never becomes a second hazard (also the filter for the LLM engine's auxiliaries)."""
     from anomalygen.knowledge.models import HAZARD_PROPERTIES
 
-    names = []
-    for name in select._catalogue():
-        info = kb.objects.get(name)
-        if info is None or info.kind != "household" or name in exclude:
-            continue
-        if set(info.properties) & (HAZARD_PROPERTIES | {"furniture", "appliance"}):
-            continue
-        if info.size_range[0] > CLUTTER_MAX_SIZE:
-            continue
-        names.append(name)
+    info = kb.objects.get(name)
+    if info is None or info.kind != "household":
+        return False
+    if set(info.properties) & (HAZARD_PROPERTIES | {"furniture", "appliance"}):
+        return False
+    return info.size_range[0] <= CLUTTER_MAX_SIZE
+
+
+def _clutter_names(kb, exclude: set[str], rng, n: int) -> list[str]:
+    names = [name for name in select._catalogue() if name not in exclude and is_dressing(kb, name)]
     if not names or n <= 0:
         return []
     idx = rng.choice(len(names), size=min(n, len(names)), replace=False)
     return [names[i] for i in sorted(idx)]
 
 
-def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], dict[str, Placed]]:
-    """Choose and place every object; returns the layout, bindings and instances by role variable."""
+def _plan(task: TaskProposal, settings, rng, hints=None) -> tuple[Layout, dict[str, str], dict[str, Placed]]:
+    """Choose and place every object; returns the layout, bindings and instances by role variable.
+
+    ``hints`` (scene/hints.py, from the LLM engine) supply sizes, floor positions and the auxiliary
+    objects instead of the random draws; every correction is noted in them or in the layout."""
     kb = _kb()
     hc = kb.hazard_classes.get(task.hazard_class)
     sc = task.scenario
@@ -224,7 +229,11 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
         cat = select.resolve_name(raw)
         if cat in by_catalogue:
             return by_catalogue[cat]
-        asset = select.pick_asset(cat, role=role, kb=kb, task=task, hc=hc, rng=rng, cap=cap, rank=rank)
+        want = hints.size_for(cat) if hints is not None else None
+        asset = select.pick_asset(cat, role=role, kb=kb, task=task, hc=hc, rng=rng, cap=cap, rank=rank, size=want)
+        if want is not None and abs(asset.size - want) > 1e-3:
+            hints.note(f"size:{cat}", f"size {want:.3f} m does not fit the generator's range or the space "
+                       f"available; built at {asset.size:.3f} m", value=want, limit=round(float(asset.size), 4))
         ch = select.Chosen(_instance_name(cat, used), cat, role, asset)
         by_catalogue[cat] = ch
         return ch
@@ -327,6 +336,11 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
 
     # ------------------------------------------------------------------ placement
     lay = Layout(rng, relevant_in_cube=settings.build.relevant_in_unit_cube)
+    if hints is not None:
+        for ch in by_catalogue.values():
+            xy = hints.world_xy(ch.catalogue)
+            if xy is not None:
+                lay.preferred[ch.name] = xy
     placed: dict[str, Placed] = {}
     support: Placed | None = None
     if support_kind is not None:
@@ -343,9 +357,15 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
         lay.place_on_floor(support, relevant=True, face=True)
         placed[support.name] = support
     side: Placed | None = None
-    clutter = _clutter_names(kb, set(by_catalogue), rng, settings.build.clutter)
+    if hints is not None:  # the LLM's auxiliaries dress the scene instead of random clutter
+        clutter = [a for a in hints.auxiliaries if a not in by_catalogue]
+    else:
+        clutter = _clutter_names(kb, set(by_catalogue), rng, settings.build.clutter)
     if clutter:
         side = _support_placed("table", _instance_name("Table", used), rng)
+        spots = [xy for xy in (hints.world_xy(a) for a in clutter) if xy is not None] if hints is not None else []
+        if spots:  # the auxiliaries stand where the LLM put them, on a side table outside the cube
+            lay.preferred[side.name] = np.mean(spots, axis=0)
         lay.place_on_floor(side, relevant=False, face=True)
         placed[side.name] = side
 
@@ -404,12 +424,15 @@ def _plan(task: TaskProposal, settings, rng) -> tuple[Layout, dict[str, str], di
     # Clutter on the side table, away from its edges; an item that does not fit is left out.
     if side is not None:
         for cat in clutter:
-            asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=kb, task=task, hc=None, rng=rng)
+            want = hints.size_for(cat) if hints is not None else None
+            asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=kb, task=task, hc=None, rng=rng, size=want)
             ch = select.Chosen(_instance_name(cat, used), cat, ObjectRole.CLUTTER, asset)
             p = _placed(ch)
             try:
                 lay.place_on_surface(p, side, _surface_of(side), inward=0.13)
             except ItemFailed:
+                if hints is not None:
+                    hints.note(f"auxiliary:{cat}", "did not fit on the side table; left out")
                 continue
             placed[p.name] = p
 
@@ -684,14 +707,16 @@ def _set_joints(model, data, placed: dict[str, Placed]) -> None:
 # ============================================================================ attempt
 
 
-def _attempt(task: TaskProposal, seed: int, settings, attempt: int) -> Built:
+def _attempt(task: TaskProposal, seed: int, settings, attempt: int, hints=None) -> Built:
     import mujoco
 
     from anomalygen.scene import validate as val
     from anomalygen.scene.graph import scene_graph
 
     rng = item_rng(seed, task.id, attempt)
-    lay, bindings, placed = _plan(task, settings, rng)
+    hints = hints.model_copy(deep=True) if hints is not None else None  # each attempt records its own
+    lay, bindings, placed = _plan(task, settings, rng, hints)
+    notes = _hint_notes(hints, lay)
     mjspec = _compose(lay, placed, settings, rng)
     model = mjspec.compile()
     data = mujoco.MjData(model)
@@ -703,7 +728,7 @@ def _attempt(task: TaskProposal, seed: int, settings, attempt: int) -> Built:
     spec = _scene_spec(task, seed, lay, placed, bindings, model, data)
     overlap = val.initial_overlap(model, data, spec)
     if overlap is not None:
-        report = ValidationReport(ok=False, reason=overlap, checks=[])
+        report = ValidationReport(ok=False, reason=overlap, checks=notes)
         return Built(spec, mjspec, model, data, report, None)
     nsteps = max(1, int(round(settings.build.settle_s / model.opt.timestep)))
     mujoco.mj_step(model, data, nstep=nsteps)
@@ -714,7 +739,22 @@ def _attempt(task: TaskProposal, seed: int, settings, attempt: int) -> Built:
     graph = scene_graph(model, data, spec)
     hc = _kb().hazard_classes.get(task.hazard_class)
     report = val.validate(model, data, spec, graph, hc)
+    report.checks = notes + report.checks
     return Built(spec, mjspec, model, data, report, graph)
+
+
+def _hint_notes(hints, lay: Layout) -> list[ValidationCheck]:
+    """Every correction to an engine's sizes and positions, for the validation report (none offline)."""
+    if hints is None:
+        return []
+    done = {c.name for c in lay.corrections}
+    notes = list(hints.checks) + list(lay.corrections)
+    notes += [
+        ValidationCheck(name=f"position:{name}", passed=True, detail="placed by its scenario placement (on or in "
+                        "another object), not at the proposed floor spot")
+        for name in lay.preferred if f"position:{name}" not in done
+    ]
+    return notes
 
 
 def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, model, data) -> SceneSpec:
@@ -778,14 +818,16 @@ def scene_id_for(task_id: str) -> str:
 # ============================================================================ public entry
 
 
-def build_scene(task: TaskProposal, *, seed: int, settings, out_dir: Path) -> SceneSpec:
-    """Build, settle, validate, repair and write one scene; raises ItemFailed with a one-line reason."""
+def build_scene(task: TaskProposal, *, seed: int, settings, out_dir: Path, hints=None) -> SceneSpec:
+    """Build, settle, validate, repair and write one scene; raises ItemFailed with a one-line reason.
+
+    ``hints`` come from a non-default scene engine (``scene/llm_engine.py``); None keeps the draws."""
     attempts = settings.build.repair_attempts + 1
     reason = "no attempt made"
     built = None
     for attempt in range(attempts):
         try:
-            built = _attempt(task, seed, settings, attempt)
+            built = _attempt(task, seed, settings, attempt, hints)
         except ItemFailed as exc:
             reason = str(exc)
             log.debug("%s attempt %d: %s", task.id, attempt, reason)
