@@ -8,7 +8,6 @@ import detect_graphs as g
 import pytest
 
 
-
 @pytest.mark.slow
 @pytest.mark.gguf
 def test_llm_detector_runs_on_the_bundled_gguf(tmp_path, kb):

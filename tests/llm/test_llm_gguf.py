@@ -10,7 +10,6 @@ from typer.testing import CliRunner
 from anomalygen.schema import TaskProposal
 
 
-
 @pytest.mark.slow
 @pytest.mark.gguf
 def test_llamacpp_cli_ask_returns_schema_valid_task_proposal(tmp_path, monkeypatch):

@@ -14,8 +14,8 @@ import math
 from pathlib import Path
 
 from anomalygen.runfolder import try_read_model
-from anomalygen.schema import FixOutcome, HazardManifest, HazardOutcome, SceneGraph
 from anomalygen.scene.truth import TRUTH_FILE, class_matches
+from anomalygen.schema import FixOutcome, HazardManifest, HazardOutcome, SceneGraph
 
 MOVED_M = 0.05  # a near-miss object displaced further than this was acted on
 TURNED = 0.1  # a near-miss joint (rad or m) moved further than this was acted on
