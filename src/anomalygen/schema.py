@@ -253,6 +253,39 @@ class SceneSpec(Artefact):
     files: dict[str, str] = Field(default_factory=dict, description="logical name -> path relative to the scene folder")
 
 
+class ManifestHazard(Strict):
+    """A hazard the builder put in the scene, bound to instances (the answer key for one hazard)."""
+
+    hazard_class: str
+    object: str = Field(description="instance name of the object at fault")
+    category: str
+    severity: float = Field(ge=0, le=1)
+    variable: str = Field(description="the class variable bound to the object at fault, e.g. $hazard")
+    bindings: dict[str, str] = Field(default_factory=dict, description="the builder's role bindings")
+    success: list[PredicateCall] = Field(
+        default_factory=list,
+        description="the class's success predicates over the object at fault ('*' where the fix may choose, e.g. any container)",
+    )
+
+
+class NearMiss(Strict):
+    """A hazard-class object the builder placed in a safe state (acting on it is unnecessary)."""
+
+    object: str
+    category: str
+    looks_like: str = Field(description="the hazard class it resembles")
+    why_safe: str
+
+
+class HazardManifest(Artefact):
+    """``scenes/<task>/truth.json``: every hazard in the scene. Hidden from detect, plan and learn."""
+
+    scene_id: str
+    task_id: str
+    hazards: list[ManifestHazard] = Field(default_factory=list)
+    near_misses: list[NearMiss] = Field(default_factory=list)
+
+
 class GraphObject(Strict):
     """What the robot perceives of one object. Never carries task or hazard names."""
 
@@ -378,15 +411,38 @@ class SubTaskResult(Strict):
     attempts: int = Field(1, ge=1, description="executions of the sub-task: retried when its check failed")
 
 
+class HazardOutcome(Strict):
+    """One manifest hazard after execution, as the referee judged it on the final scene graph."""
+
+    hazard_class: str
+    object: str
+    resolved: bool
+    detail: str = ""
+
+
+class FixOutcome(Strict):
+    """The hidden-truth verdict on one execution (written by the referee, never read by the robot)."""
+
+    hazards: list[HazardOutcome] = Field(default_factory=list)
+    resolved: bool = Field(description="every manifest hazard is resolved (a hazard-free scene: True)")
+    new_hazards: list[str] = Field(
+        default_factory=list, description="'class on object' hazards present at the end and not at the start"
+    )
+    interventions_on_safe: list[str] = Field(
+        default_factory=list, description="near-miss objects the robot moved or whose parts it moved"
+    )
+
+
 class SkillResult(Artefact):
     task_id: str
     seed: int
-    success: bool
+    success: bool = Field(description="the plan's own final condition held (what the robot believes)")
     subtasks: list[SubTaskResult] = Field(default_factory=list)
     final_predicates: list[PredicateResult] = Field(default_factory=list)
     video: str | None = None
     timings: dict[str, float] = Field(default_factory=dict)
     error: str | None = None
+    outcome: FixOutcome | None = Field(None, description="the referee's verdict against truth.json; None without one")
 
 
 # --------------------------------------------------------------------------- run bookkeeping
@@ -447,6 +503,7 @@ ARTEFACTS: dict[str, type[BaseModel]] = {
         PlacedObject,
         JointState,
         SceneSpec,
+        HazardManifest,
         SceneGraph,
         Hypothesis,
         Detection,

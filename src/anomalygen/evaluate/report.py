@@ -233,11 +233,24 @@ def render_html(report: Report, run: RunFolder) -> str:
         ks = sorted(d.hit_at_k)
         by_cat = _table(["category", *[f"hit@{k}" for k in ks]],
                         [[c, *[_f(v.get(k), 2) for k in ks]] for c, v in d.by_category.items()])
+        scored = ""
+        if d.scores is not None:
+            sc = d.scores
+            alarms = "no hazard-free scenes" if sc.false_alarm_rate is None else (
+                f"{_f(sc.false_alarm_rate, 2)} over {sc.hazard_free_scenes} hazard-free scenes")
+            scored = _table(
+                ["against the hidden truth", "value"],
+                [["hazards found (recall)", f"{sc.found}/{sc.hazards} ({_f(sc.recall, 2)})"],
+                 ["claims that were right (precision)", f"{sc.true_claims}/{sc.claims} ({_f(sc.precision, 2)})"],
+                 ["F1", _f(sc.f1, 2)],
+                 ["false alarms", alarms],
+                 *[[f"hit@{j} on {sc.single_hazard_scenes} single-hazard scenes", _f(v, 2)]
+                   for j, v in sorted(sc.hit_at_k.items())]])
         headers, rows, classes = detection_rows(d)
         by_detector = _table(headers, rows, classes)
         body = (f'<div class="plots">{_img(plots.hit_at_k_plot(d.hit_at_k), "hit at k")}<div>'
                 f"<p>{d.scenes} scenes, detector: {_e(d.detector_label)}, {d.errors} detector errors.</p>"
-                f"{by_detector}{by_cat}</div></div>")
+                f"{scored}{by_detector}{by_cat}</div></div>")
         parts.append(_section("detection", "Detection hit@k", body))
     else:
         parts.append(_section("detection", "Detection hit@k", _not_run("detect")))
@@ -246,12 +259,22 @@ def render_html(report: Report, run: RunFolder) -> str:
     if ev.success:
         s = ev.success
         bars = _img(plots.success_bars({k: (v.successes, v.n) for k, v in s.by_category.items()}), "success by category")
-        cls_rows = [[k, v.successes, v.n, _f(v.rate, 2)] for k, v in s.by_class.items()]
+        def truth(k: str) -> str:
+            r = s.resolved_by_class.get(k)
+            return f"{r.successes}/{r.n} ({_f(r.rate, 2)})" if r and r.n else "no truth"
+
+        cls_rows = [[k, v.n, f"{v.successes} ({_f(v.rate, 2)})", truth(k)] for k, v in s.by_class.items()]
         meth_rows = [[k, v.successes, v.n, _f(v.rate, 2)] for k, v in s.by_method.items()]
-        body = (f'<div class="plots">{bars}<div>{_table(["hazard class", "successes", "runs", "rate"], cls_rows)}'
+        headers = ["hazard class", "runs", "robot: plan done", "truth: hazard resolved"]
+        resolved = (f"{s.resolved.successes}/{s.resolved.n} ({_f(s.resolved.rate, 2)})" if s.resolved.n
+                    else "not judged (no truth.json)")
+        body = (f'<div class="plots">{bars}<div>{_table(headers, cls_rows)}'
                 f'{_table(["sub-task method", "successes", "runs", "rate"], meth_rows)}</div></div>'
-                f"<p>Overall: {s.overall.successes}/{s.overall.n} ({_f(s.overall.rate, 2)}) over {s.tasks} tasks; "
-                f"{s.errors} runs ended with an error. Paper: 83% (human-judged).</p>")
+                f"<p>Hazards resolved, judged against the builder's hidden truth on every class: <b>{resolved}</b>. "
+                f"The robot's own verdict (its plan's final condition held): {s.overall.successes}/{s.overall.n} "
+                f"({_f(s.overall.rate, 2)}) over {s.tasks} tasks. Runs that created a new hazard: {s.new_hazards}; "
+                f"runs that acted on an already-safe object: {s.on_safe}; {s.errors} runs ended with an error. "
+                "Paper: 83% (human-judged).</p>")
         parts.append(_section("success", "Resolution success", body))
     else:
         parts.append(_section("success", "Resolution success", _not_run("learn")))

@@ -10,6 +10,7 @@ from typing import Literal
 
 from pydantic import Field
 
+from anomalygen.detect.score import DetectionScores
 from anomalygen.schema import Artefact, LLMUsage, StageRecord, Strict
 
 
@@ -50,6 +51,7 @@ class DetectionSummary(Strict):
         from anomalygen.detect.report import detector_label
 
         return detector_label(self.detectors)
+    scores: DetectionScores | None = Field(None, description="per-hazard scores against truth.json")
 
 
 class SuccessSummary(Strict):
@@ -60,6 +62,10 @@ class SuccessSummary(Strict):
     by_class: dict[str, Rate] = Field(default_factory=dict)
     by_method: dict[str, Rate] = Field(default_factory=dict, description="sub-task success per skill method")
     errors: int = 0
+    resolved: Rate = Field(default_factory=Rate, description="runs whose every truth-manifest hazard was fixed")
+    resolved_by_class: dict[str, Rate] = Field(default_factory=dict)
+    new_hazards: int = Field(0, description="runs that left a hazard the scene did not have at the start")
+    on_safe: int = Field(0, description="runs that acted on a near-miss (an object that was already safe)")
 
 
 class AblationRow(Strict):

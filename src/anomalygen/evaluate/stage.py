@@ -73,7 +73,8 @@ def evaluate_run(run: RunFolder, settings) -> Evaluation:
         target_assets=rm.distribution(t.target_asset for t in tasks),
         scenes_built=sum(1 for s in scenes if s.validation is None or s.validation.ok),
         scenes_failed=len(run.errors("build")),
-        detection=rm.detection_summary(detections, tasks, settings.detect.k) if detections else None,
+        detection=(rm.detection_summary(detections, tasks, settings.detect.k, rm.load_manifests(run, tasks))
+                   if detections else None),
         success=rm.success_summary(results, tasks) if results else None,
         timings=dict(manifest.stages),
         llm_usage=manifest.llm_usage,

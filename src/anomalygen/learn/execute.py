@@ -141,7 +141,7 @@ def _evaluate(calls, model, data, spec, bindings) -> list[PredicateResult]:
 
 def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: str | Path | None = None,
                  max_wall_s: float = 600.0, sac_steps: int = 0, isolate: bool = True,
-                 retries: int = 1) -> SkillResult:
+                 retries: int = 1, final_graph_path: str | Path | None = None) -> SkillResult:
     """Load the scene, run the plan's sub-tasks in order, check success, optionally record a video.
 
     Execution is closed-loop: a primitive sub-task whose success check fails on the scene right after
@@ -153,6 +153,9 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
     process-global and seeded once, so a path planned in a process that has planned before depends on
     that history. In a fresh process the first seed is the item's, and the result is a function of
     (scene, plan, seed) alone, whichever worker or test runs it. Costs about a second.
+
+    ``final_graph_path`` receives the scene graph of the final, settled state: what the referee
+    judges against the hidden truth (the robot's own verdict is ``success``).
     """
     if isolate:
         from concurrent.futures import ProcessPoolExecutor
@@ -160,12 +163,13 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
 
         with ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn")) as pool:
             return pool.submit(_execute_here, str(scene_dir), plan, seed, None if video_path is None else
-                               str(video_path), max_wall_s, sac_steps, retries).result()
-    return _execute_here(scene_dir, plan, seed, video_path, max_wall_s, sac_steps, retries)
+                               str(video_path), max_wall_s, sac_steps, retries,
+                               None if final_graph_path is None else str(final_graph_path)).result()
+    return _execute_here(scene_dir, plan, seed, video_path, max_wall_s, sac_steps, retries, final_graph_path)
 
 
 def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float, sac_steps: int,
-                  retries: int = 1) -> SkillResult:
+                  retries: int = 1, final_graph_path=None) -> SkillResult:
     from anomalygen.learn.primitives import Driver
     from anomalygen.rng import item_rng
     from anomalygen.scene.graph import load_scene
@@ -215,6 +219,11 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
                                      attempts=attempt))
     drv.settle(25)
     final = _evaluate(plan.success.predicates, model, data, spec, plan.bindings)
+    if final_graph_path is not None:
+        from anomalygen.runfolder import write_model
+        from anomalygen.scene.graph import scene_graph
+
+        write_model(Path(final_graph_path), scene_graph(model, data, spec))
     timings["execute_s"] = round(time.perf_counter() - t0 - timings["load_s"], 3)
     timings["control_steps"] = float(drv.steps)
     video = None

@@ -846,7 +846,7 @@ def build_scene(task: TaskProposal, *, seed: int, settings, out_dir: Path, hints
         built = None
     if built is None:
         raise ItemFailed(f"no valid scene after {attempts} attempt(s): {reason}")
-    return write_outputs(built, settings, Path(out_dir))
+    return write_outputs(built, settings, Path(out_dir), hazard_class=task.hazard_class)
 
 
 def _vlm_check(task, built: Built, settings) -> None:
@@ -861,8 +861,10 @@ def _vlm_check(task, built: Built, settings) -> None:
     )
 
 
-def write_outputs(built: Built, settings, out_dir: Path) -> SceneSpec:
+def write_outputs(built: Built, settings, out_dir: Path, *, hazard_class: str | None = None) -> SceneSpec:
+    """scene.xml, renders, scene_graph.json, the hidden truth.json (with ``hazard_class``), scene.json last."""
     from anomalygen.scene.render import SceneRenderer, png_bytes
+    from anomalygen.scene.truth import TRUTH_FILE, hazard_manifest
 
     out_dir.mkdir(parents=True, exist_ok=True)
     model, data, mjspec = built.model, built.data, built.mjspec
@@ -881,6 +883,8 @@ def write_outputs(built: Built, settings, out_dir: Path) -> SceneSpec:
             files[f"render_{cam}"] = f"render_{cam}.png"
     spec = built.spec.model_copy(update={"validation": built.report, "files": files})
     write_model(out_dir / "scene_graph.json", built.graph)
+    if hazard_class is not None:
+        write_model(out_dir / TRUTH_FILE, hazard_manifest(spec, hazard_class, built.graph, _kb()))
     write_model(out_dir / "scene.json", spec)  # last: its presence marks the scene done
     return spec
 
