@@ -122,6 +122,7 @@ def brainstorm(
     agents: Annotated[int | None, typer.Option(help="Number of role-playing agents.")] = None,
     rounds: Annotated[int | None, typer.Option(help="Brainstorming rounds.")] = None,
     tasks: Annotated[Path | None, typer.Option("--tasks", help="Bring your own tasks.jsonl instead.")] = None,
+    tasks_text: Annotated[Path | None, typer.Option("--tasks-text", help="Plain descriptions, one per line, grounded into tasks.")] = None,
     config: ConfigOpt = None,
     seed: SeedOpt = None,
     force: ForceOpt = False,
@@ -135,7 +136,8 @@ def brainstorm(
     settings = _common(
         config, seed, quiet, backend=backend, model=model, no_cache=no_cache,
         **{"brainstorm.engine": engine, "brainstorm.mode": mode, "brainstorm.n": n, "brainstorm.agents": agents,
-           "brainstorm.rounds": rounds, "brainstorm.tasks_file": str(tasks) if tasks else None},
+           "brainstorm.rounds": rounds, "brainstorm.tasks_file": str(tasks) if tasks else None,
+           "brainstorm.tasks_text": str(tasks_text) if tasks_text else None},
     )
     _finish(_run_stage("brainstorm", _open_run(run, create=True, settings=settings), settings, force=force), as_json)
 
@@ -146,6 +148,7 @@ def build(
     only: OnlyOpt = None,
     workers: WorkersOpt = None,
     clutter: Annotated[int | None, typer.Option(help="Unrelated objects added per scene.")] = None,
+    engine: Annotated[str | None, typer.Option(help="Scene engine: knowledge (default) or llm.")] = None,
     config: ConfigOpt = None,
     seed: SeedOpt = None,
     force: ForceOpt = False,
@@ -153,9 +156,12 @@ def build(
     as_json: JsonOpt = False,
     executor: ExecutorOpt = None,
     address: AddressOpt = None,
+    backend: BackendOpt = None,
+    model: ModelOpt = None,
 ):
     """Stage 2: build each task as a validated MuJoCo scene (writes scenes/<task_id>/)."""
-    settings = _common(config, seed, quiet, workers, executor, address, **{"build.clutter": clutter})
+    settings = _common(config, seed, quiet, workers, executor, address, backend=backend, model=model,
+                       **{"build.clutter": clutter, "build.engine": engine})
     folder = _open_run(run)
     _finish(_run_stage("build", folder, settings, force=force, only=only), as_json)
 

@@ -56,6 +56,7 @@ class BrainstormConfig(Section):
     rounds: int = Field(3, ge=1)
     novelty_threshold: float = Field(0.85, gt=0, le=1, description="SBERT cosine above which a proposal is a duplicate")
     tasks_file: str | None = Field(None, description="bring your own tasks.jsonl instead of brainstorming")
+    tasks_text: str | None = Field(None, description="plain descriptions, one per line, grounded into tasks")
 
 
 class BuildConfig(Section):

@@ -146,6 +146,22 @@ class Scenario(Strict):
     co_objects: list[str] = Field(default_factory=list, description="other catalogue objects in the story")
 
 
+class GroundingMatch(Strict):
+    """How one name an LLM (or a user's free text) wrote was resolved to a knowledge-base name.
+
+    Kept in the artefact so a reader can audit every loose name: what was written, what it became,
+    by which step (exact, normalised spelling, alias, Sentence-BERT retrieval, a class default, or
+    dropped) and how similar the retrieved match was (1.0 for the deterministic steps).
+    """
+
+    field: str = Field(description="where the name was written, e.g. 'scenario.container'")
+    written: str
+    grounded: str | None = Field(None, description="the knowledge-base name; None when the name was dropped")
+    method: Literal["exact", "normalised", "alias", "retrieval", "class_default", "other", "dropped"]
+    similarity: float = 1.0
+    alternatives: list[str] = Field(default_factory=list, description="the next retrieval candidates, best first")
+
+
 class TaskProposal(Artefact):
     """One anomaly scenario (the paper's task format plus the grounding our later stages need)."""
 
@@ -163,6 +179,7 @@ class TaskProposal(Artefact):
     solution: str = Field("", description="how the hazard is resolved, in words")
     success_condition: str = Field("", description="the safe end state, in words")
     provenance: Provenance
+    grounding: list[GroundingMatch] = Field(default_factory=list, description="loose names resolved to catalogue names")
 
 
 # --------------------------------------------------------------------------- stage 2: scenes
@@ -251,6 +268,39 @@ class SceneSpec(Artefact):
     bindings: dict[str, str] = Field(default_factory=dict, description="role variable -> instance, e.g. $hazard -> pill_0")
     validation: ValidationReport | None = None
     files: dict[str, str] = Field(default_factory=dict, description="logical name -> path relative to the scene folder")
+
+
+class ManifestHazard(Strict):
+    """A hazard the builder put in the scene, bound to instances (the answer key for one hazard)."""
+
+    hazard_class: str
+    object: str = Field(description="instance name of the object at fault")
+    category: str
+    severity: float = Field(ge=0, le=1)
+    variable: str = Field(description="the class variable bound to the object at fault, e.g. $hazard")
+    bindings: dict[str, str] = Field(default_factory=dict, description="the builder's role bindings")
+    success: list[PredicateCall] = Field(
+        default_factory=list,
+        description="the class's success predicates over the object at fault ('*' where the fix may choose, e.g. any container)",
+    )
+
+
+class NearMiss(Strict):
+    """A hazard-class object the builder placed in a safe state (acting on it is unnecessary)."""
+
+    object: str
+    category: str
+    looks_like: str = Field(description="the hazard class it resembles")
+    why_safe: str
+
+
+class HazardManifest(Artefact):
+    """``scenes/<task>/truth.json``: every hazard in the scene. Hidden from detect, plan and learn."""
+
+    scene_id: str
+    task_id: str
+    hazards: list[ManifestHazard] = Field(default_factory=list)
+    near_misses: list[NearMiss] = Field(default_factory=list)
 
 
 class GraphObject(Strict):
@@ -378,15 +428,38 @@ class SubTaskResult(Strict):
     attempts: int = Field(1, ge=1, description="executions of the sub-task: retried when its check failed")
 
 
+class HazardOutcome(Strict):
+    """One manifest hazard after execution, as the referee judged it on the final scene graph."""
+
+    hazard_class: str
+    object: str
+    resolved: bool
+    detail: str = ""
+
+
+class FixOutcome(Strict):
+    """The hidden-truth verdict on one execution (written by the referee, never read by the robot)."""
+
+    hazards: list[HazardOutcome] = Field(default_factory=list)
+    resolved: bool = Field(description="every manifest hazard is resolved (a hazard-free scene: True)")
+    new_hazards: list[str] = Field(
+        default_factory=list, description="'class on object' hazards present at the end and not at the start"
+    )
+    interventions_on_safe: list[str] = Field(
+        default_factory=list, description="near-miss objects the robot moved or whose parts it moved"
+    )
+
+
 class SkillResult(Artefact):
     task_id: str
     seed: int
-    success: bool
+    success: bool = Field(description="the plan's own final condition held (what the robot believes)")
     subtasks: list[SubTaskResult] = Field(default_factory=list)
     final_predicates: list[PredicateResult] = Field(default_factory=list)
     video: str | None = None
     timings: dict[str, float] = Field(default_factory=dict)
     error: str | None = None
+    outcome: FixOutcome | None = Field(None, description="the referee's verdict against truth.json; None without one")
 
 
 # --------------------------------------------------------------------------- run bookkeeping
@@ -408,10 +481,11 @@ class LLMUsage(Strict):
     cache_hits: int = 0
     cache_misses: int = 0
     retries: int = 0
+    truncated: int = Field(0, description="replies that used the whole max_tokens budget (likely cut off)")
     cost_usd: float | None = None
 
     def add(self, other: LLMUsage) -> None:
-        for field in ("requests", "prompt_tokens", "completion_tokens", "cache_hits", "cache_misses", "retries"):
+        for field in ("requests", "prompt_tokens", "completion_tokens", "cache_hits", "cache_misses", "retries", "truncated"):
             setattr(self, field, getattr(self, field) + getattr(other, field))
         if other.cost_usd is not None:
             self.cost_usd = (self.cost_usd or 0.0) + other.cost_usd
@@ -446,6 +520,7 @@ ARTEFACTS: dict[str, type[BaseModel]] = {
         PlacedObject,
         JointState,
         SceneSpec,
+        HazardManifest,
         SceneGraph,
         Hypothesis,
         Detection,

@@ -63,8 +63,8 @@ class Responder:
             self.count += 1
             k = self.count
         if self.bad_first and r == 1 and len(body["messages"]) == 2:
-            return text(reply_json([_proposal(f"{role} idea round {r}", hazard_object="flux_capacitor")]))
-        return text(reply_json([_proposal(f"{role} idea round {r} number {k}", builds_on=shown[:1], borrowed=["location"] if shown else [])]))
+            return text(reply_json(_proposal(f"{role} idea round {r}", hazard_object="flux_capacitor")))
+        return text(reply_json(_proposal(f"{role} idea round {r} number {k}", builds_on=shown[:1], borrowed=["location"] if shown else [])))
 
 
 def _engine(cfg, **kw) -> LLMEngine:
@@ -161,6 +161,8 @@ def test_tiny_gguf_mechanics(tmp_path):
     assert summary.done == len(tasks) <= 1
     if not tasks:
         assert summary.failed >= 1 and run.errors("brainstorm")
+    for task in tasks:  # a proposal that survived was grounded, and says how
+        assert {"hazard_class", "target_asset", "scenario.hazard_object"} <= {m.field for m in task.grounding}
     manifest = json.loads(run.manifest_path.read_text())
     assert manifest["llm_usage"]["requests"] >= 1
 
@@ -169,7 +171,8 @@ def test_llm_ablation_modes(scripted_server, tmp_path):
     srv = scripted_server(Responder())
     cfg = llm_config_for(srv, tmp_path, cache=False)
     plain = _engine(cfg, agents=4, rounds=3, mode="plain").run(2)
-    assert [t.provenance.agent_role for t in plain] == [None]  # one role-less call asked for both
+    assert [t.provenance.agent_role for t in plain] == [None, None]  # one role-less request per proposal
+    assert len(srv.requests) == 2 and all("Propose one hazard scenario" in b["messages"][-1]["content"] for b in srv.requests)
     assert "You are the" not in srv.requests[-1]["messages"][0]["content"]
     srv.requests.clear()
     roleplay = _engine(cfg, agents=3, rounds=3, mode="roleplay").run(3)

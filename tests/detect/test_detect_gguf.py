@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import time
-
 import detect_graphs as g
 import pytest
 
@@ -19,9 +17,7 @@ def test_llm_detector_runs_on_the_bundled_gguf(tmp_path, kb):
 
     client = get_client(LLMConfig(backend="llamacpp", cache=False, max_tokens=160, repair_retries=1))
     graph = g.pill_on_floor()
-    start = time.perf_counter()
     hyps = LLMDetector(client, kb).detect(graph, 1)
-    wall = time.perf_counter() - start
     # grammar-constrained decoding against the per-scene schema: a real object and a known class or none
     assert len(hyps) == 1 and hyps[0].rank == 1
     names = {o.name for o in graph.objects} | {o.category for o in graph.objects}
@@ -30,4 +26,3 @@ def test_llm_detector_runs_on_the_bundled_gguf(tmp_path, kb):
     assert client.usage.requests >= 1 and client.usage.completion_tokens > 0
     judgements = Judge(threshold=0.6).judge(hyps, ground_truth(g.PILL_TASK, None, graph), graph)
     assert len(judgements) == 1 and judgements[0].method in ("exact", "sbert")
-    assert wall < 240

@@ -49,8 +49,8 @@ def scene_responder(req):
     if "kitchen_knife_0" in user:
         return reply(("mug_0", None, "The mug is in the way", "Move the mug"),
                      ("kitchen_knife_0", "store_sharp_objects", "Knife at the counter edge", "Store the knife"))
-    if not repaired:
-        return reply(("fridge", "close_open_refrigerator", "Fridge open", "Close it"))
+    if not repaired:  # a name that matches nothing in the scene, even by retrieval: sent back for repair
+        return reply(("flux_capacitor", "close_open_refrigerator", "It hums", "Look at it"))
     return reply(("refrigerator_0", "close_open_refrigerator", "The fridge door is open", "Close the fridge door"))
 
 
@@ -149,3 +149,15 @@ def test_hybrid_fills_what_the_llm_left_out_in_rule_order(scripted_server, tmp_p
     hyps = HybridDetector(get_client(llm_config_for(srv, tmp_path, cache=False))).detect(g.two_hazards(), 3)
     assert [h.target_object for h in hyps] == ["kitchen_knife_0", "marble_0"]
     assert hyps[1].explanation.startswith("not ranked by the LLM; rule order")
+
+
+def test_llm_detector_grounds_loose_names_without_a_repair(scripted_server, tmp_path):
+    """Issue 15: "fridge" and a loose class name are grounded to the scene's instance and a class id."""
+    from anomalygen.detect.llm_detector import LLMDetector
+
+    srv = scripted_server([reply(("the fridge", "food warming up", "The fridge door was left open and food warms up",
+                                  "Close the fridge door"))])
+    detector = LLMDetector(get_client(llm_config_for(srv, tmp_path, cache=False)))
+    [hyp] = detector.detect(g.open_fridge(), 3)
+    assert (hyp.target_object, hyp.hazard_class) == ("refrigerator_0", "close_open_refrigerator")
+    assert "'the fridge' -> refrigerator_0" in hyp.explanation and len(srv.requests) == 1

@@ -80,3 +80,29 @@ def test_mixed_brainstorm_modes_get_ablation_rows(tmp_path):
     rows = {r.name: r for r in evaluate_run(run, s).diversity if r.kind == "run"}
     assert set(rows) == {"modes", "modes [mode=plain]", "modes [mode=brainstorm]"}
     assert rows["modes [mode=plain]"].tasks == 2 and rows["modes [mode=brainstorm]"].tasks == 3
+
+
+def test_the_truth_verdict_is_counted_apart_from_the_robots_own():
+    from anomalygen.schema import FixOutcome, HazardOutcome, SkillResult, TaskProposal
+
+    def task(tid, cls):
+        return TaskProposal(id=tid, name="n", explanation="e", description="d", category="hygiene",
+                            hazard_class=cls, target_asset="TrashCan",
+                            scenario=dict(hazard_object="rotten_apple", room="kitchen", placement="table"),
+                            provenance=dict(engine="knowledge", mode="brainstorm"))
+
+    def verdict(ok, new=(), safe=()):
+        return FixOutcome(hazards=[HazardOutcome(hazard_class="c", object="o", resolved=ok)], resolved=ok,
+                          new_hazards=list(new), interventions_on_safe=list(safe))
+
+    results = [
+        SkillResult(task_id="a", seed=0, success=True, outcome=verdict(True)),
+        SkillResult(task_id="a", seed=1, success=True, outcome=verdict(False, new=["x on y"])),  # fooled itself
+        SkillResult(task_id="b", seed=0, success=False, outcome=verdict(False, safe=["mug_0"])),
+        SkillResult(task_id="b", seed=1, success=True),  # no truth.json: not judged
+    ]
+    s = rm.success_summary(results, [task("a", "dispose_spoiled_food"), task("b", "store_sharp_objects")])
+    assert (s.overall.successes, s.overall.n) == (3, 4)
+    assert (s.resolved.successes, s.resolved.n) == (1, 3)
+    assert s.resolved_by_class["dispose_spoiled_food"].rate == 0.5 and s.resolved_by_class["store_sharp_objects"].n == 1
+    assert (s.new_hazards, s.on_safe) == (1, 1)

@@ -8,6 +8,7 @@ import pytest
 
 from anomalygen.config import Settings
 from anomalygen.schema import TaskProposal
+from support.fixtures import scripted_server  # noqa: F401 - the scripted LLM server for the LLM scene engine
 
 
 def make_task(

@@ -2,7 +2,8 @@
 
 Every choice is drawn from the knowledge base (objects that really have the class's properties,
 placements and containers the class allows), so an Idea is valid by construction: its objects are
-in the catalogue and its hazard's preconditions can be set up by the scene builder.
+in the catalogue and its hazard's preconditions can be set up by the scene builder. (Resolving the
+loose names an LLM or a person writes is ``knowledge/grounding.py``, shared by every engine.)
 """
 
 from __future__ import annotations

@@ -2,10 +2,13 @@
 
 Round 1: each agent is given a random target asset and proposes scenarios around it from its role's
 point of view. Round r >= 2: each agent is shown every *other* agent's round r-1 proposals, told it
-is in a collaborative session, and asked to build on them (citing what it builds on). Replies are
-structured (``AgentReply``), validated against the catalogue and the knowledge base; a reply naming
-unknown objects goes back to the model with the problems listed. A failure costs one agent-round,
-never the batch.
+is in a collaborative session, and asked to build on them (citing what it builds on).
+
+Each request asks for one proposal (``LLMProposal``), with ``max_tokens`` sized from that schema:
+several proposals per reply truncated on real models. Every name in a reply is grounded first
+(``knowledge/grounding.py``: spelling, aliases, Sentence-BERT retrieval), and only what even retrieval
+cannot place goes back to the model with the problems listed. A failure costs one proposal, never the
+batch.
 """
 
 from __future__ import annotations
@@ -16,10 +19,13 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from anomalygen.brainstorm.idea import task_id
+from anomalygen.brainstorm.ground_names import ground_llm_names
+from anomalygen.brainstorm.idea import ASPECTS, task_id
 from anomalygen.brainstorm.knowledge_engine import agent_roles, split_quota
 from anomalygen.brainstorm.validate import proposal_problems
 from anomalygen.knowledge import PLACEMENTS, ROOMS, KnowledgeBase, load_kb
+from anomalygen.knowledge.grounding import NameGrounder, shared_grounder
+from anomalygen.llm.schema_tools import reply_token_budget
 from anomalygen.rng import item_rng
 from anomalygen.schema import (
     ArticulationUse,
@@ -67,12 +73,6 @@ class LLMProposal(BaseModel):
     borrowed: list[str] = Field(default_factory=list, description="what was borrowed: mechanism, location, co_objects, person_at_risk")
 
 
-class AgentReply(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-    proposals: list[LLMProposal] = Field(min_length=1)
-
-
 @dataclass
 class Shown:
     """A proposal as the other agents see it in the next round."""
@@ -94,6 +94,16 @@ class LLMEngine:
     repair_retries: int = 2
     errors: dict[str, str] = field(default_factory=dict)
     accepted: list[TaskProposal] = field(default_factory=list)
+    grounder: NameGrounder | None = None
+
+    def __post_init__(self) -> None:
+        if self.grounder is None:
+            self.grounder = NameGrounder(self.kb)
+
+    @property
+    def token_cap(self) -> int | None:
+        """The configured ``llm.max_tokens``: an upper bound on the schema-sized budget."""
+        return getattr(getattr(self.client, "config", None), "max_tokens", None)
 
     @classmethod
     def from_settings(cls, settings) -> LLMEngine:
@@ -108,30 +118,54 @@ class LLMEngine:
             agents=cfg.agents,
             rounds=cfg.rounds,
             repair_retries=settings.llm.repair_retries,
+            grounder=shared_grounder(),
         )
 
     # ------------------------------------------------------------------ run
     def run(self, n: int) -> list[TaskProposal]:
+        """``n`` proposals, one request each; rounds still show every agent the others' last round."""
         mode = BrainstormMode(self.mode)
         n_agents = 1 if mode == BrainstormMode.PLAIN else self.agents
         rounds = self.rounds if mode == BrainstormMode.BRAINSTORM else 1
         roles: list[str | None] = [None] if mode == BrainstormMode.PLAIN else agent_roles(self.kb, n_agents)
         previous: list[tuple[int, Shown]] = []
+        budget = reply_token_budget(LLMProposal, cap=self.token_cap)
         for r, quota in enumerate(split_quota(n, rounds), start=1):
             shares = split_quota(quota, n_agents, offset=r - 1)
-            jobs = [(i, share) for i, share in enumerate(shares) if share > 0]
-            convs = [self.messages(r, i, roles[i], share, previous) for i, share in jobs]
-            replies = self.client.complete_many(convs, schema=AgentReply)
+            jobs = [(i, k, share) for i, share in enumerate(shares) for k in range(share)]
+            convs = [self.messages(r, i, roles[i], previous, k=k, share=share) for i, k, share in jobs]
+            replies = self.client.complete_many(convs, schema=LLMProposal, max_tokens=budget)
             this_round: list[tuple[int, Shown]] = []
-            for (i, share), conv, reply in zip(jobs, convs, replies, strict=True):
-                item = f"r{r}-agent{i}"
+            for (i, k, share), conv, reply in zip(jobs, convs, replies, strict=True):
+                item = f"r{r}-agent{i}" + (f"-p{k + 1}" if share > 1 else "")
                 if isinstance(reply, Exception):
                     self.errors[item] = str(reply)
                     continue
                 shown_ids = {s.id for a, s in previous if a != i}
-                for p in self._accept(reply, conv, r, i, roles[i], share, shown_ids, item):
+                p = self._accept(reply, conv, r, roles[i], shown_ids, item, budget)
+                if p is not None:
                     this_round.append((i, Shown(p.id, roles[i], p.name, p.description)))
             previous = this_round
+        return list(self.accepted)
+
+    def from_texts(self, lines: list[str]) -> list[TaskProposal]:
+        """One proposal per plain description (``--tasks-text``): the model structures the line, the
+        grounder resolves its names; a line that stays invalid fails alone (``line<N>``)."""
+        budget = reply_token_budget(LLMProposal, cap=self.token_cap)
+        convs = [
+            [
+                {"role": "system", "content": self.system_prompt(None)},
+                {"role": "user", "content": "Write this household hazard as one structured scenario, keeping its "
+                 f"objects, place and people:\n{line}"},
+            ]
+            for line in lines
+        ]
+        replies = self.client.complete_many(convs, schema=LLMProposal, max_tokens=budget)
+        for n, (conv, reply) in enumerate(zip(convs, replies, strict=True), start=1):
+            if isinstance(reply, Exception):
+                self.errors[f"line{n}"] = str(reply)
+                continue
+            self._accept(reply.model_copy(update={"description": lines[n - 1]}), conv, 1, None, set(), f"line{n}", budget)
         return list(self.accepted)
 
     # ------------------------------------------------------------------ prompts
@@ -159,90 +193,86 @@ class LLMEngine:
         ]
         return "\n\n".join(parts)
 
-    def messages(self, r: int, i: int, role: str | None, share: int, previous: list[tuple[int, Shown]]) -> list[dict]:
+    def messages(
+        self, r: int, i: int, role: str | None, previous: list[tuple[int, Shown]], *, k: int = 0, share: int = 1
+    ) -> list[dict]:
+        """The request for an agent's ``k``-th proposal of round ``r`` (one proposal per request)."""
         others = [s for a, s in previous if a != i]
         if r == 1 or not others:
-            rng = item_rng(self.seed, "llm-brainstorm", r, i)
+            rng = item_rng(self.seed, "llm-brainstorm", r, i, k)
             target = self.kb.targets[int(rng.integers(len(self.kb.targets)))]
             ask = (
-                f"Round {r}. Your target object is {target}. Propose {share} distinct hazard scenario(s) in a "
-                f"home that involve the {target} (as the hazard, the place to store it, or the setting)."
+                f"Round {r}. Your target object is {target}. Propose one hazard scenario in a home that "
+                f"involves the {target} (as the hazard, the place to store it, or the setting)."
             )
         else:
             listing = "\n".join(f"- [{s.id}] ({s.role or 'participant'}) {s.name}: {s.description}" for s in others)
+            aspect = ASPECTS[(i + k) % len(ASPECTS)]
             ask = (
                 f"Round {r} of the brainstorming session. These are the other participants' proposals from "
-                f"round {r - 1}:\n{listing}\n\nBuild on them: combine a hazard mechanism, a location, objects "
-                "or the person at risk from their ideas with your own perspective, and propose "
-                f"{share} new scenario(s) that are different from all of the above. Put the ids you build on "
-                "in builds_on and what you borrowed in borrowed."
+                f"round {r - 1}:\n{listing}\n\nBuild on them: take the {aspect.replace('_', ' ')} of one of "
+                "their ideas, combine it with your own perspective, and propose one new scenario that is "
+                "different from all of the above. Put the ids you build on in builds_on and what you "
+                "borrowed in borrowed."
             )
+        if share > 1:
+            ask += f" This is idea {k + 1} of {share} you write this round; give each its own angle."
         return [{"role": "system", "content": self.system_prompt(role)}, {"role": "user", "content": ask}]
 
     # ------------------------------------------------------------------ validation and repair
-    def _accept(self, reply: AgentReply, conv, r, i, role, share, shown_ids, item) -> list[TaskProposal]:
-        problems_by_idx: dict[int, list[str]] = {}
-        kept: list[TaskProposal] = []
-        for attempt in range(self.repair_retries + 1):
-            kept, problems_by_idx = [], {}
-            for k, raw in enumerate(reply.proposals[:share]):
-                proposal, problems = self._convert(raw, r, role, shown_ids)
-                if problems:
-                    problems_by_idx[k] = problems
-                else:
-                    kept.append(proposal)
-            if not problems_by_idx or attempt == self.repair_retries:
+    def _accept(self, raw: LLMProposal, conv, r, role, shown_ids, item, budget) -> TaskProposal | None:
+        """Ground and validate one proposal; only names that even retrieval cannot place go back."""
+        proposal, problems = self._convert(raw, r, role, shown_ids)
+        for _ in range(self.repair_retries):
+            if not problems:
                 break
-            fixed = self._repair(conv, reply, problems_by_idx)
+            fixed = self._repair(conv, raw, problems, budget)
             if fixed is None:
                 break
-            reply = fixed
-        for k, problems in problems_by_idx.items():
-            self.errors[f"{item}-p{k + 1}"] = "; ".join(problems)[:500]
-        out = []
-        names = {p.name.lower() for p in self.accepted}
-        for p in kept:
-            if p.name.lower() in names:
-                continue
-            names.add(p.name.lower())
-            index = len(self.accepted) + 1
-            p = p.model_copy(update={"id": task_id(index, p.name)})
-            self.accepted.append(p)
-            out.append(p)
-        return out
+            raw = fixed
+            proposal, problems = self._convert(raw, r, role, shown_ids)
+        if problems or proposal is None:
+            self.errors[item] = "; ".join(problems)[:500]
+            return None
+        if proposal.name.lower() in {p.name.lower() for p in self.accepted}:
+            self.errors[item] = f"duplicate of an accepted proposal named '{proposal.name}'"
+            return None
+        proposal = proposal.model_copy(update={"id": task_id(len(self.accepted) + 1, proposal.name)})
+        self.accepted.append(proposal)
+        return proposal
 
-    def _repair(self, conv, reply: AgentReply, problems_by_idx: dict[int, list[str]]) -> AgentReply | None:
-        listing = "\n".join(f"proposal {k + 1}: " + "; ".join(ps) for k, ps in problems_by_idx.items())
+    def _repair(self, conv, raw: LLMProposal, problems: list[str], budget: int) -> LLMProposal | None:
         follow = conv + [
-            {"role": "assistant", "content": reply.model_dump_json()},
+            {"role": "assistant", "content": raw.model_dump_json()},
             {
                 "role": "user",
-                "content": "Some proposals cannot be built:\n" + listing + "\nUse only the catalogue names, rooms, "
-                "placements and class ids listed above. Reply with the corrected proposals.",
+                "content": "This proposal cannot be built:\n- " + "\n- ".join(problems) + "\nUse only the catalogue "
+                "names, rooms, placements and class ids listed above. Reply with the corrected proposal.",
             },
         ]
         try:
-            out = self.client.complete(follow, schema=AgentReply)
-        except Exception as exc:  # noqa: BLE001 - a failed repair keeps the proposals that were valid
-            self.errors.setdefault("repair", str(exc)[:300])
+            out = self.client.complete(follow, schema=LLMProposal, max_tokens=budget)
+        except Exception as exc:  # noqa: BLE001 - a failed repair fails this one proposal only
+            problems.append(f"repair failed: {str(exc)[:200]}")
             return None
-        return out if isinstance(out, AgentReply) else None
+        return out if isinstance(out, LLMProposal) else None
 
     def _convert(self, raw: LLMProposal, r: int, role: str | None, shown_ids: set[str]) -> tuple[TaskProposal | None, list[str]]:
         kb = self.kb
-        hc = kb.hazard_classes.get(raw.hazard_class)
+        g = ground_llm_names(raw, self.grounder)
+        hc = kb.hazard_classes.get(g.hazard_class)
         category = hc.category if hc is not None else raw.category
         articulations = []
         if raw.articulated_part:
-            obj = raw.hazard_object if raw.hazard_object in kb.objects else raw.target_asset
+            obj = g.hazard_object if g.hazard_object in kb.objects else g.target_asset
             initial = raw.part_initial_state or (hc.articulation.initial_state if hc and hc.articulation else "open")
             target_state = hc.articulation.target_state if hc and hc.articulation else "closed"
             articulations.append(ArticulationUse(object=obj, part=raw.articulated_part, initial_state=initial, target_state=target_state))
         aux = [
             AuxiliaryItem(name=n, description=kb.objects[n].description if n in kb.objects else "", purpose=purpose)
-            for n, purpose in [(raw.hazard_object, "the hazard itself"), (raw.container, "where the robot puts it")]
-            + [(c, "part of the setting") for c in raw.co_objects]
-            if n and n != raw.target_asset
+            for n, purpose in [(g.hazard_object, "the hazard itself"), (g.container, "where the robot puts it")]
+            + [(c, "part of the setting") for c in g.co_objects]
+            if n and n != g.target_asset
         ]
         try:
             proposal = TaskProposal(
@@ -251,16 +281,16 @@ class LLMEngine:
                 explanation=raw.explanation,
                 description=raw.description,
                 category=category,
-                hazard_class=raw.hazard_class,
-                hazard_other=raw.hazard_other,
-                target_asset=raw.target_asset,
+                hazard_class=g.hazard_class,
+                hazard_other=g.hazard_other,
+                target_asset=g.target_asset,
                 scenario=Scenario(
-                    hazard_object=raw.hazard_object,
-                    room=raw.room,
-                    placement=raw.placement,
+                    hazard_object=g.hazard_object,
+                    room=g.room,
+                    placement=g.placement,
                     person_at_risk=raw.person_at_risk,
-                    container=raw.container,
-                    co_objects=list(raw.co_objects),
+                    container=g.container,
+                    co_objects=g.co_objects,
                 ),
                 auxiliary_items=aux,
                 articulations=articulations,
@@ -272,16 +302,19 @@ class LLMEngine:
                     agent_role=role,
                     round=r,
                     builds_on=[b for b in raw.builds_on if b in shown_ids],
-                    borrowed=[b for b in raw.borrowed if b in ("mechanism", "location", "co_objects", "person_at_risk")],
+                    borrowed=[b for b in raw.borrowed if b in ASPECTS],
                     seed=self.seed,
                     model=getattr(self.client, "model", None),
                 ),
+                grounding=g.matches,
             )
         except ValidationError as exc:
             return None, [format_validation_error(exc)]
-        return proposal, proposal_problems(proposal, kb)
+        unresolved = {m.written for m in g.matches if m.grounded is None and m.method != "dropped"}
+        rest = [p for p in proposal_problems(proposal, kb) if not any(f"'{w}'" in p for w in unresolved)]
+        return proposal, g.problems + rest
 
 
-def reply_json(proposals: list[dict]) -> str:
-    """Serialise scripted replies (tests, examples)."""
-    return json.dumps({"proposals": proposals})
+def reply_json(proposal: dict) -> str:
+    """Serialise a scripted reply (tests, examples)."""
+    return json.dumps(proposal)

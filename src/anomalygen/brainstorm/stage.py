@@ -70,6 +70,27 @@ def generate(settings: Settings, run: RunFolder | None = None) -> tuple[list[Tas
     return eng.run(cfg.n), {}
 
 
+def tasks_from_text(settings, run: RunFolder | None = None) -> tuple[list[TaskProposal], dict[str, str]]:
+    """Proposals from ``brainstorm.tasks_text``: structured by the LLM engine when it is the brainstorm
+    engine, else grounded offline by retrieval; per-line errors either way."""
+    from anomalygen.brainstorm.free_text import read_lines, tasks_from_lines
+
+    lines = read_lines(settings.brainstorm.tasks_text)
+    if settings.engine_for("brainstorm") == Engine.LLM:
+        from anomalygen.brainstorm.llm_engine import LLMEngine
+
+        llm = LLMEngine.from_settings(settings)
+        tasks = llm.from_texts(lines)
+        if run is not None:
+            from anomalygen.llm import record_usage
+
+            record_usage(run, llm.client.reset_usage())
+        return tasks, llm.errors
+    from anomalygen.knowledge import load_kb
+
+    return tasks_from_lines(lines, load_kb(), seed=settings.seed)
+
+
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False) -> StageSummary:
     started = time.perf_counter()
     record = StageRecord(started=now_iso())
@@ -78,6 +99,10 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False) -> Sta
     errors: dict[str, str] = {}
     if cfg.tasks_file:
         tasks = load_user_tasks(cfg.tasks_file)
+        write_jsonl(run.tasks_path, tasks)
+        summary.done = len(tasks)
+    elif cfg.tasks_text:
+        tasks, errors = tasks_from_text(settings, run)
         write_jsonl(run.tasks_path, tasks)
         summary.done = len(tasks)
     elif not force and run.tasks_path.is_file() and _valid_existing(run):

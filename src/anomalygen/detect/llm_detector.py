@@ -2,17 +2,16 @@
 
 The model sees the observation (objects, states, relations; never the task) and the knowledge base's
 list of hazard classes, and answers with structured hypotheses through the LLM layer. Its reply is
-untrusted: the reply schema is built per scene so ``target_object`` must name an object that is
-actually in the scene and ``hazard_class`` must be a known class id; a reply that breaks either goes
-back to the model with the validation error (the LLM layer's repair loop), and a scene whose replies
-never validate fails alone (``LLMItemError``), never the batch.
+untrusted: the reply schema is built per scene and grounds every name as it validates
+(``knowledge.grounding``): ``target_object`` "fridge" becomes the scene's ``refrigerator_0``, a loose
+class name becomes the closest class id (or null when none fits). Only a name that even retrieval
+cannot place goes back to the model with the validation error (the LLM layer's repair loop), and a
+scene whose replies never validate fails alone (``LLMItemError``), never the batch.
 """
 
 from __future__ import annotations
 
-from typing import Literal
-
-from pydantic import BaseModel, ConfigDict, Field, create_model
+from pydantic import BaseModel, ConfigDict, Field, create_model, model_validator
 
 from anomalygen.detect.observation import observation_text
 from anomalygen.schema import Hypothesis, SceneGraph
@@ -33,18 +32,47 @@ def class_menu(kb) -> str:
     return "Known hazard classes (use the id in hazard_class, or null if none fits):\n" + "\n".join(lines)
 
 
-def reply_schema(graph: SceneGraph, class_ids: list[str], k: int) -> type[BaseModel]:
-    """A reply model whose enums are this scene's objects and the known classes, so bad names fail validation."""
+def reply_schema(graph: SceneGraph, grounder, k: int, notes: list[str] | None = None) -> type[BaseModel]:
+    """A reply model that grounds each hypothesis's object and class names while it validates.
+
+    ``notes`` collects one line per name that was not written exactly (kept in the hypotheses'
+    explanations, so a detection says how its names were resolved)."""
+    vocab = grounder.instances([(o.name, o.category) for o in graph.objects])
     names = sorted({o.name for o in graph.objects} | {o.category for o in graph.objects})
-    Target = Literal[tuple(names)] if names else str  # type: ignore[valid-type]
-    Klass = Literal[tuple(sorted(class_ids))] if class_ids else str  # type: ignore[valid-type]
+    class_ids = sorted(grounder.kb.hazard_classes)
+    notes = notes if notes is not None else []
+
+    def ground(model):
+        context = f"{model.problem} {model.solution}"
+        m = vocab.ground(model.target_object, "target_object", query=f"{model.target_object}. {context}")
+        if m.grounded is None:
+            raise ValueError(
+                f"target_object '{model.target_object}' is not an object in this scene (closest: "
+                f"{', '.join(m.alternatives[:2]) or '-'}); use one of {', '.join(names)}"
+            )
+        if m.method != "exact":
+            notes.append(f"'{m.written}' -> {m.grounded} ({m.method})")
+        model.target_object = m.grounded
+        if model.hazard_class is not None:
+            c = grounder.hazard_class(model.hazard_class, context, hazard_objects=[_category(graph, m.grounded)])
+            if c.method != "exact":
+                notes.append(f"class '{c.written}' -> {c.grounded} ({c.method})")
+            model.hazard_class = None if c.grounded == "other" else c.grounded
+        return model
+
     draft = create_model(
         "HazardHypothesis",
-        __config__=ConfigDict(extra="forbid"),
+        __config__=ConfigDict(extra="forbid", validate_assignment=False),
+        __validators__={"ground": model_validator(mode="after")(ground)},
         problem=(str, Field(min_length=3, max_length=400, description="what is wrong and who could be hurt")),
         solution=(str, Field(min_length=3, max_length=400, description="what the robot should do about it")),
-        target_object=(Target, Field(description="name of the scene object at fault")),
-        hazard_class=(Klass | None, Field(None, description="id of the matching hazard class, or null")),
+        # The names stay in the JSON schema as enums, so a backend with grammar-constrained decoding
+        # (llama.cpp) still writes an exact name; servers that ignore them get grounded instead.
+        target_object=(str, Field(description="name of the scene object at fault, as written in the observation",
+                                  json_schema_extra={"enum": names})),
+        hazard_class=(str | None, Field(None, description="id of the matching hazard class, or null",
+                                        json_schema_extra=lambda js: js.update(anyOf=[{"type": "string", "enum": class_ids},
+                                                                                      {"type": "null"}]))),
     )
     return create_model(
         "SceneHazards",
@@ -71,8 +99,11 @@ class LLMDetector:
         self.seed = seed
 
     def detect(self, graph: SceneGraph, k: int) -> list[Hypothesis]:
+        from anomalygen.knowledge.grounding import NameGrounder, shared_grounder
+
         kb = self.kb if self.kb is not None else _kb()
-        schema = reply_schema(graph, list(kb.hazard_classes), k)
+        notes: list[str] = []
+        schema = reply_schema(graph, shared_grounder() if self.kb is None else NameGrounder(kb), k, notes)
         reply = self.client.complete(
             [{"role": "system", "content": SYSTEM_PROMPT}, {"role": "user", "content": user_prompt(graph, kb, k)}],
             schema=schema,
@@ -94,7 +125,7 @@ class LLMDetector:
                     target_object=h.target_object,
                     hazard_class=h.hazard_class,
                     score=round(1.0 - 0.1 * len(out), 3),
-                    explanation=f"LLM ({self.client.model})",
+                    explanation=f"LLM ({self.client.model})" + (f"; grounded {'; '.join(notes)}" if notes else ""),
                 )
             )
         return out
@@ -104,3 +135,7 @@ def _kb():
     from anomalygen.knowledge import load_kb
 
     return load_kb()
+
+
+def _category(graph: SceneGraph, name: str) -> str:
+    return next((o.category for o in graph.objects if o.name == name), name)

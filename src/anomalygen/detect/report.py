@@ -12,6 +12,7 @@ from collections.abc import Sequence
 
 from pydantic import Field
 
+from anomalygen.detect.score import DetectionScores
 from anomalygen.schema import Artefact, Detection, Strict, TaskProposal
 
 
@@ -30,7 +31,8 @@ class Miss(Strict):
 
 
 class DetectionReport(Artefact):
-    detector: str
+    detector: str = Field(description="the one detector of every scene, or 'mixed (...)' with counts")
+    detectors: dict[str, int] = Field(default_factory=dict, description="detector -> scenes it produced")
     k: int
     scenes: int
     errors: int = 0
@@ -41,6 +43,15 @@ class DetectionReport(Artefact):
     misses: list[Miss]
     judge_methods: dict[str, int] = Field(default_factory=dict, description="how the first hits were judged")
     missing_scenes: list[str] = Field(default_factory=list, description="tasks without a detection record")
+    scores: DetectionScores | None = Field(None, description="per-hazard scores against the scenes' truth.json")
+
+
+def detector_label(counts: dict[str, int]) -> str:
+    """'rules', 'llm', or 'mixed (llm 6, rules 14)': a run that fell back on another detector for some
+    scenes is never labelled by the one it only partly used."""
+    if len(counts) == 1:
+        return next(iter(counts))
+    return "mixed (" + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) + ")" if counts else "none"
 
 
 def _rates(dets: Sequence[Detection], k: int) -> HitRates:
@@ -80,8 +91,10 @@ def summarise(detections: Sequence[Detection], tasks: Sequence[TaskProposal], k:
                     reason=reason,
                 )
             )
+    used = Counter(d.detector for d in dets)
     return DetectionReport(
-        detector=dets[0].detector if dets else "rules",
+        detector=detector_label(used),
+        detectors=dict(sorted(used.items())),
         k=k,
         scenes=len(dets),
         errors=sum(1 for d in dets if d.error),
@@ -127,5 +140,11 @@ def print_report(report: DetectionReport, *, console=None, max_misses: int = 20)
             console.print(f"  {m.task_id} [{m.hazard_class}] top-1 {m.top1}: {m.reason}", highlight=False)
         if len(report.misses) > max_misses:
             console.print(f"  ... {len(report.misses) - max_misses} more in detections_summary.json")
+    if report.scores is not None:
+        sc = report.scores
+        alarms = "n/a (no hazard-free scene)" if sc.false_alarm_rate is None else f"{sc.false_alarm_rate:.3f}"
+        console.print(f"[bold]against truth.json[/bold]: {sc.hazards} hazards in {sc.scenes} scenes; "
+                      f"recall {sc.recall:.3f} ({sc.found}), precision {sc.precision:.3f} "
+                      f"({sc.true_claims}/{sc.claims} claims), F1 {sc.f1:.3f}; false alarms {alarms}", highlight=False)
     if report.missing_scenes:
         console.print(f"[yellow]{len(report.missing_scenes)} task(s) have no detection (scene not built or failed)[/yellow]")

@@ -87,7 +87,8 @@ def detect_scene(task: TaskProposal, graph: SceneGraph, spec: SceneSpec | None, 
     return Detection(
         task_id=task.id,
         scene_id=graph.scene_id,
-        detector=settings.detect.detector,
+        # A hybrid that fell back on the rule order produced a rule detection: say so per scene.
+        detector="rules" if getattr(detector, "fell_back", None) else settings.detect.detector,
         hypotheses=hyps,
         judgements=judgements,
         hit_rank=hit,
@@ -160,6 +161,7 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
     detections = [d for t in tasks if (d := try_read_model(detection_path(run, t.id), Detection)) is not None]
     write_jsonl(run.detections_path, detections)
     report = summarise(detections, tasks, settings.detect.k)
+    report.scores = _scores_against_truth(run, tasks, detections, settings.detect.k)
     write_model(summary_path(run), report)
     fallbacks = sum(1 for r in summary.results.values() if isinstance(r, dict) and r.get("fallback"))
     if not settings.quiet:
@@ -171,6 +173,15 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
             console.print(f"[yellow]{fallbacks} scene(s): LLM ranking failed, rule order kept[/yellow]")
     summary.results["report"] = report.model_dump(mode="json")
     return summary
+
+
+def _scores_against_truth(run: RunFolder, tasks, detections, k: int):
+    """Per-hazard scores against the scenes' truth.json, read here (after detection) by the scorer only."""
+    from anomalygen.detect.score import score_detections
+    from anomalygen.evaluate.run_metrics import load_manifests
+
+    manifests = load_manifests(run, tasks)
+    return score_detections(detections, manifests, k) if manifests else None
 
 
 def _record_llm_usage(run: RunFolder, summary: StageSummary) -> None:

@@ -19,7 +19,7 @@ from pydantic import Field
 
 from anomalygen.evaluate import plots
 from anomalygen.evaluate import run_metrics as rm
-from anomalygen.evaluate.baselines import PAPER_ABLATION
+from anomalygen.evaluate.baselines import PAPER_ABLATION, PAPER_DETECTION
 from anomalygen.evaluate.results import Evaluation
 from anomalygen.runfolder import RunFolder, atomic_write_text, now_iso, write_model
 from anomalygen.runner import StageSummary
@@ -162,6 +162,33 @@ def _not_run(stage: str) -> str:
     return f'<p class="notrun">{NOT_RUN}: the {_e(stage)} stage has produced no artefacts yet.</p>'
 
 
+ABLATION_HEADERS = ["mode", "source", "tasks", "Self-BLEU ↓", "SBERT sim ↓", "WMD ↑ (ours)", "WMD ↓ (paper, as published)"]
+
+
+def ablation_rows(ev: Evaluation) -> tuple[list[str], list[list], list[str]]:
+    """Our measured diversity per engine and mode beside the paper's figures, each row labelled."""
+    rows: list[list] = []
+    classes: list[str] = []
+    for mode in ("plain", "roleplay", "brainstorm"):
+        for r in (a for a in ev.ablation if a.mode == mode):
+            rows.append([mode, f"measured ({r.engine} engine)", r.tasks, _f(r.self_bleu), _f(r.sbert), _f(r.wmd), ""])
+            classes.append("")
+        bleu, sbert, wmd = PAPER_ABLATION[mode]
+        rows.append([mode, "paper", 100, _f(bleu), _f(sbert), "", _f(wmd)])
+        classes.append("paper")
+    return ABLATION_HEADERS, rows, classes
+
+
+def detection_rows(d) -> tuple[list[str], list[list], list[str]]:
+    """hit@k measured per detector (and over all scenes when mixed) beside the paper's human-judged rates."""
+    ks = sorted(d.hit_at_k)
+    rows: list[list] = [[f"measured: {name}", d.detectors.get(name, 0), *[_f(v.get(k), 2) for k in ks]] for name, v in d.by_detector.items()]
+    if len(d.by_detector) > 1:
+        rows.append([f"measured: all ({d.detector_label})", d.scenes, *[_f(d.hit_at_k.get(k), 2) for k in ks]])
+    rows.append(["paper (human-judged)", "—", *[_f(PAPER_DETECTION.get(k), 2) for k in ks]])
+    return ["detector", "scenes", *[f"hit@{k}" for k in ks]], rows, [""] * (len(rows) - 1) + ["paper"]
+
+
 def render_html(report: Report, run: RunFolder) -> str:
     ev = report.evaluation
     parts = []
@@ -186,9 +213,11 @@ def render_html(report: Report, run: RunFolder) -> str:
         note = ("<p>Text = task name + description. Baselines are recomputed from the packaged public task lists; "
                 "“paper” rows are the published figures (ViT/CLIP image columns). Our image column uses "
                 f"{_e(', '.join(embedders) or 'no image embedder')}; WMD uses MiniLM word-piece vectors.</p>")
-        ablation = _table(["brainstorm mode (paper)", "Self-BLEU", "SBERT", "WMD"],
-                          [[m, *v] for m, v in PAPER_ABLATION.items()], ["paper"] * len(PAPER_ABLATION))
-        parts.append(_section("diversity", "Diversity", table + note + "<h3>Brainstorming ablation (paper)</h3>" + ablation))
+        headers, rows, classes = ablation_rows(ev)
+        ablation = _table(headers, rows, classes) + ("<p>Measured rows are this run's proposals grouped by engine and "
+                                                      "mode; the paper's are published. The paper reads its WMD as lower "
+                                                      "is better; ours is a distance, so higher means more diverse.</p>")
+        parts.append(_section("diversity", "Diversity", table + note + "<h3>Brainstorming ablation</h3>" + ablation))
     else:
         parts.append(_section("diversity", "Diversity", _not_run("evaluate")))
 
@@ -208,8 +237,24 @@ def render_html(report: Report, run: RunFolder) -> str:
         ks = sorted(d.hit_at_k)
         by_cat = _table(["category", *[f"hit@{k}" for k in ks]],
                         [[c, *[_f(v.get(k), 2) for k in ks]] for c, v in d.by_category.items()])
+        scored = ""
+        if d.scores is not None:
+            sc = d.scores
+            alarms = "no hazard-free scenes" if sc.false_alarm_rate is None else (
+                f"{_f(sc.false_alarm_rate, 2)} over {sc.hazard_free_scenes} hazard-free scenes")
+            scored = _table(
+                ["against the hidden truth", "value"],
+                [["hazards found (recall)", f"{sc.found}/{sc.hazards} ({_f(sc.recall, 2)})"],
+                 ["claims that were right (precision)", f"{sc.true_claims}/{sc.claims} ({_f(sc.precision, 2)})"],
+                 ["F1", _f(sc.f1, 2)],
+                 ["false alarms", alarms],
+                 *[[f"hit@{j} on {sc.single_hazard_scenes} single-hazard scenes", _f(v, 2)]
+                   for j, v in sorted(sc.hit_at_k.items())]])
+        headers, rows, classes = detection_rows(d)
+        by_detector = _table(headers, rows, classes)
         body = (f'<div class="plots">{_img(plots.hit_at_k_plot(d.hit_at_k), "hit at k")}<div>'
-                f"<p>{d.scenes} scenes, {d.errors} detector errors.</p>{by_cat}</div></div>")
+                f"<p>{d.scenes} scenes, detector: {_e(d.detector_label)}, {d.errors} detector errors.</p>"
+                f"{scored}{by_detector}{by_cat}</div></div>")
         parts.append(_section("detection", "Detection hit@k", body))
     else:
         parts.append(_section("detection", "Detection hit@k", _not_run("detect")))
@@ -218,12 +263,22 @@ def render_html(report: Report, run: RunFolder) -> str:
     if ev.success:
         s = ev.success
         bars = _img(plots.success_bars({k: (v.successes, v.n) for k, v in s.by_category.items()}), "success by category")
-        cls_rows = [[k, v.successes, v.n, _f(v.rate, 2)] for k, v in s.by_class.items()]
+        def truth(k: str) -> str:
+            r = s.resolved_by_class.get(k)
+            return f"{r.successes}/{r.n} ({_f(r.rate, 2)})" if r and r.n else "no truth"
+
+        cls_rows = [[k, v.n, f"{v.successes} ({_f(v.rate, 2)})", truth(k)] for k, v in s.by_class.items()]
         meth_rows = [[k, v.successes, v.n, _f(v.rate, 2)] for k, v in s.by_method.items()]
-        body = (f'<div class="plots">{bars}<div>{_table(["hazard class", "successes", "runs", "rate"], cls_rows)}'
+        headers = ["hazard class", "runs", "robot: plan done", "truth: hazard resolved"]
+        resolved = (f"{s.resolved.successes}/{s.resolved.n} ({_f(s.resolved.rate, 2)})" if s.resolved.n
+                    else "not judged (no truth.json)")
+        body = (f'<div class="plots">{bars}<div>{_table(headers, cls_rows)}'
                 f'{_table(["sub-task method", "successes", "runs", "rate"], meth_rows)}</div></div>'
-                f"<p>Overall: {s.overall.successes}/{s.overall.n} ({_f(s.overall.rate, 2)}) over {s.tasks} tasks; "
-                f"{s.errors} runs ended with an error. Paper: 83% (human-judged).</p>")
+                f"<p>Hazards resolved, judged against the builder's hidden truth on every class: <b>{resolved}</b>. "
+                f"The robot's own verdict (its plan's final condition held): {s.overall.successes}/{s.overall.n} "
+                f"({_f(s.overall.rate, 2)}) over {s.tasks} tasks. Runs that created a new hazard: {s.new_hazards}; "
+                f"runs that acted on an already-safe object: {s.on_safe}; {s.errors} runs ended with an error. "
+                "Paper: 83% (human-judged).</p>")
         parts.append(_section("success", "Resolution success", body))
     else:
         parts.append(_section("success", "Resolution success", _not_run("learn")))
@@ -276,6 +331,10 @@ def render_html(report: Report, run: RunFolder) -> str:
 # --------------------------------------------------------------------------- Markdown
 
 
+def _md_table(headers: list[str], rows: list[list]) -> list[str]:
+    return ["| " + " | ".join(headers) + " |", "|" + "---|" * len(headers)] + ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+
+
 def render_markdown(report: Report) -> str:
     ev = report.evaluation
     lines = [f"# anomalygen report — {ev.run}", "", f"Generated {report.generated}.", ""]
@@ -289,10 +348,13 @@ def render_markdown(report: Report) -> str:
                   for r in ev.diversity]
     else:
         lines.append(NOT_RUN)
+    if ev.diversity:
+        lines += ["", "### Brainstorming ablation", "", *_md_table(*ablation_rows(ev)[:2])]
     lines += ["", "## Detection", ""]
     if ev.detection:
         lines.append(", ".join(f"hit@{k} = {v:.2f}" for k, v in sorted(ev.detection.hit_at_k.items()))
-                     + f" over {ev.detection.scenes} scenes")
+                     + f" over {ev.detection.scenes} scenes (detector: {ev.detection.detector_label})")
+        lines += ["", *_md_table(*detection_rows(ev.detection)[:2])]
     else:
         lines.append(NOT_RUN)
     lines += ["", "## Success by category", ""]

@@ -10,6 +10,7 @@ from typing import Literal
 
 from pydantic import Field
 
+from anomalygen.detect.score import DetectionScores
 from anomalygen.schema import Artefact, LLMUsage, StageRecord, Strict
 
 
@@ -42,6 +43,15 @@ class DetectionSummary(Strict):
     hit_at_k: dict[int, float] = Field(description="k -> fraction of scenes whose first hit has rank <= k")
     errors: int = 0
     by_category: dict[str, dict[int, float]] = Field(default_factory=dict)
+    detectors: dict[str, int] = Field(default_factory=dict, description="detector -> scenes it produced")
+    by_detector: dict[str, dict[int, float]] = Field(default_factory=dict, description="detector -> hit@k of its scenes")
+
+    @property
+    def detector_label(self) -> str:
+        from anomalygen.detect.report import detector_label
+
+        return detector_label(self.detectors)
+    scores: DetectionScores | None = Field(None, description="per-hazard scores against truth.json")
 
 
 class SuccessSummary(Strict):
@@ -52,12 +62,28 @@ class SuccessSummary(Strict):
     by_class: dict[str, Rate] = Field(default_factory=dict)
     by_method: dict[str, Rate] = Field(default_factory=dict, description="sub-task success per skill method")
     errors: int = 0
+    resolved: Rate = Field(default_factory=Rate, description="runs whose every truth-manifest hazard was fixed")
+    resolved_by_class: dict[str, Rate] = Field(default_factory=dict)
+    new_hazards: int = Field(0, description="runs that left a hazard the scene did not have at the start")
+    on_safe: int = Field(0, description="runs that acted on a near-miss (an object that was already safe)")
+
+
+class AblationRow(Strict):
+    """Our measured diversity of one (engine, brainstorm mode) group of this run's proposals."""
+
+    engine: str
+    mode: str
+    tasks: int
+    self_bleu: float | None = None
+    sbert: float | None = None
+    wmd: float | None = None
 
 
 class Evaluation(Artefact):
     run: str
     tasks: int
     diversity: list[DiversityRow] = Field(default_factory=list)
+    ablation: list[AblationRow] = Field(default_factory=list, description="measured diversity per engine and mode")
     categories: dict[str, int] = Field(default_factory=dict)
     classes: dict[str, int] = Field(default_factory=dict)
     target_assets: dict[str, int] = Field(default_factory=dict)

@@ -35,18 +35,28 @@ def hit_at_k(detections: Sequence[Detection], k: int) -> dict[int, float]:
             for j in range(1, k + 1)}
 
 
-def detection_summary(detections: Sequence[Detection], tasks: Sequence[TaskProposal], k: int) -> DetectionSummary:
+def detection_summary(
+    detections: Sequence[Detection], tasks: Sequence[TaskProposal], k: int, manifests=None
+) -> DetectionSummary:
+    """hit@k over every scene, by category; with ``manifests`` (task id -> truth) per-hazard scores too."""
+    from anomalygen.detect.score import score_detections
+
     k = max([k, *(len(d.hypotheses) for d in detections)]) if detections else k
     category = {t.id: str(t.category) for t in tasks}
     groups: dict[str, list[Detection]] = {}
+    by_detector: dict[str, list[Detection]] = {}
     for d in detections:
         groups.setdefault(category.get(d.task_id, "unknown"), []).append(d)
+        by_detector.setdefault(d.detector, []).append(d)
     return DetectionSummary(
         scenes=len(detections),
         k=k,
         hit_at_k=hit_at_k(detections, k),
         errors=sum(1 for d in detections if d.error),
         by_category={c: hit_at_k(ds, k) for c, ds in sorted(groups.items())},
+        detectors={name: len(ds) for name, ds in sorted(by_detector.items())},
+        by_detector={name: hit_at_k(ds, k) for name, ds in sorted(by_detector.items())},
+        scores=score_detections(detections, manifests, k) if manifests else None,
     )
 
 
@@ -63,6 +73,9 @@ def success_summary(results: Sequence[SkillResult], tasks: Sequence[TaskProposal
         cell.n += 1
         cell.successes += int(ok)
 
+    resolved = Rate()
+    resolved_by_class: dict[str, Rate] = {}
+    harm = {"new": 0, "safe": 0}
     for r in results:
         task = by_id.get(r.task_id)
         overall.n += 1
@@ -71,7 +84,17 @@ def success_summary(results: Sequence[SkillResult], tasks: Sequence[TaskProposal
         bump(by_class, task.hazard_class if task else "unknown", r.success)
         for sub in r.subtasks:
             bump(by_method, str(sub.method), sub.success)
+        if r.outcome is not None:  # the referee's verdict against truth.json
+            resolved.n += 1
+            resolved.successes += int(r.outcome.resolved)
+            bump(resolved_by_class, task.hazard_class if task else "unknown", r.outcome.resolved)
+            harm["new"] += int(bool(r.outcome.new_hazards))
+            harm["safe"] += int(bool(r.outcome.interventions_on_safe))
     return SuccessSummary(
+        resolved=resolved,
+        resolved_by_class=dict(sorted(resolved_by_class.items())),
+        new_hazards=harm["new"],
+        on_safe=harm["safe"],
         results=len(results),
         tasks=len({r.task_id for r in results}),
         overall=overall,
@@ -87,6 +110,13 @@ def success_summary(results: Sequence[SkillResult], tasks: Sequence[TaskProposal
 
 def load_tasks(run: RunFolder) -> list[TaskProposal]:
     return run.load_tasks() if run.tasks_path.is_file() else []
+
+
+def load_manifests(run: RunFolder, tasks: Sequence[TaskProposal]) -> dict:
+    """Task id -> the builder's truth manifest, for scenes that have one (the answer key: metrics only)."""
+    from anomalygen.evaluate.referee import load_manifest
+
+    return {t.id: m for t in tasks if (m := load_manifest(run.scene_dir(t.id))) is not None}
 
 
 def load_detections(run: RunFolder) -> list[Detection]:

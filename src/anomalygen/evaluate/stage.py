@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 from anomalygen.evaluate import run_metrics as rm
 from anomalygen.evaluate.diversity import diversity_table, rich_table
-from anomalygen.evaluate.results import Evaluation
+from anomalygen.evaluate.results import AblationRow, DiversityRow, Evaluation
 from anomalygen.evaluate.text_metrics import task_text
 from anomalygen.runfolder import RunFolder, now_iso, read_model, write_model
 from anomalygen.runner import StageSummary
@@ -43,8 +43,13 @@ def evaluate_run(run: RunFolder, settings: Settings) -> Evaluation:
 
     renders = rm.scene_renders(run)
     by_mode: dict[str, list[str]] = {}
+    engines = {str(t.provenance.engine) for t in tasks}
+    group_of: dict[str, tuple[str, str]] = {}  # row label -> (engine, mode)
     for t in tasks:
-        by_mode.setdefault(f"mode={t.provenance.mode}", []).append(task_text(t.name, t.description))
+        engine, mode = str(t.provenance.engine), str(t.provenance.mode)
+        label = f"mode={mode}" if len(engines) == 1 else f"engine={engine} mode={mode}"
+        group_of[label] = (engine, mode)
+        by_mode.setdefault(label, []).append(task_text(t.name, t.description))
     rows = diversity_table(
         run.root.name,
         [task_text(t.name, t.description) for t in tasks],
@@ -57,6 +62,7 @@ def evaluate_run(run: RunFolder, settings: Settings) -> Evaluation:
         timings=timings,
         groups=by_mode if len(by_mode) > 1 else None,  # brainstorm ablation rows when modes are mixed
     )
+    ablation = measured_ablation(run.root.name, rows, group_of)
     not_run = [name for name, present in (
         ("brainstorm", bool(tasks)), ("build", bool(scenes)), ("detect", bool(detections)),
         ("plan", run.plans_dir.is_dir() and any(run.plans_dir.glob("*.json"))), ("learn", bool(results)),
@@ -65,18 +71,31 @@ def evaluate_run(run: RunFolder, settings: Settings) -> Evaluation:
         run=run.root.name,
         tasks=len(tasks),
         diversity=rows,
+        ablation=ablation,
         categories=rm.category_distribution(tasks),
         classes=rm.class_distribution(tasks),
         target_assets=rm.distribution(t.target_asset for t in tasks),
         scenes_built=sum(1 for s in scenes if s.validation is None or s.validation.ok),
         scenes_failed=len(run.errors("build")),
-        detection=rm.detection_summary(detections, tasks, settings.detect.k) if detections else None,
+        detection=(rm.detection_summary(detections, tasks, settings.detect.k, rm.load_manifests(run, tasks))
+                   if detections else None),
         success=rm.success_summary(results, tasks) if results else None,
         timings=dict(manifest.stages),
         llm_usage=manifest.llm_usage,
         not_run=not_run,
         wall_s=timings,
     )
+
+
+def measured_ablation(run_name: str, rows: list[DiversityRow], group_of: dict[str, tuple[str, str]]) -> list[AblationRow]:
+    """Our diversity per (engine, mode): the group rows, or the whole-run row when there is one group."""
+    by_name = {r.name: r for r in rows if r.kind == "run"}
+    out = []
+    for label, (engine, mode) in group_of.items():
+        row = by_name.get(run_name) if len(group_of) == 1 else by_name.get(f"{run_name} [{label}]")
+        if row is not None:
+            out.append(AblationRow(engine=engine, mode=mode, tasks=row.tasks, self_bleu=row.self_bleu, sbert=row.sbert, wmd=row.wmd))
+    return out
 
 
 def run_stage(run: RunFolder, settings: Settings) -> StageSummary:

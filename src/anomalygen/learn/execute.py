@@ -151,7 +151,8 @@ def _evaluate(calls, model, data, spec, bindings) -> list[PredicateResult]:
 
 def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: str | Path | None = None,
                  max_wall_s: float = 600.0, sac_steps: int = 0, isolate: bool = True,
-                 retries: int = 1, reward_mode: str = "spec") -> SkillResult:
+                 retries: int = 1, reward_mode: str = "spec",
+                 final_graph_path: str | Path | None = None) -> SkillResult:
     """Load the scene, run the plan's sub-tasks in order, check success, optionally record a video.
 
     Execution is closed-loop: a primitive sub-task whose success check fails on the scene right after
@@ -166,6 +167,9 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
 
     ``reward_mode`` is ``learn.reward_mode``: "code" trains SAC sub-tasks on sandboxed reward code
     (:func:`~anomalygen.rl.sac_subtask.run_sac_subtask`).
+
+    ``final_graph_path`` receives the scene graph of the final, settled state: what the referee
+    judges against the hidden truth (the robot's own verdict is ``success``).
     """
     if isolate:
         from concurrent.futures import ProcessPoolExecutor
@@ -173,12 +177,14 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
 
         with ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn")) as pool:
             return pool.submit(_execute_here, str(scene_dir), plan, seed, None if video_path is None else
-                               str(video_path), max_wall_s, sac_steps, retries, reward_mode).result()
-    return _execute_here(scene_dir, plan, seed, video_path, max_wall_s, sac_steps, retries, reward_mode)
+                               str(video_path), max_wall_s, sac_steps, retries, reward_mode,
+                               None if final_graph_path is None else str(final_graph_path)).result()
+    return _execute_here(scene_dir, plan, seed, video_path, max_wall_s, sac_steps, retries, reward_mode,
+                         final_graph_path)
 
 
 def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float, sac_steps: int,
-                  retries: int = 1, reward_mode: str = "spec") -> SkillResult:
+                  retries: int = 1, reward_mode: str = "spec", final_graph_path=None) -> SkillResult:
     from anomalygen.control.driver import Driver
     from anomalygen.rng import item_rng
     from anomalygen.scene.graph import load_scene
@@ -231,6 +237,11 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
                                      attempts=attempt))
     drv.settle(25)
     final = _evaluate(plan.success.predicates, model, data, spec, plan.bindings)
+    if final_graph_path is not None:
+        from anomalygen.runfolder import write_model
+        from anomalygen.scene.graph import scene_graph
+
+        write_model(Path(final_graph_path), scene_graph(model, data, spec))
     timings["execute_s"] = round(time.perf_counter() - t0 - timings["load_s"], 3)
     timings["control_steps"] = float(drv.steps)
     video = None

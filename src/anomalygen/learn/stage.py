@@ -9,17 +9,19 @@ At the end a success table by hazard class goes to stderr and into ``summary.res
 from __future__ import annotations
 
 from collections import defaultdict
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from anomalygen.errors import ItemFailed
 from anomalygen.runfolder import RunFolder, try_read_model, write_model
 from anomalygen.runner import StageContext, StageSummary, run_items
-from anomalygen.schema import Plan, SkillResult
+from anomalygen.schema import FixOutcome, Plan, SceneGraph, SkillResult
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
 
 STAGE = "learn"
+FINAL_GRAPH = "final_graph.json"  # the scene graph after execution, for the referee
 
 
 def _item_id(task_id: str, seed: int) -> str:
@@ -41,39 +43,75 @@ def learn_item(item_id: str, payload: dict, ctx: StageContext) -> dict:
         raise ItemFailed(f"no valid plan for {task_id}")
     out = run.skill_dir(task_id, seed)
     video = out / "video.mp4" if settings.learn.video else None
+    final_graph = out / FINAL_GRAPH
     result = execute_plan(run.scene_dir(task_id), plan, seed=seed, video_path=video,
                           sac_steps=settings.learn.sac_steps, retries=settings.learn.retries,
-                          reward_mode=settings.learn.reward_mode)
+                          reward_mode=settings.learn.reward_mode, final_graph_path=final_graph)
     if result.video:
         result = result.model_copy(update={"video": "video.mp4"})
+    result = result.model_copy(update={"outcome": referee_verdict(run.scene_dir(task_id), final_graph)})
     write_model(out / "result.json", result)
     return {"success": result.success, "hazard_class": payload["hazard_class"]}
 
 
+def referee_verdict(scene_dir, final_graph_path) -> FixOutcome | None:
+    """The hidden-truth verdict, after the robot has finished (None for a scene without truth.json)."""
+    from anomalygen.evaluate.referee import judge_fix, load_manifest
+    from anomalygen.knowledge import load_kb
+
+    manifest = load_manifest(scene_dir)
+    initial = try_read_model(Path(scene_dir) / "scene_graph.json", SceneGraph)
+    final = try_read_model(Path(final_graph_path), SceneGraph)
+    if manifest is None or initial is None or final is None:
+        return None
+    return judge_fix(manifest, initial, final, load_kb())
+
+
 def success_table(run: RunFolder, items: list[tuple[str, dict]]) -> dict[str, dict[str, float]]:
-    """Per hazard class: executions, successes, rate (from the result files on disk)."""
-    acc: dict[str, list[int]] = defaultdict(lambda: [0, 0])
+    """Per hazard class: executions; the robot's own verdict (``success``); the referee's verdict
+    against the hidden truth (``resolved``, over the runs that have a truth manifest, ``judged``);
+    and the harm done (``new_hazards``, ``on_safe``: runs that acted on a near-miss)."""
+    acc: dict[str, dict[str, int]] = defaultdict(lambda: dict.fromkeys(TABLE_COUNTS, 0))
     for item_id, payload in items:
         task_id, seed = _split(item_id)
         res = try_read_model(run.skill_dir(task_id, seed) / "result.json", SkillResult)
         row = acc[payload["hazard_class"]]
-        row[0] += 1
-        row[1] += int(bool(res is not None and res.success))
-    return {hc: {"n": n, "success": s, "rate": round(s / n, 3) if n else 0.0} for hc, (n, s) in sorted(acc.items())}
+        row["n"] += 1
+        row["success"] += int(bool(res is not None and res.success))
+        if res is not None and res.outcome is not None:
+            row["judged"] += 1
+            row["resolved"] += int(res.outcome.resolved)
+            row["new_hazards"] += int(bool(res.outcome.new_hazards))
+            row["on_safe"] += int(bool(res.outcome.interventions_on_safe))
+    table: dict[str, dict[str, float]] = {}
+    for hc, row in sorted(acc.items()):
+        table[hc] = {**row, "rate": round(row["success"] / row["n"], 3) if row["n"] else 0.0,
+                     "resolved_rate": round(row["resolved"] / row["judged"], 3) if row["judged"] else 0.0}
+    return table
+
+
+TABLE_COUNTS = ("n", "success", "judged", "resolved", "new_hazards", "on_safe")
 
 
 def _print_table(table: dict[str, dict[str, float]]) -> None:
     from rich.console import Console
     from rich.table import Table
 
-    t = Table(title="skill success by hazard class")
-    for col in ("hazard class", "runs", "success", "rate"):
+    t = Table(title="fixes by hazard class (robot's verdict vs the hidden truth)")
+    columns = ("hazard class", "runs", "robot: done", "truth: resolved", "new hazards", "acted on safe")
+    for col in columns:
         t.add_column(col, justify="left" if col == "hazard class" else "right")
+
+    def cells(name: str, row: dict) -> list[str]:
+        n, judged = row["n"], row["judged"]
+        done = f"{row['success']} ({row['success'] / n:.0%})" if n else "-"
+        resolved = f"{row['resolved']}/{judged} ({row['resolved'] / judged:.0%})" if judged else "no truth"
+        return [name, str(n), done, resolved, str(row["new_hazards"]), str(row["on_safe"])]
+
     for hc, row in table.items():
-        t.add_row(hc, str(row["n"]), str(row["success"]), f"{row['rate']:.0%}")
-    n = sum(r["n"] for r in table.values())
-    s = sum(r["success"] for r in table.values())
-    t.add_row("all", str(n), str(s), f"{s / n:.0%}" if n else "-")
+        t.add_row(*cells(hc, row))
+    total = {k: sum(r[k] for r in table.values()) for k in TABLE_COUNTS}
+    t.add_row(*cells("all", total))
     Console(stderr=True).print(t)
 
 

@@ -152,6 +152,8 @@ class LLMClient:
                 result = parse_reply(raw.text, schema)
             except ReplyInvalid as exc:
                 last_error = str(exc)
+                if raw.completion_tokens >= limit:  # cut off, not wrong: say so rather than hide it
+                    last_error = f"reply truncated at max_tokens={limit}; {last_error}"
             else:
                 self._store(pending)
                 return result
@@ -273,7 +275,7 @@ class LLMClient:
                 raise LLMItemError(
                     self._scrub(f"{self.backend.name} request failed: {_one_line(str(exc))}")
                 ) from None
-            self._account(raw)
+            self._account(raw, req.max_tokens)
             return raw
         raise AssertionError("unreachable")  # pragma: no cover
 
@@ -284,7 +286,7 @@ class LLMClient:
                 delay *= 1.0 + 0.25 * float(self._rng.random())
         return delay
 
-    def _account(self, raw: RawReply) -> None:
+    def _account(self, raw: RawReply, max_tokens: int | None = None) -> None:
         cost = None
         p_in, p_out = self.config.price_prompt_per_mtok, self.config.price_completion_per_mtok
         if p_in is not None or p_out is not None:
@@ -293,6 +295,8 @@ class LLMClient:
             self.usage.requests += 1
             self.usage.prompt_tokens += raw.prompt_tokens
             self.usage.completion_tokens += raw.completion_tokens
+            if max_tokens is not None and raw.completion_tokens >= max_tokens:
+                self.usage.truncated += 1
             if cost is not None:
                 self.usage.cost_usd = (self.usage.cost_usd or 0.0) + cost
 

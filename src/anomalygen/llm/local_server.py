@@ -146,6 +146,11 @@ class LocalServer:
         words = line[0].split() if line else []
         if len(words) == 2 and words[0] == "READY":
             return words[1]
+        if not reader.is_alive():  # stdout closed: the child is exiting; let its status be read
+            try:
+                proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                pass
         status = describe_exit(proc.poll())
         tail = self.log_tail()
         self.stop()

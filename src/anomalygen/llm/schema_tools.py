@@ -92,3 +92,34 @@ def _cap(node: Any, *, max_string: int, max_items: int, required_only: bool) -> 
             int(out.get("maxItems", max_items)), max(max_items, int(out.get("minItems", 0)))
         )
     return out
+
+
+#: Tokens a reply spends per field kind: a free-text string (a sentence or a few), a short name, a
+#: list (a few names), plus the JSON punctuation and the field name itself.
+TOKENS_PER_TEXT_FIELD = 96
+TOKENS_PER_NAME_FIELD = 16
+TOKENS_PER_LIST_FIELD = 48
+TEXT_FIELD_HINTS = ("sentence", "why", "situation", "explanation", "description", "how", "words")
+
+
+def reply_token_budget(schema: type[BaseModel], *, floor: int = 128, cap: int | None = None) -> int:
+    """``max_tokens`` for one reply of ``schema``, sized from its fields rather than one global value.
+
+    Why: a fixed budget either truncates a long object (the reply is then invalid JSON) or, when
+    several objects are asked for at once, hides how many were cut off. Free-text fields (named like
+    description or documented as sentences) get a paragraph's worth, names a few words, lists a few
+    names; 25 % on top covers JSON syntax and the field names. ``cap`` (the configured
+    ``llm.max_tokens``) stays an upper bound the user can set.
+    """
+    total = 0
+    for name, info in schema.model_fields.items():
+        doc = f"{name} {info.description or ''}".lower()
+        annotation = str(info.annotation)
+        if "list" in annotation:
+            total += TOKENS_PER_LIST_FIELD
+        elif any(h in doc for h in TEXT_FIELD_HINTS) or name in ("solution", "success_condition", "explanation"):
+            total += TOKENS_PER_TEXT_FIELD
+        else:
+            total += TOKENS_PER_NAME_FIELD
+    budget = max(floor, int(total * 1.25))
+    return budget if cap is None else min(budget, int(cap))

@@ -204,19 +204,21 @@ def _cavity_cap(asset) -> float:
     return 0.8 * 2 * float(min(cav.half_extents))
 
 
-def _clutter_names(kb, exclude: set[str], rng, n: int) -> list[str]:
+def is_dressing(kb, name: str) -> bool:
+    """Can ``name`` dress a scene as clutter? Small household things with no hazard property, so a
+    decoration never becomes a second hazard (also the filter for the LLM engine's auxiliaries)."""
     from anomalygen.knowledge.models import HAZARD_PROPERTIES
 
-    names = []
-    for name in select._catalogue():
-        info = kb.objects.get(name)
-        if info is None or info.kind != "household" or name in exclude:
-            continue
-        if set(info.properties) & (HAZARD_PROPERTIES | {"furniture", "appliance"}):
-            continue
-        if info.size_range[0] > CLUTTER_MAX_SIZE:
-            continue
-        names.append(name)
+    info = kb.objects.get(name)
+    if info is None or info.kind != "household":
+        return False
+    if set(info.properties) & (HAZARD_PROPERTIES | {"furniture", "appliance"}):
+        return False
+    return info.size_range[0] <= CLUTTER_MAX_SIZE
+
+
+def _clutter_names(kb, exclude: set[str], rng, n: int) -> list[str]:
+    names = [name for name in select._catalogue() if name not in exclude and is_dressing(kb, name)]
     if not names or n <= 0:
         return []
     idx = rng.choice(len(names), size=min(n, len(names)), replace=False)
@@ -243,6 +245,7 @@ class Selection:
     support_var: select.Chosen | None = None
     aux: list[select.Chosen] = field(default_factory=list)
     hazard_is_target: bool = False
+    hints: object | None = None  # scene/hints.py: sizes, positions and auxiliaries from the LLM engine
 
     @property
     def variables(self) -> set[str]:
@@ -253,8 +256,12 @@ class Selection:
         cat = select.resolve_name(raw)
         if cat in self.by_catalogue:
             return self.by_catalogue[cat]
+        want = self.hints.size_for(cat) if self.hints is not None else None
         asset = select.pick_asset(cat, role=role, kb=self.kb, task=self.task, hc=self.hc, rng=self.rng, cap=cap,
-                                  rank=rank)
+                                  rank=rank, size=want)
+        if want is not None and abs(asset.size - want) > 1e-3:
+            self.hints.note(f"size:{cat}", f"size {want:.3f} m does not fit the generator's range or the space "
+                            f"available; built at {asset.size:.3f} m", value=want, limit=round(float(asset.size), 4))
         ch = select.Chosen(_instance_name(cat, self.used), cat, role, asset)
         self.by_catalogue[cat] = ch
         return ch
@@ -265,12 +272,15 @@ class Selection:
         self.used.discard(ch.name)
 
 
-def select_objects(task: TaskProposal, rng) -> Selection:
-    """Choose an asset for every role the task needs (target, hazard, container, supports, co-objects)."""
+def select_objects(task: TaskProposal, rng, hints=None) -> Selection:
+    """Choose an asset for every role the task needs (target, hazard, container, supports, co-objects).
+
+    ``hints`` (scene/hints.py, from the LLM engine) supply sizes, floor positions and the auxiliary
+    objects instead of the random draws; every correction is noted in them or in the layout."""
     kb = _kb()
     sc = task.scenario
     kind, parent_raw = _parse_placement(sc.placement)
-    sel = Selection(task, rng, kb, kb.hazard_classes.get(task.hazard_class), kind, parent_raw)
+    sel = Selection(task, rng, kb, kb.hazard_classes.get(task.hazard_class), kind, parent_raw, hints=hints)
     hc, variables = sel.hc, sel.variables
     sel.hazard_is_target = select.resolve_name(sc.hazard_object) == select.resolve_name(task.target_asset)
     # Big things first: they bound what fits in/on them.
@@ -380,6 +390,11 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
     target, parent, hazard = sel.target, sel.parent, sel.hazard
     support_kind = kind if kind in SURFACE_PLACEMENTS else None
     lay = Layout(rng, relevant_in_cube=settings.build.relevant_in_unit_cube)
+    if sel.hints is not None:
+        for ch in sel.by_catalogue.values():
+            xy = sel.hints.world_xy(ch.catalogue)
+            if xy is not None:
+                lay.preferred[ch.name] = xy
     placed: dict[str, Placed] = {}
     support: Placed | None = None
     if support_kind is not None:
@@ -396,9 +411,15 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
         lay.place_on_floor(support, relevant=True, face=True)
         placed[support.name] = support
     side: Placed | None = None
-    clutter = _clutter_names(sel.kb, set(sel.by_catalogue), rng, settings.build.clutter)
+    if sel.hints is not None:  # the LLM's auxiliaries dress the scene instead of random clutter
+        clutter = [a for a in sel.hints.auxiliaries if a not in sel.by_catalogue]
+    else:
+        clutter = _clutter_names(sel.kb, set(sel.by_catalogue), rng, settings.build.clutter)
     if clutter:
         side = _support_placed("table", _instance_name("Table", used), rng)
+        spots = [xy for xy in (sel.hints.world_xy(a) for a in clutter) if xy is not None] if sel.hints is not None else []
+        if spots:  # the auxiliaries stand where the LLM put them, on a side table outside the cube
+            lay.preferred[side.name] = np.mean(spots, axis=0)
         lay.place_on_floor(side, relevant=False, face=True)
         placed[side.name] = side
     task_objects = [target, parent, sel.container, sel.support_var, *sel.aux]
@@ -432,12 +453,16 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
     # Clutter on the side table, away from its edges; an item that does not fit is left out.
     if side is not None:
         for cat in clutter:
-            asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng)
+            want = sel.hints.size_for(cat) if sel.hints is not None else None
+            asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng,
+                                      size=want)
             ch = select.Chosen(_instance_name(cat, used), cat, ObjectRole.CLUTTER, asset)
             p = _placed(ch)
             try:
                 lay.place_on_surface(p, side, _surface_of(side), inward=INWARD)
             except ItemFailed:
+                if sel.hints is not None:
+                    sel.hints.note(f"auxiliary:{cat}", "did not fit on the side table; left out")
                 continue
             placed[p.name] = p
 
@@ -519,9 +544,9 @@ def bind_roles(sel: Selection, support: Placed | None) -> dict[str, str]:
     return bindings
 
 
-def _plan(task: TaskProposal, settings: Settings, rng) -> tuple[Layout, dict[str, str], dict[str, Placed]]:
+def _plan(task: TaskProposal, settings: Settings, rng, hints=None) -> tuple[Layout, dict[str, str], dict[str, Placed]]:
     """Choose and place every object; returns the layout, bindings and instances by name."""
-    sel = select_objects(task, rng)
+    sel = select_objects(task, rng, hints)
     set_initial_joints(sel)
     lay, placed, support = place(sel, settings)
     return lay, bind_roles(sel, support), placed
@@ -782,14 +807,16 @@ def _set_joints(model, data, placed: dict[str, Placed]) -> None:
 # ============================================================================ attempt
 
 
-def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int) -> Built:
+def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hints=None) -> Built:
     import mujoco
 
     from anomalygen.scene import validate as val
     from anomalygen.scene.graph import scene_graph
 
     rng = item_rng(seed, task.id, attempt)
-    lay, bindings, placed = _plan(task, settings, rng)
+    hints = hints.model_copy(deep=True) if hints is not None else None  # each attempt records its own
+    lay, bindings, placed = _plan(task, settings, rng, hints)
+    notes = _hint_notes(hints, lay)
     mjspec = _compose(lay, placed, settings, rng)
     model = mjspec.compile()
     data = mujoco.MjData(model)
@@ -801,7 +828,7 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int) ->
     spec = _scene_spec(task, seed, lay, placed, bindings, model, data)
     overlap = val.initial_overlap(model, data, spec)
     if overlap is not None:
-        report = ValidationReport(ok=False, reason=overlap, checks=[])
+        report = ValidationReport(ok=False, reason=overlap, checks=notes)
         return Built(spec, mjspec, model, data, report, None)
     nsteps = max(1, int(round(settings.build.settle_s / model.opt.timestep)))
     mujoco.mj_step(model, data, nstep=nsteps)
@@ -812,7 +839,22 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int) ->
     graph = scene_graph(model, data, spec)
     hc = _kb().hazard_classes.get(task.hazard_class)
     report = val.validate(model, data, spec, graph, hc)
+    report.checks = notes + report.checks
     return Built(spec, mjspec, model, data, report, graph)
+
+
+def _hint_notes(hints, lay: Layout) -> list[ValidationCheck]:
+    """Every correction to an engine's sizes and positions, for the validation report (none offline)."""
+    if hints is None:
+        return []
+    done = {c.name for c in lay.corrections}
+    notes = list(hints.checks) + list(lay.corrections)
+    notes += [
+        ValidationCheck(name=f"position:{name}", passed=True, detail="placed by its scenario placement (on or in "
+                        "another object), not at the proposed floor spot")
+        for name in lay.preferred if f"position:{name}" not in done
+    ]
+    return notes
 
 
 def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, model, data) -> SceneSpec:
@@ -876,14 +918,16 @@ def scene_id_for(task_id: str) -> str:
 # ============================================================================ public entry
 
 
-def build_scene(task: TaskProposal, *, seed: int, settings: Settings, out_dir: Path) -> SceneSpec:
-    """Build, settle, validate, repair and write one scene; raises ItemFailed with a one-line reason."""
+def build_scene(task: TaskProposal, *, seed: int, settings: Settings, out_dir: Path, hints=None) -> SceneSpec:
+    """Build, settle, validate, repair and write one scene; raises ItemFailed with a one-line reason.
+
+    ``hints`` come from a non-default scene engine (``scene/llm_engine.py``); None keeps the draws."""
     attempts = settings.build.repair_attempts + 1
     reason = "no attempt made"
     built = None
     for attempt in range(attempts):
         try:
-            built = _attempt(task, seed, settings, attempt)
+            built = _attempt(task, seed, settings, attempt, hints)
         except ItemFailed as exc:
             reason = str(exc)
             log.debug("%s attempt %d: %s", task.id, attempt, reason)
@@ -902,7 +946,7 @@ def build_scene(task: TaskProposal, *, seed: int, settings: Settings, out_dir: P
         built = None
     if built is None:
         raise ItemFailed(f"no valid scene after {attempts} attempt(s): {reason}")
-    return write_outputs(built, settings, Path(out_dir))
+    return write_outputs(built, settings, Path(out_dir), hazard_class=task.hazard_class)
 
 
 def _vlm_check(task, built: Built, settings: Settings) -> None:
@@ -917,8 +961,10 @@ def _vlm_check(task, built: Built, settings: Settings) -> None:
     )
 
 
-def write_outputs(built: Built, settings: Settings, out_dir: Path) -> SceneSpec:
+def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_class: str | None = None) -> SceneSpec:
+    """scene.xml, renders, scene_graph.json, the hidden truth.json (with ``hazard_class``), scene.json last."""
     from anomalygen.scene.render import SceneRenderer, png_bytes
+    from anomalygen.scene.truth import TRUTH_FILE, hazard_manifest
 
     out_dir.mkdir(parents=True, exist_ok=True)
     model, data, mjspec = built.model, built.data, built.mjspec
@@ -937,6 +983,8 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path) -> SceneSpec:
             files[f"render_{cam}"] = f"render_{cam}.png"
     spec = built.spec.model_copy(update={"validation": built.report, "files": files})
     write_model(out_dir / "scene_graph.json", built.graph)
+    if hazard_class is not None:
+        write_model(out_dir / TRUTH_FILE, hazard_manifest(spec, hazard_class, built.graph, _kb()))
     write_model(out_dir / "scene.json", spec)  # last: its presence marks the scene done
     return spec
 

@@ -19,7 +19,7 @@ import numpy as np
 from anomalygen.errors import ItemFailed
 from anomalygen.scene.furniture import Support
 from anomalygen.scene.robot import BASE_RADIUS
-from anomalygen.schema import ObjectRole
+from anomalygen.schema import ObjectRole, ValidationCheck
 
 REGION_ORIGIN = np.array([0.8, -0.6, 0.0])  # world position of the cube corner (0, 0, 0)
 REGION_SIZE = np.array([1.1, 1.2, 1.0])
@@ -99,6 +99,10 @@ class Layout:
         self.relevant_in_cube = relevant_in_cube
         self.items: list[Placed] = []
         self.base = np.array([0.0, 0.0, 0.0])
+        #: Floor positions an engine proposed per instance (the LLM scene engine); tried first.
+        self.preferred: dict[str, np.ndarray] = {}
+        #: What the solver did with each preferred position, for the scene's validation report.
+        self.corrections: list[ValidationCheck] = []
 
     # ---------------------------------------------------------------- proposals
     def propose_xy(self, relevant: bool) -> np.ndarray:
@@ -155,10 +159,14 @@ class Layout:
     def place_on_floor(
         self, obj: Placed, *, relevant: bool, face: bool = True, clear_of: list[Placed] | None = None
     ) -> None:
-        """Stand ``obj`` on the floor at a proposal that overlaps nothing (furniture faces the robot)."""
+        """Stand ``obj`` on the floor at a proposal that overlaps nothing (furniture faces the robot).
+
+        A preferred position is tried first; if it overlaps, the solver falls back on its own draws
+        and records the move."""
+        want = self.preferred.get(obj.name)
         for attempt in range(2 * TRIES):
             # a crowded cube: fall back to anywhere in the room rather than fail the scene
-            xy = self.propose_xy(relevant and attempt < TRIES)
+            xy = want.copy() if (want is not None and attempt == 0) else self.propose_xy(relevant and attempt < TRIES)
             if face and obj.front is not None:
                 # furniture faces the robot, square to the room (multiples of 90 degrees)
                 yaw = face_robot_yaw(obj.front, self.base[:2] - xy)
@@ -179,8 +187,17 @@ class Layout:
             if not self.collides(obj):
                 obj.support = "floor"
                 self.items.append(obj)
+                if want is not None:
+                    self._record_preferred(obj, want, moved=attempt > 0)
                 return
         raise ItemFailed(f"no free floor spot for {obj.name}")
+
+    def _record_preferred(self, obj: Placed, want: np.ndarray, *, moved: bool) -> None:
+        got = obj.world_center()[:2]
+        shift = float(np.linalg.norm(got - want))
+        detail = (f"proposed at ({want[0]:.2f}, {want[1]:.2f}) overlapped another object, the robot or the walkway; "
+                  f"moved to ({got[0]:.2f}, {got[1]:.2f})") if moved else f"placed at the proposed ({want[0]:.2f}, {want[1]:.2f})"
+        self.corrections.append(ValidationCheck(name=f"position:{obj.name}", passed=True, value=round(shift, 4), detail=detail))
 
     def place_on_surface(
         self,

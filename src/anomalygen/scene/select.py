@@ -106,9 +106,12 @@ def kb_size_range(kb, catalogue: str) -> tuple[float, float] | None:
     return tuple(info.size_range) if info is not None else None
 
 
-def choose_size(kb, catalogue: str, rng: np.random.Generator, *, cap: float | None = None) -> float:
+def choose_size(
+    kb, catalogue: str, rng: np.random.Generator, *, cap: float | None = None, preferred: float | None = None
+) -> float:
     """Largest dimension: uniform in the knowledge base's range (intersected with the generator's),
-    clamped by ``cap`` (the spatial rule of a container opening or a support surface)."""
+    clamped by ``cap`` (the spatial rule of a container opening or a support surface). A
+    ``preferred`` size (an engine's, e.g. the LLM's) is used instead of the draw, clamped the same way."""
     from anomalygen.assets.core import size_range
 
     lo, hi = size_range(catalogue)
@@ -121,6 +124,8 @@ def choose_size(kb, catalogue: str, rng: np.random.Generator, *, cap: float | No
         if cap < lo:
             raise ItemFailed(f"{catalogue} (at least {lo:.2f} m) does not fit a {cap:.2f} m space")
         hi = min(hi, cap)
+    if preferred is not None:
+        return float(min(hi, max(lo, preferred)))
     return float(rng.uniform(lo, hi))
 
 
@@ -188,6 +193,7 @@ def pick_asset(
     rng: np.random.Generator,
     cap: float | None = None,
     rank: bool = False,
+    size: float | None = None,
 ):
     """Generate candidates, verify them, rank the target ones by SBERT; the first plausible one wins."""
     from anomalygen.assets.core import generate
@@ -197,8 +203,7 @@ def pick_asset(
     seeds = [int(s) for s in rng.integers(0, 2**31 - 1, size=n)]
     candidates, problems = [], []
     for s in seeds:
-        size = choose_size(kb, catalogue, rng, cap=cap)
-        asset = generate(catalogue, s, size=size)
+        asset = generate(catalogue, s, size=choose_size(kb, catalogue, rng, cap=cap, preferred=size))
         problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap)
         if problem is None:
             candidates.append(asset)

@@ -11,9 +11,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from anomalygen.runfolder import RunFolder, atomic_write_bytes, try_read_model
+from anomalygen.runfolder import RunFolder, atomic_write_bytes, try_read_model, write_model
 from anomalygen.runner import StageContext, StageSummary, run_items
-from anomalygen.schema import SceneSpec, TaskProposal
+from anomalygen.schema import Engine, SceneSpec, TaskProposal
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
@@ -33,8 +33,16 @@ def build_item(item_id: str, payload: str, ctx: StageContext) -> str:
 
     task = TaskProposal.model_validate_json(payload)
     settings = ctx.settings
+    out_dir = ctx.run.scene_dir(item_id)
     with _one_torch_thread():
-        spec = build_scene(task, seed=settings.seed, settings=settings, out_dir=ctx.run.scene_dir(item_id))
+        hints = None
+        if settings.build.engine == Engine.LLM:  # explicit only: the offline engine stays the default
+            from anomalygen.scene.llm_engine import plan_scene
+
+            hints = plan_scene(task, settings)
+        spec = build_scene(task, seed=settings.seed, settings=settings, out_dir=out_dir, hints=hints)
+    if hints is not None:
+        write_model(out_dir / "llm_layout.json", hints)  # what the LLM said, before the builder's corrections
     return spec.scene_id
 
 
