@@ -64,6 +64,9 @@ class BuildConfig(Section):
     clutter: int = Field(2, ge=0, description="unrelated everyday objects added per scene")
     near_misses: int = Field(1, ge=0, description="hazard-looking objects placed safely per scene (scene/mix.py)")
     multi_hazard: float = Field(0.25, ge=0, le=1, description="share of scenes given a second hazard (litter on the floor)")
+    hazard_free: float = Field(
+        0.15, ge=0, le=1, description="share of scenes built with the task's hazard made safe (shut away, closed)"
+    )
     settle_s: float = Field(1.0, gt=0)
     render_width: int = Field(320, ge=32)
     render_height: int = Field(240, ge=32)

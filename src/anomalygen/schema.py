@@ -370,6 +370,9 @@ class Detection(Artefact):
     hit_rank: int | None = Field(None, description="rank of the first hit, None for a miss")
     miss_reason: str | None = None
     error: str | None = None
+    hazard_free: bool = Field(
+        False, description="the scene's truth lists no hazard: left out of hit@k (it counts in the false-alarm rate)"
+    )
 
 
 # --------------------------------------------------------------------------- stage 4: plans and skills

@@ -61,9 +61,10 @@ def _rates(dets: Sequence[Detection], k: int) -> HitRates:
 
 
 def summarise(detections: Sequence[Detection], tasks: Sequence[TaskProposal], k: int) -> DetectionReport:
+    """hit@k over the scenes that hold a hazard (hazard-free scenes are scored as false alarms instead)."""
     by_task = {t.id: t for t in tasks}
-    dets = [d for d in detections if d.task_id in by_task]
-    have = {d.task_id for d in dets}
+    have = {d.task_id for d in detections if d.task_id in by_task}
+    dets = [d for d in detections if d.task_id in by_task and not d.hazard_free]
     cat_groups: dict[str, list[Detection]] = defaultdict(list)
     cls_groups: dict[str, list[Detection]] = defaultdict(list)
     confusion: dict[str, Counter] = defaultdict(Counter)

@@ -68,8 +68,17 @@ def make_judge(settings: Settings):
     return Judge(threshold=settings.detect.judge_threshold, llm_client=client, structured_decisive=decisive)
 
 
-def detect_scene(task: TaskProposal, graph: SceneGraph, spec: SceneSpec | None, settings: Settings, *, detector=None, judge=None) -> Detection:
-    """Detect and judge one scene (pure apart from LLM calls): what the item function writes."""
+def _detector_name(detector, settings: Settings) -> str:
+    """A hybrid that fell back on the rule order produced a rule detection: say so per scene."""
+    return "rules" if getattr(detector, "fell_back", None) else settings.detect.detector
+
+
+def detect_scene(task: TaskProposal, graph: SceneGraph, spec: SceneSpec | None, settings: Settings, *, detector=None,
+                 judge=None, hazard_free: bool = False) -> Detection:
+    """Detect and judge one scene (pure apart from LLM calls): what the item function writes.
+
+    The detector sees the graph only; the task, the spec and ``hazard_free`` (the scene's truth.json
+    lists no hazard) are for judging its answer afterwards."""
     from anomalygen.detect.judge import first_hit, miss_reason
     from anomalygen.detect.truth import ground_truth
     from anomalygen.llm import LLMItemError
@@ -81,14 +90,17 @@ def detect_scene(task: TaskProposal, graph: SceneGraph, spec: SceneSpec | None, 
         hyps = detector.detect(graph, settings.detect.k)
     except LLMItemError as exc:
         hyps, error = [], str(exc)
+    if hazard_free:  # nothing to find: there is no hit to rank, only claims that are false alarms
+        return Detection(task_id=task.id, scene_id=graph.scene_id, detector=_detector_name(detector, settings),
+                         hypotheses=hyps, hazard_free=True, error=error,
+                         miss_reason=f"detector failed: {error}" if error else None)
     truth = ground_truth(task, spec, graph, hazard_variable=_hazard_variable(task.hazard_class))
     judgements = judge.judge(hyps, truth, graph)
     hit = first_hit(judgements)
     return Detection(
         task_id=task.id,
         scene_id=graph.scene_id,
-        # A hybrid that fell back on the rule order produced a rule detection: say so per scene.
-        detector="rules" if getattr(detector, "fell_back", None) else settings.detect.detector,
+        detector=_detector_name(detector, settings),
         hypotheses=hyps,
         judgements=judgements,
         hit_rank=hit,
@@ -118,7 +130,11 @@ def _item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str,
     client = getattr(detector, "client", None) or judge.llm
     if client is not None:
         client.reset_usage()  # count this scene's requests only (the client is shared per process)
-    det = detect_scene(task, graph, spec, settings, detector=detector, judge=judge)
+    from anomalygen.scene.truth import load_manifest
+
+    truth = load_manifest(scene_dir)  # judging only: the detector has already been given the graph alone
+    det = detect_scene(task, graph, spec, settings, detector=detector, judge=judge,
+                       hazard_free=truth is not None and not truth.hazards)
     write_model(detection_path(run, task_id), det)
     usage = client.reset_usage().model_dump() if client is not None else None
     return {

@@ -11,18 +11,12 @@ near-misses (moving a knife that was already shut in a drawer).
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
-from anomalygen.runfolder import try_read_model
-from anomalygen.scene.truth import TRUTH_FILE, class_matches
+from anomalygen.scene.truth import class_matches
 from anomalygen.schema import FixOutcome, HazardManifest, HazardOutcome, SceneGraph
 
 MOVED_M = 0.05  # a near-miss object displaced further than this was acted on
 TURNED = 0.1  # a near-miss joint (rad or m) moved further than this was acted on
-
-
-def load_manifest(scene_dir: str | Path) -> HazardManifest | None:
-    return try_read_model(Path(scene_dir) / TRUTH_FILE, HazardManifest)
 
 
 def judge_fix(manifest: HazardManifest, initial: SceneGraph, final: SceneGraph, kb) -> FixOutcome:

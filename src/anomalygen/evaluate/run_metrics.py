@@ -29,7 +29,9 @@ def class_distribution(tasks: Sequence[TaskProposal]) -> dict[str, int]:
 
 
 def hit_at_k(detections: Sequence[Detection], k: int) -> dict[int, float]:
-    """Fraction of scenes whose first correct hypothesis has rank <= j, for j = 1..k (errors are misses)."""
+    """Fraction of scenes whose first correct hypothesis has rank <= j, for j = 1..k (errors are misses;
+    hazard-free scenes have nothing to hit and are left out)."""
+    detections = [d for d in detections if not d.hazard_free]
     n = len(detections)
     return {j: (sum(1 for d in detections if d.hit_rank is not None and d.hit_rank <= j) / n if n else 0.0)
             for j in range(1, k + 1)}
@@ -114,7 +116,7 @@ def load_tasks(run: RunFolder) -> list[TaskProposal]:
 
 def load_manifests(run: RunFolder, tasks: Sequence[TaskProposal]) -> dict:
     """Task id -> the builder's truth manifest, for scenes that have one (the answer key: metrics only)."""
-    from anomalygen.evaluate.referee import load_manifest
+    from anomalygen.scene.truth import load_manifest
 
     return {t.id: m for t in tasks if (m := load_manifest(run.scene_dir(t.id))) is not None}
 

@@ -56,8 +56,9 @@ def learn_item(item_id: str, payload: dict, ctx: StageContext) -> dict:
 
 def referee_verdict(scene_dir, final_graph_path) -> FixOutcome | None:
     """The hidden-truth verdict, after the robot has finished (None for a scene without truth.json)."""
-    from anomalygen.evaluate.referee import judge_fix, load_manifest
+    from anomalygen.evaluate.referee import judge_fix
     from anomalygen.knowledge import load_kb
+    from anomalygen.scene.truth import load_manifest
 
     manifest = load_manifest(scene_dir)
     initial = try_read_model(Path(scene_dir) / "scene_graph.json", SceneGraph)

@@ -48,6 +48,9 @@ def _plan_from_oracle(task_id: str, payload: dict, ctx: StageContext) -> Plan:
     spec = try_read_model(ctx.run.scene_dir(task_id) / "scene.json", SceneSpec)
     bindings = dict(spec.bindings) if spec is not None else {}
     hazard_class = payload["hazard_class"]
+    if spec is not None and not spec.bindings:  # a hazard-free scene: the oracle knows there is nothing to fix
+        return Plan(task_id=task_id, source="ground_truth", engine=settings.engine_for("learn"), subtasks=[],
+                    success=SuccessSpec(predicates=[]), bindings={})
     if settings.engine_for("learn").value == "llm":
         return _plan_with_llm(task_id, payload, ctx, hazard_class, bindings, spec, None)
     return plan_from_kb(task_id, hazard_class, bindings, spec=spec, source="ground_truth",

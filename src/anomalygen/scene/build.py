@@ -62,6 +62,7 @@ INWARD = 0.13  # m kept from a support's edge by things that are not the edge ha
 HAZARD_NEAR_SIDE = 0.4  # m: the hazard's centre at most this far from the robot-facing edge (arm's reach)
 LOOSE_ON_SUPPORT_MAX = 0.35  # m: a loose task object smaller than this goes on the support, not the floor
 CLUTTER_MAX_SIZE = 0.3
+SAFE_STATE = {"open": "closed", "on": "off"}  # a part's state in a hazard-free scene
 
 
 LOOSE_SOLREF = 0.005  # s: contact time constant of loose objects (2.5 physics steps)
@@ -246,6 +247,7 @@ class Selection:
     aux: list[select.Chosen] = field(default_factory=list)
     hazard_is_target: bool = False
     hints: object | None = None  # scene/hints.py: sizes, positions and auxiliaries from the LLM engine
+    hazard_free: bool = False  # build the task's hazard in its safe state (scene/mix.py)
 
     @property
     def variables(self) -> set[str]:
@@ -377,10 +379,13 @@ def set_initial_joints(sel: Selection) -> None:
         ):
             label = parent.asset.joint(cav.joint).label
             uses.setdefault(parent.catalogue, []).append((label, "open"))
+    if sel.hazard_free:  # every part the hazard needed open or on is built shut instead
+        uses = {cat: [(p, SAFE_STATE.get(st, st)) for p, st in pairs] for cat, pairs in uses.items()}
     for cat, pairs in uses.items():
         if cat in sel.by_catalogue:
             select.set_articulations(sel.by_catalogue[cat], pairs, sel.rng)
-    _check_articulations(task, hc, sel.by_catalogue, sel.target)
+    if not sel.hazard_free:
+        _check_articulations(task, hc, sel.by_catalogue, sel.target)
 
 
 def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed], Placed | None]:
@@ -435,7 +440,10 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
         lay.place_on_floor(p, relevant=True, face=True)
 
     if hazard.name not in placed:
-        _place_hazard(sel, lay, placed, support, support_kind)
+        if sel.hazard_free:
+            _place_hazard_safely(sel, lay, placed, support)
+        else:
+            _place_hazard(sel, lay, placed, support, support_kind)
 
     # Remaining loose task objects: on the support (away from its edge) or on the floor.
     for ch in task_objects:
@@ -467,7 +475,7 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
             placed[p.name] = p
 
     items = mix.choose_judgement_items(sel.task.id, sel.task.hazard_class, set(sel.by_catalogue) | set(clutter),
-                                       sel.kb, settings)
+                                       sel.kb, settings, hazard_free=sel.hazard_free)
     _place_judgement_items(sel, lay, placed, [s for s in (side, support) if s is not None], items)
 
     focus = placed[hazard.name]
@@ -527,6 +535,30 @@ def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], suppor
         raise ItemFailed(f"unsupported placement {sel.task.scenario.placement!r}")
 
 
+def _place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None) -> None:
+    """The task's object where it is no hazard: shut inside its container, else well inside the
+    surface, else on the floor away from the walkway (a second chance for the layout)."""
+    hazard, container = sel.hazard, sel.container
+    hp = placed[hazard.name] = _placed(hazard)
+    if container is not None and container is not hazard and container.asset.cavities:
+        holder = placed.get(container.name)
+        if holder is None:
+            holder = placed[container.name] = _placed(container)
+            lay.place_on_floor(holder, relevant=True, face=True)
+        lo, hi, _ = _cavity_world(holder)
+        lay.place_in_cavity(hp, holder, (lo, hi))
+        for joint in container.asset.joints:  # shut every lid, door and drawer of the container
+            if select.kb_label(joint.label) in ENCLOSING_LABELS:
+                holder.joint_values[joint.name] = float(joint.closed_value)
+        holder.sweep = 0.0
+        return
+    if support is not None:
+        lay.place_on_surface(hp, support, _surface_of(support), inward=INWARD, near_side=HAZARD_NEAR_SIDE)
+        return
+    fixtures = [p for p in lay.items if p.fixed]
+    lay.place_on_floor(hp, relevant=True, face=False, clear_of=fixtures)
+
+
 def bind_roles(sel: Selection, support: Placed | None) -> dict[str, str]:
     """The role variables ($hazard, $target, $container, $support) bound to instance names."""
     kind, parent = sel.kind, sel.parent
@@ -544,12 +576,16 @@ def bind_roles(sel: Selection, support: Placed | None) -> dict[str, str]:
     return bindings
 
 
-def _plan(task: TaskProposal, settings: Settings, rng, hints=None) -> tuple[Layout, dict[str, str], dict[str, Placed]]:
-    """Choose and place every object; returns the layout, bindings and instances by name."""
+def _plan(task: TaskProposal, settings: Settings, rng, hints=None,
+          hazard_free: bool = False) -> tuple[Layout, dict[str, str], dict[str, Placed]]:
+    """Choose and place every object; returns the layout, bindings and instances by name.
+
+    A hazard-free scene has no bindings: there is nothing to fix, and the oracle plans nothing."""
     sel = select_objects(task, rng, hints)
+    sel.hazard_free = hazard_free
     set_initial_joints(sel)
     lay, placed, support = place(sel, settings)
-    return lay, bind_roles(sel, support), placed
+    return lay, ({} if hazard_free else bind_roles(sel, support)), placed
 
 
 def _co_object_for(hc, kb, candidates) -> select.Chosen | None:
@@ -807,7 +843,8 @@ def _set_joints(model, data, placed: dict[str, Placed]) -> None:
 # ============================================================================ attempt
 
 
-def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hints=None) -> Built:
+def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hints=None,
+             hazard_free: bool = False) -> Built:
     import mujoco
 
     from anomalygen.scene import validate as val
@@ -815,7 +852,7 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
 
     rng = item_rng(seed, task.id, attempt)
     hints = hints.model_copy(deep=True) if hints is not None else None  # each attempt records its own
-    lay, bindings, placed = _plan(task, settings, rng, hints)
+    lay, bindings, placed = _plan(task, settings, rng, hints, hazard_free)
     notes = _hint_notes(hints, lay)
     mjspec = _compose(lay, placed, settings, rng)
     model = mjspec.compile()
@@ -838,9 +875,24 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
     spec = _scene_spec(task, seed, lay, placed, bindings, model, data)
     graph = scene_graph(model, data, spec)
     hc = _kb().hazard_classes.get(task.hazard_class)
-    report = val.validate(model, data, spec, graph, hc)
+    report = val.validate(model, data, spec, graph, None if hazard_free else hc)
+    if hazard_free and report.ok:
+        report = _check_hazard_free(report, graph, task.hazard_class)
     report.checks = notes + report.checks
     return Built(spec, mjspec, model, data, report, graph)
+
+
+def _check_hazard_free(report: ValidationReport, graph, hazard_class: str) -> ValidationReport:
+    """A hazard-free variant must not show the task's hazard anywhere once settled."""
+    from anomalygen.scene.truth import class_matches
+
+    still = sorted(obj for cls, obj, _ in class_matches(graph, _kb()) if cls == hazard_class)
+    check = ValidationCheck(name="hazard_free", passed=not still,
+                            detail=f"{hazard_class} still holds for {', '.join(still)}" if still else "made safe")
+    report.checks.append(check)
+    if still:
+        report.ok, report.reason = False, check.detail
+    return report
 
 
 def _hint_notes(hints, lay: Layout) -> list[ValidationCheck]:
@@ -918,8 +970,12 @@ def scene_id_for(task_id: str) -> str:
 # ============================================================================ public entry
 
 
-def build_scene(task: TaskProposal, *, seed: int, settings: Settings, out_dir: Path, hints=None) -> SceneSpec:
+def build_scene(task: TaskProposal, *, seed: int, settings: Settings, out_dir: Path, hints=None,
+                hazard_free: bool = False) -> SceneSpec:
     """Build, settle, validate, repair and write one scene; raises ItemFailed with a one-line reason.
+
+    ``hazard_free`` builds the task's object in its safe state (``scene/mix.py``); its truth.json then
+    lists only what the settled scene really shows.
 
     ``hints`` come from a non-default scene engine (``scene/llm_engine.py``); None keeps the draws."""
     attempts = settings.build.repair_attempts + 1
@@ -927,7 +983,7 @@ def build_scene(task: TaskProposal, *, seed: int, settings: Settings, out_dir: P
     built = None
     for attempt in range(attempts):
         try:
-            built = _attempt(task, seed, settings, attempt, hints)
+            built = _attempt(task, seed, settings, attempt, hints, hazard_free)
         except ItemFailed as exc:
             reason = str(exc)
             log.debug("%s attempt %d: %s", task.id, attempt, reason)
@@ -946,7 +1002,7 @@ def build_scene(task: TaskProposal, *, seed: int, settings: Settings, out_dir: P
         built = None
     if built is None:
         raise ItemFailed(f"no valid scene after {attempts} attempt(s): {reason}")
-    return write_outputs(built, settings, Path(out_dir), hazard_class=task.hazard_class)
+    return write_outputs(built, settings, Path(out_dir), hazard_class=None if hazard_free else task.hazard_class)
 
 
 def _vlm_check(task, built: Built, settings: Settings) -> None:
@@ -962,7 +1018,9 @@ def _vlm_check(task, built: Built, settings: Settings) -> None:
 
 
 def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_class: str | None = None) -> SceneSpec:
-    """scene.xml, renders, scene_graph.json, the hidden truth.json (with ``hazard_class``), scene.json last."""
+    """scene.xml, renders, scene_graph.json, the hidden truth.json, scene.json last.
+
+    ``hazard_class`` is the hazard the builder set up (None for a hazard-free scene)."""
     from anomalygen.scene.render import SceneRenderer, png_bytes
     from anomalygen.scene.truth import TRUTH_FILE, hazard_manifest
 
@@ -983,8 +1041,7 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_cla
             files[f"render_{cam}"] = f"render_{cam}.png"
     spec = built.spec.model_copy(update={"validation": built.report, "files": files})
     write_model(out_dir / "scene_graph.json", built.graph)
-    if hazard_class is not None:
-        write_model(out_dir / TRUTH_FILE, hazard_manifest(spec, hazard_class, built.graph, _kb()))
+    write_model(out_dir / TRUTH_FILE, hazard_manifest(spec, hazard_class, built.graph, _kb()))
     write_model(out_dir / "scene.json", spec)  # last: its presence marks the scene done
     return spec
 

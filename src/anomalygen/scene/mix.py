@@ -7,7 +7,10 @@ names the most alarming object scores perfectly without judging anything. So the
   inside a table top (``INWARD`` from every edge, beyond the knowledge base's edge distance), which a
   careless detector would flag and a careful one leaves alone;
 - **a second hazard**, in ``build.multi_hazard`` of the scenes: a piece of litter on the floor, with a
-  bin in the room so the robot can fix it.
+  bin in the room so the robot can fix it;
+- **no hazard at all**, in ``build.hazard_free`` of the scenes: the task's object is built in its safe
+  state instead (shut in its container, well inside its surface, its door or lid closed), so the
+  scene holds a near-miss where the hazard would have been.
 
 Every draw comes from a generator of its own (``item_rng(seed, task, "mix")``), so with both
 features off a scene is exactly what it was without this module. Whatever ends up hazardous or safe
@@ -58,8 +61,10 @@ class JudgementItems:
     rng: np.random.Generator | None = None
 
 
-def choose_judgement_items(task_id: str, hazard_class: str, in_scene: set[str], kb, settings: Settings) -> JudgementItems:
-    """The near-misses and second hazard for one scene, drawn from the scene's own mix generator."""
+def choose_judgement_items(task_id: str, hazard_class: str, in_scene: set[str], kb, settings: Settings,
+                           *, hazard_free: bool = False) -> JudgementItems:
+    """The near-misses and second hazard for one scene, drawn from the scene's own mix generator
+    (a hazard-free scene gets no second hazard: it is meant to hold none)."""
     cfg = settings.build
     rng = item_rng(settings.seed, task_id, "mix")
     items = JudgementItems(rng=rng)
@@ -67,7 +72,8 @@ def choose_judgement_items(task_id: str, hazard_class: str, in_scene: set[str], 
     if names and cfg.near_misses > 0:
         picks = rng.choice(len(names), size=min(cfg.near_misses, len(names)), replace=False)
         items.near_misses = [names[i] for i in sorted(picks)]
-    if cfg.multi_hazard > 0 and hazard_class != SECOND_HAZARD_CLASS and rng.random() < cfg.multi_hazard:
+    second = rng.random() < cfg.multi_hazard if cfg.multi_hazard > 0 else False
+    if second and not hazard_free and hazard_class != SECOND_HAZARD_CLASS:
         hc = kb.hazard_classes[SECOND_HAZARD_CLASS]
         cands = [n for n in kb.hazard_candidates(hc) if n not in in_scene
                  and kb.objects[n].size_range[0] <= MAX_ITEM_SIZE]
@@ -77,3 +83,9 @@ def choose_judgement_items(task_id: str, hazard_class: str, in_scene: set[str], 
             if bins and not set(bins) & in_scene:
                 items.bin = bins[0]
     return items
+
+
+def is_hazard_free(task_id: str, settings: Settings) -> bool:
+    """Whether this task's scene is built with its hazard made safe (``build.hazard_free`` of the scenes)."""
+    share = settings.build.hazard_free
+    return share > 0 and float(item_rng(settings.seed, task_id, "hazard-free").random()) < share

@@ -30,6 +30,7 @@ def scene_ok(scene_dir: Path) -> bool:
 def build_item(item_id: str, payload: str, ctx: StageContext) -> str:
     """Build one task's scene; returns the scene id (ItemFailed propagates as the item's reason)."""
     from anomalygen.scene.build import build_scene
+    from anomalygen.scene.mix import is_hazard_free
 
     task = TaskProposal.model_validate_json(payload)
     settings = ctx.settings
@@ -40,7 +41,8 @@ def build_item(item_id: str, payload: str, ctx: StageContext) -> str:
             from anomalygen.scene.llm_engine import plan_scene
 
             hints = plan_scene(task, settings)
-        spec = build_scene(task, seed=settings.seed, settings=settings, out_dir=out_dir, hints=hints)
+        spec = build_scene(task, seed=settings.seed, settings=settings, out_dir=out_dir, hints=hints,
+                           hazard_free=is_hazard_free(task.id, settings))
     if hints is not None:
         write_model(out_dir / "llm_layout.json", hints)  # what the LLM said, before the builder's corrections
     return spec.scene_id

@@ -29,6 +29,15 @@ TRUTH_FILE = "truth.json"
 CHOSEN_BY_THE_FIX = ("container", "support")  # predicate arguments the fix may fill with any object
 
 
+def load_manifest(scene_dir) -> HazardManifest | None:
+    """The scene's truth.json (for the referee and the scorers only), or None when there is none."""
+    from pathlib import Path
+
+    from anomalygen.runfolder import try_read_model
+
+    return try_read_model(Path(scene_dir) / TRUTH_FILE, HazardManifest)
+
+
 def bound_success(hc, fault_variable: str, fault_object: str, bindings: dict[str, str]) -> list[PredicateCall]:
     """The class's success predicates over the object at fault, with '*' where the fix chooses."""
     fixed = {fault_variable: fault_object}
@@ -80,11 +89,12 @@ def class_matches(graph: SceneGraph, kb) -> list[tuple[str, str, dict[str, str]]
     return [(hc_id, obj, b) for (hc_id, obj), b in sorted(found.items())]
 
 
-def hazard_manifest(spec: SceneSpec, hazard_class: str, graph: SceneGraph, kb) -> HazardManifest:
-    """The manifest of a settled, validated scene built for a task of ``hazard_class``."""
+def hazard_manifest(spec: SceneSpec, hazard_class: str | None, graph: SceneGraph, kb) -> HazardManifest:
+    """The manifest of a settled, validated scene built for a task of ``hazard_class`` (None: the
+    builder set up no hazard, and only what the settled scene shows is listed)."""
     category = {o.name: o.category for o in graph.objects}
     hazards: list[ManifestHazard] = []
-    hc = kb.hazard_classes.get(hazard_class)
+    hc = kb.hazard_classes.get(hazard_class) if hazard_class else None
     intended: set[str] = set()
     if hc is not None:
         var = hc.hazard_variable if hc.hazard_variable in spec.bindings else "$hazard"
