@@ -25,6 +25,7 @@ Names other stages rely on (see docs/scene.md), each a constant below so no modu
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -255,6 +256,9 @@ class Robot:
     """
 
     def __init__(self, model: mujoco.MjModel):
+        import mujoco
+
+        self._mj = mujoco
         self.model = model
         self.cup = int(model.body(CUP_BODY).id)
         self.cup_geom = int(model.geom(CUP_GEOM).id)
@@ -300,24 +304,34 @@ class Robot:
 
     def move_target(self, data: mujoco.MjData, action, *, dp: float, dr: float) -> None:
         """Move the target by ``dp * a[:3]`` (leashed) and turn it by the axis-angle ``a[3:6]`` (at most
-        ``dr`` rad) in the cup frame. ``action`` entries must already lie in [-1, 1].
+        ``dr`` rad) in the cup frame. ``action`` is a float64 array whose entries lie in [-1, 1].
 
         The arithmetic is exactly that of the SAC door benchmark's env, so its learning curves (and
         the tests that pin them) are unchanged: the axis is ``a / (|a| + 1e-9)``, and the target
-        quaternion is renormalised every step.
+        quaternion is renormalised every step. Scalar maths where it gives numpy's exact values, and
+        MuJoCo's own quaternion functions where it would not, keep it cheap: it is every env's hot path.
         """
-        import mujoco
-
         if data is not self._data:  # cache the views: each MjData attribute access is a pybind call
             self._data = data
-            self._mpos, self._mquat = data.mocap_pos[self.mocap], data.mocap_quat[self.mocap]
-            self._dq, self._q = np.zeros(4), np.zeros(4)
-        a = np.asarray(action, dtype=float)
-        self.leash(data, self._mpos + dp * a[:3])
-        n = np.linalg.norm(a[3:6])
-        mujoco.mju_axisAngle2Quat(self._dq, a[3:6] / (n + 1e-9), dr * min(1.0, n))
-        mujoco.mju_mulQuat(self._q, self._mquat, self._dq)  # q_target * dq: a turn about the cup's own axes
-        self._mquat[:] = self._q / np.linalg.norm(self._q)
+            self._mpos, self._mquat, self._cpos = data.mocap_pos[self.mocap], data.mocap_quat[self.mocap], data.xpos[self.cup]
+            self._axis, self._dq, self._q = np.zeros(3), np.zeros(4), np.zeros(4)
+        a0, a1, a2, a3, a4, a5 = action.tolist()[:6]
+        mx, my, mz = self._mpos.tolist()
+        cx, cy, cz = self._cpos.tolist()
+        lim = TARGET_LEASH
+        # cup + clip(target + dp * a - cup): float for float the same operations as numpy's
+        self._mpos[:] = (cx + min(max(mx + dp * a0 - cx, -lim), lim), cy + min(max(my + dp * a1 - cy, -lim), lim),
+                         cz + min(max(mz + dp * a2 - cz, -lim), lim))
+        r = action[3:6]
+        n = math.sqrt(r.dot(r))  # = np.linalg.norm(r); a Python sum of squares rounds differently
+        k = n + 1e-9
+        self._axis[:] = (a3 / k, a4 / k, a5 / k)
+        self._mj.mju_axisAngle2Quat(self._dq, self._axis, dr * min(1.0, n))
+        q = self._q
+        self._mj.mju_mulQuat(q, self._mquat, self._dq)  # q_target * dq: a turn about the cup's own axes
+        w, x, y, z = q.tolist()
+        k = math.sqrt(q.dot(q))  # = np.linalg.norm(q)
+        self._mquat[:] = (w / k, x / k, y / k, z / k)
 
     def apply_action(self, data: mujoco.MjData, action, *, dp: float, dr: float) -> np.ndarray:
         """Map one 7-D action onto the target and the suction toggle (no physics step).
