@@ -106,3 +106,12 @@ def test_the_truth_verdict_is_counted_apart_from_the_robots_own():
     assert (s.resolved.successes, s.resolved.n) == (1, 3)
     assert s.resolved_by_class["dispose_spoiled_food"].rate == 0.5 and s.resolved_by_class["store_sharp_objects"].n == 1
     assert (s.new_hazards, s.on_safe) == (1, 1)
+
+
+def test_hazard_free_scenes_are_left_out_of_hit_at_k():
+    from anomalygen.schema import Detection, Hypothesis
+
+    hit = Detection(task_id="a", scene_id="s", detector="rules", hit_rank=1,
+                    hypotheses=[Hypothesis(rank=1, problem="p", solution="s", target_object="k_0")])
+    quiet = Detection(task_id="b", scene_id="s2", detector="rules", hazard_free=True, hypotheses=[])
+    assert rm.hit_at_k([hit, quiet], 2) == {1: 1.0, 2: 1.0}

@@ -1,0 +1,50 @@
+"""Hazard-free scenes: the task's object is built in its safe state and the answer key says so."""
+
+from __future__ import annotations
+
+from anomalygen.config import Settings
+from anomalygen.runfolder import read_model
+from anomalygen.schema import HazardManifest, SceneGraph, SceneSpec
+
+from .conftest import TASKS
+
+SAFE = Settings(build={"clutter": 1, "near_misses": 0, "multi_hazard": 0.0})
+
+
+def _build(key, tmp_path):
+    from anomalygen.scene.build import build_scene
+
+    out = tmp_path / key
+    build_scene(TASKS[key], seed=0, settings=SAFE, out_dir=out, hazard_free=True)
+    return (read_model(out / "scene.json", SceneSpec), read_model(out / "scene_graph.json", SceneGraph),
+            read_model(out / "truth.json", HazardManifest))
+
+
+def test_a_hazard_free_fridge_scene_has_its_door_shut_and_an_empty_answer_key(tmp_path):
+    spec, graph, truth = _build("fridge", tmp_path)
+    fridge = next(o for o in graph.objects if o.category == "Refrigerator")
+    assert all(j.open_fraction < 0.05 for j in fridge.joints if j.label == "door")
+    assert truth.hazards == [] and spec.bindings == {}
+    assert any(c.name == "hazard_free" and c.passed for c in spec.validation.checks)
+
+
+def test_a_hazard_free_pill_scene_shuts_the_pills_away(tmp_path):
+    from anomalygen.scene.truth import class_matches
+    from anomalygen.knowledge import load_kb
+
+    spec, graph, truth = _build("floor", tmp_path)  # a button battery, normally on the floor
+    battery = next(o for o in graph.objects if o.category == "button_battery")
+    assert not battery.on_floor and not battery.child_reachable
+    assert any(r.subject == battery.name and r.predicate == "inside" for r in graph.relations)
+    assert not any(obj == battery.name for _, obj, _ in class_matches(graph, load_kb()))
+    assert truth.hazards == [] and battery.name in {n.object for n in truth.near_misses}
+
+
+def test_the_share_of_hazard_free_scenes_follows_the_setting():
+    from anomalygen.scene.mix import is_hazard_free
+
+    ids = [f"t{i:04d}" for i in range(400)]
+    share = sum(is_hazard_free(t, Settings()) for t in ids) / len(ids)
+    assert 0.10 <= share <= 0.20  # default 0.15
+    assert not any(is_hazard_free(t, Settings(build={"hazard_free": 0.0})) for t in ids)
+    assert [is_hazard_free(t, Settings()) for t in ids] == [is_hazard_free(t, Settings()) for t in ids]
