@@ -45,7 +45,11 @@ def main() -> int:
     ap.add_argument("--retries", type=int, default=None, help="learn.retries (closed-loop redos; default: config's)")
     a = ap.parse_args()
     run = Path(a.out or tempfile.mkdtemp(prefix="bench_primitives_")) / "run"
-    env = {**os.environ, "ANOMALYGEN_LEARN__VIDEO": "false"}
+    # the oracle plans on single-hazard scenes: this figure measures the skills, not detection (that is
+    # bench_loop.py), so plans come from the builder's bindings and the judgement mix is off
+    env = {**os.environ, "ANOMALYGEN_LEARN__VIDEO": "false", "ANOMALYGEN_LEARN__PLAN_SOURCE": "ground_truth",
+           "ANOMALYGEN_BUILD__HAZARD_FREE": "0", "ANOMALYGEN_BUILD__MULTI_HAZARD": "0",
+           "ANOMALYGEN_BUILD__NEAR_MISSES": "0"}
     if a.retries is not None:
         env["ANOMALYGEN_LEARN__RETRIES"] = str(a.retries)
     t0 = time.perf_counter()
@@ -54,10 +58,10 @@ def main() -> int:
     chosen = [t["id"] for t in tasks if t["hazard_class"] in PRIMITIVE_CLASSES]
     only = [x for tid in chosen for x in ("--only", tid)]
     t_build = time.perf_counter()
-    _cli("build", "--run", str(run), "--workers", str(a.workers), "--seed", str(a.seed), *only)
+    _cli("build", "--run", str(run), "--workers", str(a.workers), "--seed", str(a.seed), *only, env=env)
     built = [tid for tid in chosen if (run / "scenes" / tid / "scene.json").is_file()]
     only = [x for tid in built for x in ("--only", tid)]
-    _cli("plan", "--run", str(run), *only)
+    _cli("plan", "--run", str(run), *only, env=env)
     t_learn = time.perf_counter()
     _cli("learn", "--run", str(run), "--seeds", str(a.seeds), "--workers", str(a.workers), *only, env=env)
     t_end = time.perf_counter()

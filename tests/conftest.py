@@ -15,11 +15,13 @@ for key in [k for k in os.environ if k.startswith("ANOMALYGEN_")]:
     del os.environ[key]
 
 
+import pytest  # noqa: E402
+
+
+@pytest.hookimpl(tryfirst=True)  # before xdist reads the groups in its own hook
 def pytest_collection_modifyitems(items):
     """Tests on the real GGUF share one xdist worker (``--dist loadgroup``): two llama.cpp servers,
     each spinning two threads on a two-core machine, starve each other and the physics tests."""
-    import pytest
-
     for item in items:
         if item.get_closest_marker("gguf") and not item.get_closest_marker("xdist_group"):
             item.add_marker(pytest.mark.xdist_group("gguf"))

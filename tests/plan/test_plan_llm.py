@@ -157,9 +157,20 @@ def test_a_good_reply_becomes_the_plan_it_describes(scripted_server, tmp_path): 
     assert "store_sharp_objects" in question and "role" not in question.split("Hazard class")[0]
 
 
+def test_a_loosely_named_object_is_grounded_without_a_repair(scripted_server, tmp_path):  # noqa: F811
+    loose = json.loads(json.dumps(FRIDGE_REPLY))
+    loose["subtasks"][0]["params"]["object"] = "the Fridge"
+    srv = scripted_server([text(json.dumps(loose))])
+    client = get_client(llm_config_for(srv, tmp_path, cache=False))
+    spec = fridge_scene()
+    plan = P.plan_from_llm("t-fridge", "close_open_refrigerator", dict(spec.bindings), spec=spec, client=client)
+    assert plan.subtasks[0].params == {"object": "refrigerator_0", "part": "door", "target": 0.0}
+    assert len(srv.requests) == 1 and client.usage.retries == 0
+
+
 def test_a_reply_naming_an_object_not_in_the_scene_is_repaired(scripted_server, tmp_path):  # noqa: F811
     bad = json.loads(json.dumps(FRIDGE_REPLY))
-    bad["subtasks"][0]["params"]["object"] = "fridge"
+    bad["subtasks"][0]["params"]["object"] = "flux_capacitor"
 
     def responder(req):
         return text(json.dumps(FRIDGE_REPLY if _repairing(req) else bad))
@@ -171,7 +182,7 @@ def test_a_reply_naming_an_object_not_in_the_scene_is_repaired(scripted_server, 
     assert plan.subtasks[0].params == {"object": "refrigerator_0", "part": "door", "target": 0.0}
     assert len(srv.requests) == 2
     repair = srv.requests[1]["messages"][-1]["content"]
-    assert "'fridge' is not an object in the scene" in repair and "refrigerator_0" in repair
+    assert "'flux_capacitor' is not an object in the scene" in repair and "refrigerator_0" in repair
     assert client.usage.requests == 2 and client.usage.retries == 1
 
 

@@ -189,6 +189,20 @@ def detection_rows(d) -> tuple[list[str], list[list], list[str]]:
     return ["detector", "scenes", *[f"hit@{k}" for k in ks]], rows, [""] * (len(rows) - 1) + ["paper"]
 
 
+def _hazard_table_html(t) -> str:
+    """Per class, against the hidden truth: hazards present, detected, planned, resolved; then the harm."""
+    def pct(a: int, b: int) -> str:
+        return f"{a} ({a / b:.0%})" if b else "-"
+
+    rows = [[name, r.hazards, pct(r.detected, r.hazards), pct(r.planned, r.hazards), f"{pct(r.resolved, r.runs)} of {r.runs}"]
+            for name, r in [*t.by_class.items(), ("all classes", t.total)]]
+    table = _table(["hazard class", "hazards present", "detected", "planned", "resolved (runs)"], rows)
+    return (f"<p>Every hazard in every scene's hidden truth, by class: {t.scenes} scenes, "
+            f"{t.hazard_free_scenes} of them hazard-free. Runs that created a new hazard: "
+            f"{pct(t.runs_with_new_hazards, t.runs)}; runs that acted on an already-safe object: "
+            f"{pct(t.runs_acting_on_safe, t.runs)}.</p>{table}")
+
+
 def render_html(report: Report, run: RunFolder) -> str:
     ev = report.evaluation
     parts = []
@@ -279,6 +293,8 @@ def render_html(report: Report, run: RunFolder) -> str:
                 f"({_f(s.overall.rate, 2)}) over {s.tasks} tasks. Runs that created a new hazard: {s.new_hazards}; "
                 f"runs that acted on an already-safe object: {s.on_safe}; {s.errors} runs ended with an error. "
                 "Paper: 83% (human-judged).</p>")
+        if ev.hazards is not None:
+            body = _hazard_table_html(ev.hazards) + body
         parts.append(_section("success", "Resolution success", body))
     else:
         parts.append(_section("success", "Resolution success", _not_run("learn")))

@@ -11,6 +11,7 @@ from typing import Literal
 from pydantic import Field
 
 from anomalygen.detect.score import DetectionScores
+from anomalygen.evaluate.hazard_table import HazardTable
 from anomalygen.schema import Artefact, LLMUsage, StageRecord, Strict
 
 
@@ -91,6 +92,7 @@ class Evaluation(Artefact):
     scenes_failed: int = 0
     detection: DetectionSummary | None = None
     success: SuccessSummary | None = None
+    hazards: HazardTable | None = Field(None, description="per class: present, detected, planned, resolved (truth)")
     timings: dict[str, StageRecord] = Field(default_factory=dict)
     llm_usage: LLMUsage = Field(default_factory=LLMUsage)
     not_run: list[str] = Field(default_factory=list, description="stages with no artefacts yet")

@@ -80,11 +80,20 @@ def evaluate_run(run: RunFolder, settings: Settings) -> Evaluation:
         detection=(rm.detection_summary(detections, tasks, settings.detect.k, rm.load_manifests(run, tasks))
                    if detections else None),
         success=rm.success_summary(results, tasks) if results else None,
+        hazards=_hazards(run, tasks, settings),
         timings=dict(manifest.stages),
         llm_usage=manifest.llm_usage,
         not_run=not_run,
         wall_s=timings,
     )
+
+
+def _hazards(run: RunFolder, tasks, settings: Settings):
+    """The loop table, when the scenes carry truth manifests (None for runs built before them)."""
+    from anomalygen.evaluate.hazard_table import hazard_table
+
+    table = hazard_table(run, [t.id for t in tasks], settings.learn.seeds)
+    return table if table.scenes else None
 
 
 def measured_ablation(run_name: str, rows: list[DiversityRow], group_of: dict[str, tuple[str, str]]) -> list[AblationRow]:

@@ -50,6 +50,9 @@ MAX_SUBTASKS = 8
 # --------------------------------------------------------------------------- reply schema
 
 
+KEEP_AS_WRITTEN = {"ee", "surface_centre"}  # reply words that are not object names
+
+
 class ReplyParams(BaseModel):
     """Primitive parameters, flat: each primitive reads the ones it needs (see PRIMITIVES)."""
 
@@ -333,6 +336,11 @@ def reply_schema(scene: PlanScene) -> type[TaskPlan]:
     }
 
     class TaskPlanInScene(TaskPlan):
+        @model_validator(mode="before")
+        @classmethod
+        def _grounded(cls, data: Any) -> Any:
+            return ground_reply_names(data, scene)
+
         @model_validator(mode="after")
         def _in_scene(self) -> TaskPlanInScene:
             problems = check_reply(self, scene)
@@ -356,6 +364,40 @@ def reply_schema(scene: PlanScene) -> type[TaskPlan]:
 
     TaskPlanInScene.__name__ = TaskPlanInScene.__qualname__ = "TaskPlan"
     return TaskPlanInScene
+
+
+def ground_reply_names(data: Any, scene: PlanScene) -> Any:
+    """Object names the model wrote loosely ("the fridge", "Kettle") resolved to the scene's instances
+    by the one grounding module (spelling, aliases, retrieval), before validation. A name that even
+    retrieval cannot place is left as written, so the scene check names it and the repair turn asks
+    again."""
+    if not isinstance(data, dict) or not isinstance(data.get("subtasks"), list):
+        return data
+    from anomalygen.knowledge.grounding import shared_grounder
+
+    vocab = shared_grounder().instances([(o.name, o.asset.category) for o in scene.spec.objects])
+
+    def grounded(value: Any, where: str) -> Any:
+        if not isinstance(value, str) or value in scene.objects or value.startswith("$") or value in KEEP_AS_WRITTEN:
+            return value
+        head, sep, tail = value.partition(":")
+        match = vocab.ground(head, where).grounded
+        return f"{match}{sep}{tail}" if match is not None else value
+
+    for st in data["subtasks"]:
+        if not isinstance(st, dict):
+            continue
+        params = st.get("params")
+        if isinstance(params, dict):
+            for key in ("object", "region"):
+                if key in params:
+                    params[key] = grounded(params[key], f"params.{key}")
+        for term in st.get("reward") or []:
+            if isinstance(term, dict):
+                for key in ("a", "b"):
+                    if key in term:
+                        term[key] = grounded(term[key], f"reward.{key}")
+    return data
 
 
 # --------------------------------------------------------------------------- prompt

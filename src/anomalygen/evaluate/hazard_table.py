@@ -1,0 +1,93 @@
+"""The loop in one table: per hazard class, hazards present, detected, planned and resolved.
+
+Every figure is counted against the builder's hidden truth (``truth.json``), hazard by hazard, over
+every class: a hazard is *detected* when a claim of the scene's detection names it, *planned* when the
+scene's plan acts on its object, *resolved* when the referee found it fixed at the end of a run (over
+the runs of its scene). Harm is counted per run: runs that created a new hazard, and runs that acted
+on a near-miss (an object that was already safe).
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+
+from pydantic import Field
+
+from anomalygen.runfolder import RunFolder, try_read_model
+from anomalygen.schema import Detection, Plan, SkillResult, Strict
+
+
+class ClassRow(Strict):
+    hazards: int = 0
+    detected: int = 0
+    planned: int = 0
+    runs: int = Field(0, description="(hazard, seed) executions judged")
+    resolved: int = Field(0, description="of those, the hazard was fixed at the end")
+
+
+class HazardTable(Strict):
+    by_class: dict[str, ClassRow] = Field(default_factory=dict)
+    total: ClassRow = Field(default_factory=ClassRow)
+    scenes: int = 0
+    hazard_free_scenes: int = 0
+    runs: int = Field(0, description="executions (scene, seed) judged by the referee")
+    runs_with_new_hazards: int = 0
+    runs_acting_on_safe: int = 0
+
+
+def hazard_table(run: RunFolder, task_ids: list[str], seeds: int) -> HazardTable:
+    """The table over ``task_ids`` (every scene with a truth.json), ``seeds`` runs per scene."""
+    from anomalygen.detect.score import claim_matches
+    from anomalygen.scene.truth import load_manifest
+
+    rows: dict[str, ClassRow] = defaultdict(ClassRow)
+    table = HazardTable()
+    for tid in task_ids:
+        manifest = load_manifest(run.scene_dir(tid))
+        if manifest is None:
+            continue
+        table.scenes += 1
+        table.hazard_free_scenes += int(not manifest.hazards)
+        det = try_read_model(run.detections_dir / f"{tid}.json", Detection)
+        plan = try_read_model(run.plan_path(tid), Plan)
+        acted = {str(st.params.get("object")) for st in plan.subtasks} if plan is not None else set()
+        results = [r for s in range(seeds) if (r := try_read_model(run.skill_dir(tid, s) / "result.json", SkillResult))]
+        for r in results:
+            if r.outcome is None:
+                continue
+            table.runs += 1
+            table.runs_with_new_hazards += int(bool(r.outcome.new_hazards))
+            table.runs_acting_on_safe += int(bool(r.outcome.interventions_on_safe))
+        for h in manifest.hazards:
+            row = rows[h.hazard_class]
+            row.hazards += 1
+            hyps = det.hypotheses if det is not None else []
+            row.detected += int(any(claim_matches(x, h.object, h.hazard_class, h.category) for x in hyps))
+            row.planned += int(h.object in acted)
+            for r in results:
+                outcome = next((o for o in (r.outcome.hazards if r.outcome else []) if o.object == h.object), None)
+                if outcome is not None:
+                    row.runs += 1
+                    row.resolved += int(outcome.resolved)
+    table.by_class = dict(sorted(rows.items()))
+    for row in table.by_class.values():
+        for key in ("hazards", "detected", "planned", "runs", "resolved"):
+            setattr(table.total, key, getattr(table.total, key) + getattr(row, key))
+    return table
+
+
+def markdown(table: HazardTable, title: str = "") -> str:
+    """The table as Markdown, one line a class and a total line."""
+    def pct(a: int, b: int) -> str:
+        return f"{a} ({a / b:.0%})" if b else "-"
+
+    lines = [f"**{title}**" if title else "", "",
+             "| hazard class | hazards | detected | planned | resolved (runs) |", "|---|---|---|---|---|"]
+    for name, r in [*table.by_class.items(), ("**all**", table.total)]:
+        lines.append(f"| {name} | {r.hazards} | {pct(r.detected, r.hazards)} | {pct(r.planned, r.hazards)} | "
+                     f"{pct(r.resolved, r.runs)} of {r.runs} |")
+    lines.append("")
+    lines.append(f"{table.scenes} scenes ({table.hazard_free_scenes} hazard-free), {table.runs} runs: "
+                 f"{pct(table.runs_with_new_hazards, table.runs)} created a new hazard, "
+                 f"{pct(table.runs_acting_on_safe, table.runs)} acted on an already-safe object.")
+    return "\n".join(lines).strip() + "\n"
