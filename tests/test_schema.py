@@ -53,6 +53,9 @@ def _example(cls):
         S.SkillResult: S.SkillResult(task_id="t", seed=0, success=True),
         S.RunManifest: S.RunManifest(name="r", created="2026-01-01T00:00:00+00:00", package_version="0"),
         S.ItemError: S.ItemError(item_id="t", stage="build", error="boom"),
+        S.HazardManifest: S.HazardManifest(scene_id="s", task_id="t", hazards=[S.ManifestHazard(
+            hazard_class="close_open_refrigerator", object="fridge_0", category="Refrigerator", severity=0.7,
+            variable="$target", success=[S.PredicateCall(name="joint_closed", args={"object": "fridge_0"})])]),
     }
     return examples[cls]
 

@@ -1,6 +1,6 @@
 """What the robot perceives of a built scene: the one door through which detect, plan and learn read it.
 
-Why one module: the builder writes the answer key next to the scene (``truth.json``, the role
+Why one module: the builder writes the answer key next to the scene (the truth manifest, the role
 bindings and object roles in ``scene.json``, the task itself). The robot side must never see them,
 or every figure it earns grades itself. Everything the robot side reads about a scene comes from
 here: the scene graph (objects, states, relations), the renders, the simulator model, and a copy of
