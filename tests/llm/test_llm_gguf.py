@@ -18,6 +18,9 @@ def test_llamacpp_cli_ask_returns_schema_valid_task_proposal(tmp_path, monkeypat
 
     assert bundled_model_path().suffix == ".gguf"
     monkeypatch.setenv("ANOMALYGEN_LLM__CACHE_PATH", str(tmp_path / "cache.sqlite"))
+    # a bounded budget: with the defaults (3 repairs of up to 1,024 tokens) a loaded 2-core box can spend 15 minutes
+    monkeypatch.setenv("ANOMALYGEN_LLM__MAX_TOKENS", "1024")
+    monkeypatch.setenv("ANOMALYGEN_LLM__REPAIR_RETRIES", "1")
     args = ["ask", "--backend", "llamacpp", "--schema", "TaskProposal", "--seed", "0"]
     args.append("A knife lies on the edge of a kitchen counter")
     result = CliRunner().invoke(app, args)
