@@ -154,12 +154,21 @@ class HazardClass(KBModel):
 
     def variable_names(self) -> list[str]:
         """Variables in first-use order across preconditions (the order match_class binds them)."""
-        seen: list[str] = []
-        for call in self.preconditions:
-            for value in call.args.values():
-                if isinstance(value, str) and value.startswith("$") and value not in seen:
-                    seen.append(value)
-        return seen
+        return _variables_in(call.args for call in self.preconditions)
+
+    def recipe_variable_names(self) -> list[str]:
+        """Variables the recipe's steps refer to, in first-use order (what a fix must bind)."""
+        return _variables_in(step.args for step in self.recipe)
+
+
+def _variables_in(arg_dicts) -> list[str]:
+    """``$variables`` among the values of ``arg_dicts``, each once, in first-use order."""
+    seen: list[str] = []
+    for args in arg_dicts:
+        for value in args.values():
+            if isinstance(value, str) and value.startswith("$") and value not in seen:
+                seen.append(value)
+    return seen
 
 
 class PartInfo(KBModel):

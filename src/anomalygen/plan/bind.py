@@ -21,16 +21,6 @@ from anomalygen.schema import GraphObject, SceneGraph
 REACH_TOP_M = 1.6  # a container whose top is higher than this is out of the arm's comfortable reach
 
 
-def recipe_variables(hc) -> list[str]:
-    """Role variables the class's recipe refers to, in first-use order."""
-    seen: list[str] = []
-    for step in hc.recipe:
-        for value in step.args.values():
-            if isinstance(value, str) and value.startswith("$") and value not in seen:
-                seen.append(value)
-    return seen
-
-
 def bind_fix(hc, fault: str, graph: SceneGraph, kb) -> dict[str, str]:
     """Every role variable of ``hc``'s recipe bound to a perceived object; ItemFailed when one cannot be."""
     from anomalygen.knowledge.predicates import PredicateError, match_class
@@ -45,7 +35,7 @@ def bind_fix(hc, fault: str, graph: SceneGraph, kb) -> dict[str, str]:
         matches = []
     if matches:
         bindings.update(sorted(matches[0].bindings.items()))
-    for var in recipe_variables(hc):
+    for var in hc.recipe_variable_names():
         if var in bindings:
             continue
         if var == "$container":
