@@ -90,7 +90,7 @@ RECIPE_ARGS: dict[str, tuple[str, ...]] = {
     "pick": ("object",),
     "place_inside": ("object", "container"),
     "place_on": ("object", "support"),
-    "open_joint": ("object", "label"),
+    "open_joint": ("object", "label", "fraction"),  # fraction: how far to open (default: most of the way)
     "close_joint": ("object", "label"),
     "switch_off": ("object", "label"),
     "move_away_from_edge": ("object",),

@@ -23,7 +23,7 @@ from anomalygen.schema import CLOSED_TOL, GraphObject, PredicateCall, PredicateR
 #: Horizontal clearance (m) from furniture/appliances beyond which a floor object is "in the walkway".
 WALKWAY_CLEARANCE = 0.3
 #: Properties of the objects that line a room (a floor object close to one of them is out of the way).
-_ROOM_FIXTURES = ("furniture", "appliance")
+ROOM_FIXTURES = ("furniture", "appliance")
 
 
 class PredicateError(ValueError):
@@ -286,7 +286,7 @@ def _in_walkway(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
     if ctx.relations(obj.name, "inside") or ctx.relations(obj.name, "under"):
         return False, f"{obj.name} is tucked away"
     fixtures = [
-        o for o in ctx.graph.objects if o.name != obj.name and any(p in o.properties for p in _ROOM_FIXTURES)
+        o for o in ctx.graph.objects if o.name != obj.name and any(p in o.properties for p in ROOM_FIXTURES)
     ]
     close = [o for o in fixtures if aabb_gap(obj, o, horizontal=True) <= WALKWAY_CLEARANCE]
     if close:

@@ -72,7 +72,8 @@ def _drive_joints(drv, st: SubTask, obj: str, prim: str, prm: dict):
             far = hi if abs(hi - closed) > abs(lo - closed) else lo
             goal = far if opening else closed
             gap = abs(float(drv.data.joint(js.name).qpos[0]) - goal) / max(abs(hi - lo), 1e-6)
-            cands.append((gap, js.name, closed + 0.6 * (far - closed) if opening else goal, closed,
+            fraction = float(prm.get("open_fraction", OPEN_FRACTION))
+            cands.append((gap, js.name, closed + fraction * (far - closed) if opening else goal, closed,
                           0.025 * abs(hi - lo)))
     if not cands and prm.get("joint") is not None:
         cands = [(1.0, str(prm["joint"]), float(prm.get("target", 0.0)), 0.0, 0.02)]

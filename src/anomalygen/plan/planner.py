@@ -80,6 +80,8 @@ def step_to_subtask(index: int, action: str, args: dict[str, str], bindings: dic
         params: dict = {"object": target_obj}
         if args.get("part"):
             params["part"] = args["part"]
+        if action == "open_joint" and args.get("fraction"):
+            params["open_fraction"] = float(args["fraction"])
         terms = [RewardTerm(kind="action_penalty", weight=0.01)]
         if joint is not None:
             params["joint"] = joint

@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from anomalygen.errors import ItemFailed
+from anomalygen.knowledge.predicates import ROOM_FIXTURES
 from anomalygen.rng import item_rng, stable_hash
 from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
 from anomalygen.scene import furniture, layout, mix, robot, robot_model, select
@@ -63,6 +64,7 @@ HAZARD_NEAR_SIDE = 0.4  # m: the hazard's centre at most this far from the robot
 LOOSE_ON_SUPPORT_MAX = 0.35  # m: a loose task object smaller than this goes on the support, not the floor
 CLUTTER_MAX_SIZE = 0.3
 SAFE_STATE = {"open": "closed", "on": "off"}  # a part's state in a hazard-free scene
+OPPOSITE_STATE = {"open": "closed", "closed": "open", "on": "off", "off": "on"}
 
 
 LOOSE_SOLREF = 0.005  # s: contact time constant of loose objects (2.5 physics steps)
@@ -366,9 +368,11 @@ def set_initial_joints(sel: Selection) -> None:
             uses.setdefault(select.resolve_name(a.object), []).append((a.part, a.initial_state))
         except ItemFailed:
             continue
+    class_part = None  # the part whose state is the class's hazard (a window left shut, a door left open)
     if hc is not None and hc.articulation is not None:
         var_obj = {"$target": sel.target, "$hazard": sel.hazard}.get(hc.articulation.variable)
         if var_obj is not None:
+            class_part = (var_obj.catalogue, hc.articulation.part)
             uses.setdefault(var_obj.catalogue, []).append(
                 (hc.articulation.part, hc.articulation.initial_state)
             )
@@ -379,13 +383,30 @@ def set_initial_joints(sel: Selection) -> None:
         ):
             label = parent.asset.joint(cav.joint).label
             uses.setdefault(parent.catalogue, []).append((label, "open"))
-    if sel.hazard_free:  # every part the hazard needed open or on is built shut instead
-        uses = {cat: [(p, SAFE_STATE.get(st, st)) for p, st in pairs] for cat, pairs in uses.items()}
+    if sel.hazard_free:  # the class's part in its opposite state; any other part open or on is shut
+        uses = {cat: [(p, (OPPOSITE_STATE if (cat, p) == class_part else SAFE_STATE).get(st, st)) for p, st in pairs]
+                for cat, pairs in uses.items()}
     for cat, pairs in uses.items():
         if cat in sel.by_catalogue:
             select.set_articulations(sel.by_catalogue[cat], pairs, sel.rng)
+    if sel.hazard_free and class_part is not None and class_part[0] in sel.by_catalogue:
+        _open_as_the_fix_would(sel.by_catalogue[class_part[0]], class_part[1], hc)
     if not sel.hazard_free:
         _check_articulations(task, hc, sel.by_catalogue, sel.target)
+
+
+def _open_as_the_fix_would(chosen: select.Chosen, label: str, hc) -> None:
+    """A part the fix opens only part way (a window opened a crack for air) is built that way in a
+    hazard-free scene: wide open it would be another class's hazard."""
+    step = next((st for st in hc.recipe if st.action == "open_joint" and st.args.get("fraction")), None)
+    if step is None:
+        return
+    fraction = float(step.args["fraction"])
+    for joint in select.joints_with_label(chosen.asset, label):
+        lo, hi = joint.range
+        closed = joint.closed_value
+        far = hi if abs(hi - closed) >= abs(lo - closed) else lo
+        chosen.joint_values[joint.name] = float(closed + fraction * (far - closed))
 
 
 def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed], Placed | None]:
@@ -456,7 +477,7 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
                 continue
             except ItemFailed:
                 pass
-        lay.place_on_floor(p, relevant=True, face=True)
+        lay.place_beside(p, _room_fixtures(sel.kb, lay))
 
     # Clutter on the side table, away from its edges; an item that does not fit is left out.
     if side is not None:
@@ -504,6 +525,12 @@ def _place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed
         p = _placed(select.Chosen(_instance_name(cat, sel.used), cat, role, asset))
         lay.place_on_floor(p, relevant=True, face=face)
         placed[p.name] = p
+
+
+def _room_fixtures(kb, lay: Layout) -> list[Placed]:
+    """Placed furniture and appliances: what the knowledge base counts as lining the room (a floor
+    object beside one is out of the walkway)."""
+    return [p for p in lay.items if p.fixed and set(ROOM_FIXTURES) & set(kb.properties_of(p.catalogue))]
 
 
 def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None,
@@ -555,8 +582,7 @@ def _place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed],
     if support is not None:
         lay.place_on_surface(hp, support, _surface_of(support), inward=INWARD, near_side=HAZARD_NEAR_SIDE)
         return
-    fixtures = [p for p in lay.items if p.fixed]
-    lay.place_on_floor(hp, relevant=True, face=False, clear_of=fixtures)
+    lay.place_beside(hp, _room_fixtures(sel.kb, lay))
 
 
 def bind_roles(sel: Selection, support: Placed | None) -> dict[str, str]:

@@ -28,6 +28,7 @@ ROOM_CENTER = np.array([1.0, 0.0])
 DROP_GAP = 0.002  # objects start this far above their support and settle onto it
 EDGE_BAND = (0.015, 0.07)  # metres from the edge for *_edge placements (KB threshold: 0.12)
 WALKWAY_CLEAR = 0.42  # > the KB's 0.3 m walkway clearance, with margin
+TUCK_GAP = (0.03, 0.12)  # metres from a fixture's side for an item tucked out of the walkway (KB: 0.3)
 ARM_REACH = 0.95  # horizontal reach from the base centre to an object, with the arm's offset
 TRIES = 60
 
@@ -191,6 +192,30 @@ class Layout:
                     self._record_preferred(obj, want, moved=attempt > 0)
                 return
         raise ItemFailed(f"no free floor spot for {obj.name}")
+
+    def place_beside(self, obj: Placed, fixtures: list[Placed]) -> None:
+        """Stand a loose object on the floor against the side of a piece of furniture, out of the walkway.
+
+        Why: an ordinary object the builder leaves in the open floor is, by the knowledge base's own
+        rule, a tripping hazard the scene never meant to have. Falls back on a free floor spot only
+        when no fixture has room beside it."""
+        bodies = [f for f in fixtures if f.fixed]
+        for _ in range(TRIES if bodies else 0):
+            f = bodies[int(self.rng.integers(len(bodies)))]
+            c, h = f.world_center(), f.world_half()  # the body itself, not its doors' sweep
+            obj.yaw = float(self.rng.uniform(-math.pi, math.pi))
+            oh = obj.world_half()
+            axis, sign = int(self.rng.integers(2)), float(self.rng.choice([-1.0, 1.0]))
+            xy = c[:2].copy()
+            xy[axis] += sign * (h[axis] + oh[axis] + self.rng.uniform(*TUCK_GAP))
+            xy[1 - axis] += self.rng.uniform(-1.0, 1.0) * max(h[1 - axis] - oh[1 - axis], 0.0)
+            obj.pos = np.array([xy[0], xy[1], -obj.lo[2] + DROP_GAP])
+            obj.pos[:2] -= obj.world_center()[:2] - obj.pos[:2]
+            if not self.collides(obj):
+                obj.support = "floor"
+                self.items.append(obj)
+                return
+        self.place_on_floor(obj, relevant=True, face=False)
 
     def _record_preferred(self, obj: Placed, want: np.ndarray, *, moved: bool) -> None:
         got = obj.world_center()[:2]
