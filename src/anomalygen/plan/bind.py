@@ -7,7 +7,8 @@ relates to (the window of a stuffy room). The robot chooses them itself, here, f
 - variables in the class's preconditions come from matching the class on the perceived graph with
   the object at fault fixed (the same reading of the scene that made the detection);
 - ``$container``: the nearest object of a kind the class puts such things in (the knowledge base's
-  containers for the class and object) that the object fits and the arm can reach;
+  containers for the class and object) that the object fits and the arm can reach, preferring one
+  that ends the hazard once shut (``ends_hazard``);
 - ``$support``: the nearest surface of a kind the class lays things on.
 """
 
@@ -16,9 +17,10 @@ from __future__ import annotations
 import math
 
 from anomalygen.errors import ItemFailed
-from anomalygen.schema import GraphObject, SceneGraph
+from anomalygen.schema import CHILD_REACH, ENCLOSING_LABELS, GraphObject, Relation, SceneGraph
 
 REACH_TOP_M = 1.6  # a container whose top is higher than this is out of the arm's comfortable reach
+AFTER_PLACE_LIFT_M = 0.02  # predicted height of a placed object above its container's base
 
 
 def bind_fix(hc, fault: str, graph: SceneGraph, kb) -> dict[str, str]:
@@ -55,7 +57,35 @@ def choose_container(hc, obj: GraphObject, graph: SceneGraph, kb) -> str:
             and o.position[2] + o.size[2] / 2 <= REACH_TOP_M]
     if not fits:
         raise ItemFailed(f"no reachable container for {obj.name} in the scene (wanted: {', '.join(kinds) or 'none'})")
-    return _nearest(obj, fits)
+    ending = [o for o in fits if ends_hazard(hc, obj, o, graph)]
+    return _nearest(obj, ending or fits)
+
+
+def ends_hazard(hc, obj: GraphObject, container: GraphObject, graph: SceneGraph) -> bool:
+    """Would the class stop holding for ``obj`` once it is shut inside ``container``?
+
+    Why: "inside a box" ends a litter hazard but not a choking one when the box is an open carton on
+    the floor. The robot predicts the scene after its fix (the object low inside the container, the
+    container's doors, drawers and lids shut) and checks the class's own preconditions on it.
+    """
+    from anomalygen.knowledge.predicates import PredicateError, match_class
+
+    bottom = container.height_above_floor + AFTER_PLACE_LIFT_M
+    shuts = any(lbl in j.label for j in container.joints for lbl in ENCLOSING_LABELS)
+    moved = obj.model_copy(update={
+        "position": [container.position[0], container.position[1], bottom + obj.size[2] / 2],
+        "height_above_floor": bottom, "on_floor": False, "distance_to_edge": None,
+        "child_reachable": bottom <= CHILD_REACH and not shuts,
+    })
+    after = graph.model_copy(update={
+        "objects": [moved if o.name == obj.name else o for o in graph.objects],
+        "relations": [r for r in graph.relations if obj.name not in (r.subject, r.object)]
+        + [Relation(subject=obj.name, predicate="inside", object=container.name)],
+    })
+    try:
+        return not match_class(hc, after, fixed={hc.hazard_variable: obj.name})
+    except PredicateError:
+        return True
 
 
 def choose_support(hc, obj: GraphObject, graph: SceneGraph) -> str:

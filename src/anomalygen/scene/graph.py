@@ -191,7 +191,9 @@ def scene_graph(model: mujoco.MjModel, data: mujoco.MjData, spec: SceneSpec) -> 
     relations: list[Relation] = []
     for i, obj in enumerate(spec.objects):
         height = float(lo[i][2])
-        on_floor = "floor" in supports[i] or height < ON_FLOOR_TOL
+        container = inside_of[i]
+        # low inside a bin is not on the floor: only a floor contact says so then (a bin's base is thin)
+        on_floor = "floor" in supports[i] or (height < ON_FLOOR_TOL and container is None)
         edge = None
         # distance from the object's footprint to the edge of its main support's top (the widest
         # supporting geom; a laptop also touching a mug in the middle of the table is not at an
@@ -201,7 +203,6 @@ def scene_graph(model: mujoco.MjModel, data: mujoco.MjData, spec: SceneSpec) -> 
             geom = max(under, key=lambda g: float(np.prod(geom_hi[g][:2] - geom_lo[g][:2])))
             d = np.minimum(lo[i][:2] - geom_lo[geom][:2], geom_hi[geom][:2] - hi[i][:2])
             edge = float(np.min(d))
-        container = inside_of[i]
         enclosed = container is not None and closed[container]
         objects.append(
             GraphObject(

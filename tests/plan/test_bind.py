@@ -1,0 +1,34 @@
+"""The robot's own choice of container: one that ends the hazard once shut, not merely the nearest."""
+
+from __future__ import annotations
+
+from anomalygen.knowledge import load_kb
+from anomalygen.plan.bind import choose_container, ends_hazard
+from tests.knowledge.graphs import furniture, graph, joint, obj
+
+
+def _scene():
+    marble = obj("marble_0", "marble", at="floor", xy=(0.0, 0.0), size=(0.02, 0.02, 0.02))
+    carton = furniture("box_0", "Box", xy=(0.3, 0.0), size=(0.5, 0.5, 0.3), joints=[joint("flap", 0.0)])
+    cabinet = furniture("storagefurniture_0", "StorageFurniture", xy=(1.5, 0.0), joints=[joint("drawer", 0.0)])
+    trash = furniture("trashcan_0", "TrashCan", xy=(0.4, 0.4), size=(0.3, 0.3, 0.4), joints=[joint("lid", 0.0)])
+    paper = obj("paper_ball_0", "paper_ball", at="floor", xy=(0.2, 0.3), size=(0.08, 0.08, 0.08))
+    return graph(marble, carton, cabinet, trash, paper)
+
+
+def test_a_choking_hazard_goes_behind_a_drawer_not_into_the_nearer_open_carton():
+    kb, g = load_kb(), _scene()
+    hc = kb.hazard_classes["remove_choking_hazards"]
+    marble = next(o for o in g.objects if o.name == "marble_0")
+    by = {o.name: o for o in g.objects}
+    assert not ends_hazard(hc, marble, by["box_0"], g)  # flaps do not keep a toddler out
+    assert ends_hazard(hc, marble, by["storagefurniture_0"], g)
+    assert choose_container(hc, marble, g, kb) == "storagefurniture_0"
+
+
+def test_litter_is_done_with_once_in_the_nearest_bin():
+    kb, g = load_kb(), _scene()
+    hc = kb.hazard_classes["pick_up_floor_litter"]
+    paper = next(o for o in g.objects if o.name == "paper_ball_0")
+    assert ends_hazard(hc, paper, next(o for o in g.objects if o.name == "trashcan_0"), g)
+    assert choose_container(hc, paper, g, kb) == "trashcan_0"
