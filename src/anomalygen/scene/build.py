@@ -22,23 +22,32 @@ import math
 import os
 import shutil
 from dataclasses import dataclass, field
-from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from anomalygen.errors import ItemFailed
+from anomalygen.knowledge import load_kb
 from anomalygen.rng import item_rng, stable_hash
 from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
 from anomalygen.scene import furniture, layout, mix, robot, robot_model, select
 from anomalygen.scene.graph import FLOOR_GEOM
+from anomalygen.scene.instances import (
+    HAZARD_NEAR_SIDE,
+    INWARD,
+    cavity_cap,
+    cavity_world,
+    container_room,
+    instance_name,
+    placed_instance,
+    placed_support,
+    surface_of,
+)
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.sensors import add_observation_sensors
 from anomalygen.schema import (
-    CLOSURE_LABELS,
     ENCLOSING_LABELS,
-    SWINGING_CLOSURES,
     AssetRef,
     AssetSource,
     JointState,
@@ -58,21 +67,12 @@ SURFACE_PLACEMENTS = {"table", "low_table", "table_edge", "counter", "counter_ed
 CAMERAS = ("front", "top", "wrist")
 MAX_AUX = 3
 CONTAINER_REDRAWS = 4  # other container sizes drawn before a smaller hazard is tried
-INWARD = 0.13  # m kept from a support's edge by things that are not the edge hazard
-HAZARD_NEAR_SIDE = 0.4  # m: the hazard's centre at most this far from the robot-facing edge (arm's reach)
 LOOSE_ON_SUPPORT_MAX = 0.35  # m: a loose task object smaller than this goes on the support, not the floor
 CLUTTER_MAX_SIZE = 0.3
 SAFE_STATE = {"open": "closed", "on": "off"}  # a part's state in a hazard-free scene
 
 
 LOOSE_SOLREF = 0.005  # s: contact time constant of loose objects (2.5 physics steps)
-
-
-@lru_cache(maxsize=1)
-def _kb():
-    from anomalygen.knowledge import load_kb
-
-    return load_kb()
 
 
 @dataclass
@@ -90,119 +90,11 @@ class Built:
 # ============================================================================ selection
 
 
-def _instance_name(catalogue: str, used: set[str]) -> str:
-    base = catalogue.lower()
-    i = 0
-    while f"{base}_{i}" in used:
-        i += 1
-    name = f"{base}_{i}"
-    used.add(name)
-    return name
-
-
 def _parse_placement(placement: str) -> tuple[str, str | None]:
     for prefix in ("inside:", "on:"):
         if placement.startswith(prefix):
             return prefix[:-1], placement[len(prefix) :]
     return placement, None
-
-
-def _front(asset) -> np.ndarray | None:
-    """Local direction the asset's doors/drawers open to (the catalogue convention is -y)."""
-    if any(j.label in CLOSURE_LABELS for j in asset.joints) or asset.cavities:
-        return np.array([0.0, -1.0])
-    return None
-
-
-def _sweep(asset, values: dict[str, float]) -> float:
-    """How far open doors/drawers reach out of the closed bounding box, conservatively."""
-    ext = asset.aabb[1] - asset.aabb[0]
-    out = 0.0
-    for j in asset.joints:
-        v = values.get(j.name)
-        if v is None or abs(v - j.closed_value) < 1e-6:
-            continue
-        if j.type == "slide":
-            out = max(out, abs(v - j.closed_value) + 0.02)
-        elif j.label in SWINGING_CLOSURES:
-            out = max(out, min(float(max(ext[0], ext[2] if abs(j.axis[2]) < 0.5 else ext[0])), 1.0))
-    return out
-
-
-def _placed(chosen: select.Chosen) -> Placed:
-    lo, hi = (np.asarray(v, float) for v in chosen.asset.aabb)
-    p = Placed(
-        name=chosen.name,
-        catalogue=chosen.catalogue,
-        role=chosen.role,
-        lo=lo,
-        hi=hi,
-        fixed=chosen.fixed,
-        asset=chosen.asset,
-        joint_values=dict(chosen.joint_values),
-        front=_front(chosen.asset),
-    )
-    p.sweep = _sweep(chosen.asset, chosen.joint_values)
-    return p
-
-
-def _support_placed(kind: str, name: str, rng, role=ObjectRole.SUPPORT) -> Placed:
-    sup = furniture.sample_support(kind, rng)
-    lo, hi = sup.aabb()
-    return Placed(
-        name=name,
-        catalogue=sup.category,
-        role=role,
-        lo=lo,
-        hi=hi,
-        fixed=True,
-        support_geom=sup,
-        front=np.array([-1.0, 0.0]),
-    )
-
-
-def _surface_of(holder: Placed):
-    """The top surface of a holder in world coordinates: (lo_xy, hi_xy, top_z)."""
-    if holder.support_geom is not None:
-        s = holder.support_geom
-        return layout.surface_world(holder, (0.0, 0.0, s.top), s.half)
-    surfaces = list(holder.asset.surfaces)
-    if not surfaces:
-        lo, hi = holder.asset.aabb
-        return layout.surface_world(
-            holder, (0.0, 0.0, float(hi[2])), (float(hi[0] - lo[0]) / 2 * 0.8, float(hi[1] - lo[1]) / 2 * 0.8)
-        )
-    best = max(surfaces, key=lambda s: s.half_size[0] * s.half_size[1])
-    return layout.surface_world(holder, best.center, best.half_size)
-
-
-def _cavity_world(holder: Placed):
-    asset = holder.asset
-    if not asset.cavities:
-        raise ItemFailed(f"{holder.catalogue} has no interior to put things in")
-    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
-    center = np.asarray(cav.center, float).copy()
-    if cav.joint is not None:
-        j = asset.joint(cav.joint)
-        if j.type == "slide":
-            v = holder.joint_values.get(j.name, j.closed_value)
-            center += np.asarray(j.axis) * (v - 0.0)
-    c, s = math.cos(holder.yaw), math.sin(holder.yaw)
-    wc = holder.pos + np.array([c * center[0] - s * center[1], s * center[0] + c * center[1], center[2]])
-    h = np.asarray(cav.half_extents, float)
-    wh = np.array([abs(c) * h[0] + abs(s) * h[1], abs(s) * h[0] + abs(c) * h[1], h[2]])
-    return wc - wh, wc + wh, cav
-
-
-def _container_room(asset) -> float:
-    """Longest thing that lies flat in the container's biggest cavity (along its long side)."""
-    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
-    return 0.95 * 2 * float(max(cav.half_extents[0], cav.half_extents[1]))
-
-
-def _cavity_cap(asset) -> float:
-    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
-    return 0.8 * 2 * float(min(cav.half_extents))
 
 
 def is_dressing(kb, name: str) -> bool:
@@ -264,7 +156,7 @@ class Selection:
         if want is not None and abs(asset.size - want) > 1e-3:
             self.hints.note(f"size:{cat}", f"size {want:.3f} m does not fit the generator's range or the space "
                             f"available; built at {asset.size:.3f} m", value=want, limit=round(float(asset.size), 4))
-        ch = select.Chosen(_instance_name(cat, self.used), cat, role, asset)
+        ch = select.Chosen(instance_name(cat, self.used), cat, role, asset)
         self.by_catalogue[cat] = ch
         return ch
 
@@ -279,7 +171,7 @@ def select_objects(task: TaskProposal, rng, hints=None) -> Selection:
 
     ``hints`` (scene/hints.py, from the LLM engine) supply sizes, floor positions and the auxiliary
     objects instead of the random draws; every correction is noted in them or in the layout."""
-    kb = _kb()
+    kb = load_kb()
     sc = task.scenario
     kind, parent_raw = _parse_placement(sc.placement)
     sel = Selection(task, rng, kb, kb.hazard_classes.get(task.hazard_class), kind, parent_raw, hints=hints)
@@ -294,7 +186,7 @@ def select_objects(task: TaskProposal, rng, hints=None) -> Selection:
     if kind == "inside" and parent is not None:
         if not parent.asset.cavities:
             raise ItemFailed(f"placement inside:{parent_raw} but {parent.catalogue} has no interior")
-        cap = _cavity_cap(parent.asset)
+        cap = cavity_cap(parent.asset)
     hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=cap)
     if hazard is target:
         target.role = ObjectRole.HAZARD
@@ -310,11 +202,11 @@ def select_objects(task: TaskProposal, rng, hints=None) -> Selection:
             # Draw the container again (other sizes), then a smaller hazard, before giving up.
             # A container that is also the scene's target keeps its draw (other steps refer to it).
             for _ in range(CONTAINER_REDRAWS if container is not target else 0):
-                if hazard.size <= _container_room(container.asset):
+                if hazard.size <= container_room(container.asset):
                     break
                 sel.forget(container)
                 container = sel.choose(container_name, ObjectRole.CONTAINER)
-            room = _container_room(container.asset)
+            room = container_room(container.asset)
             if hazard.size > room and hazard is not target:
                 sel.forget(hazard)
                 hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=min(cap or room, room))
@@ -410,9 +302,9 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
             and not sel.hazard_is_target
             and _table_height_ok(target.asset)
         ):
-            support = placed.setdefault(target.name, _placed(target))
+            support = placed.setdefault(target.name, placed_instance(target))
         else:
-            support = _support_placed(base_kind, _instance_name(furniture.CATEGORY[base_kind], used), rng)
+            support = placed_support(base_kind, instance_name(furniture.CATEGORY[base_kind], used), rng)
         lay.place_on_floor(support, relevant=True, face=True)
         placed[support.name] = support
     side: Placed | None = None
@@ -421,7 +313,7 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
     else:
         clutter = _clutter_names(sel.kb, set(sel.by_catalogue), rng, settings.build.clutter)
     if clutter:
-        side = _support_placed("table", _instance_name("Table", used), rng)
+        side = placed_support("table", instance_name("Table", used), rng)
         spots = [xy for xy in (sel.hints.world_xy(a) for a in clutter) if xy is not None] if sel.hints is not None else []
         if spots:  # the auxiliaries stand where the LLM put them, on a side table outside the cube
             lay.preferred[side.name] = np.mean(spots, axis=0)
@@ -433,10 +325,10 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
     for ch in task_objects:
         if ch is None or ch.name in placed or not ch.fixed or ch is hazard:
             continue
-        p = placed[ch.name] = _placed(ch)
+        p = placed[ch.name] = placed_instance(ch)
         lay.place_on_floor(p, relevant=True, face=True)
     if hazard.fixed and hazard.name not in placed:
-        p = placed[hazard.name] = _placed(hazard)
+        p = placed[hazard.name] = placed_instance(hazard)
         lay.place_on_floor(p, relevant=True, face=True)
 
     if hazard.name not in placed:
@@ -449,10 +341,10 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
     for ch in task_objects:
         if ch is None or ch.name in placed:
             continue
-        p = placed[ch.name] = _placed(ch)
+        p = placed[ch.name] = placed_instance(ch)
         if support is not None and ch.size < LOOSE_ON_SUPPORT_MAX:
             try:
-                lay.place_on_surface(p, support, _surface_of(support), inward=INWARD)
+                lay.place_on_surface(p, support, surface_of(support), inward=INWARD)
                 continue
             except ItemFailed:
                 pass
@@ -464,10 +356,10 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
             want = sel.hints.size_for(cat) if sel.hints is not None else None
             asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng,
                                       size=want)
-            ch = select.Chosen(_instance_name(cat, used), cat, ObjectRole.CLUTTER, asset)
-            p = _placed(ch)
+            ch = select.Chosen(instance_name(cat, used), cat, ObjectRole.CLUTTER, asset)
+            p = placed_instance(ch)
             try:
-                lay.place_on_surface(p, side, _surface_of(side), inward=INWARD)
+                lay.place_on_surface(p, side, surface_of(side), inward=INWARD)
             except ItemFailed:
                 if sel.hints is not None:
                     sel.hints.note(f"auxiliary:{cat}", "did not fit on the side table; left out")
@@ -490,10 +382,10 @@ def _place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed
     rng = items.rng
     for cat in items.near_misses if surfaces else []:
         asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng)
-        p = _placed(select.Chosen(_instance_name(cat, sel.used), cat, ObjectRole.CLUTTER, asset))
+        p = placed_instance(select.Chosen(instance_name(cat, sel.used), cat, ObjectRole.CLUTTER, asset))
         holder = surfaces[int(rng.integers(len(surfaces)))]
         try:
-            lay.place_on_surface(p, holder, _surface_of(holder), inward=INWARD)
+            lay.place_on_surface(p, holder, surface_of(holder), inward=INWARD)
         except ItemFailed:
             continue
         placed[p.name] = p
@@ -501,7 +393,7 @@ def _place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed
         if cat is None:
             continue
         asset = select.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng)
-        p = _placed(select.Chosen(_instance_name(cat, sel.used), cat, role, asset))
+        p = placed_instance(select.Chosen(instance_name(cat, sel.used), cat, role, asset))
         lay.place_on_floor(p, relevant=True, face=face)
         placed[p.name] = p
 
@@ -510,7 +402,7 @@ def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], suppor
                   support_kind: str | None) -> None:
     """The hazard object, where the scenario says."""
     kind, parent, hazard = sel.kind, sel.parent, sel.hazard
-    hp = placed[hazard.name] = _placed(hazard)
+    hp = placed[hazard.name] = placed_instance(hazard)
     if kind == "floor":
         lay.place_on_floor(hp, relevant=True, face=False)
     elif kind == "walkway":
@@ -519,18 +411,18 @@ def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], suppor
     elif support is not None:
         edge = support_kind.endswith("_edge")
         lay.place_on_surface(
-            hp, support, _surface_of(support), edge=edge, inward=0.0 if edge else INWARD, near_side=HAZARD_NEAR_SIDE
+            hp, support, surface_of(support), edge=edge, inward=0.0 if edge else INWARD, near_side=HAZARD_NEAR_SIDE
         )
     elif kind in ("inside", "on") and parent is not None:
         ppl = placed.get(parent.name)
         if ppl is None:
-            ppl = placed[parent.name] = _placed(parent)
+            ppl = placed[parent.name] = placed_instance(parent)
             lay.place_on_floor(ppl, relevant=True, face=True)
         if kind == "inside":
-            lo, hi, _ = _cavity_world(ppl)
+            lo, hi, _ = cavity_world(ppl)
             lay.place_in_cavity(hp, ppl, (lo, hi))
         else:
-            lay.place_on_surface(hp, ppl, _surface_of(ppl), inward=0.0)
+            lay.place_on_surface(hp, ppl, surface_of(ppl), inward=0.0)
     else:
         raise ItemFailed(f"unsupported placement {sel.task.scenario.placement!r}")
 
@@ -539,13 +431,13 @@ def _place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed],
     """The task's object where it is no hazard: shut inside its container, else well inside the
     surface, else on the floor away from the walkway (a second chance for the layout)."""
     hazard, container = sel.hazard, sel.container
-    hp = placed[hazard.name] = _placed(hazard)
+    hp = placed[hazard.name] = placed_instance(hazard)
     if container is not None and container is not hazard and container.asset.cavities:
         holder = placed.get(container.name)
         if holder is None:
-            holder = placed[container.name] = _placed(container)
+            holder = placed[container.name] = placed_instance(container)
             lay.place_on_floor(holder, relevant=True, face=True)
-        lo, hi, _ = _cavity_world(holder)
+        lo, hi, _ = cavity_world(holder)
         lay.place_in_cavity(hp, holder, (lo, hi))
         for joint in container.asset.joints:  # shut every lid, door and drawer of the container
             if select.kb_label(joint.label) in ENCLOSING_LABELS:
@@ -553,7 +445,7 @@ def _place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed],
         holder.sweep = 0.0
         return
     if support is not None:
-        lay.place_on_surface(hp, support, _surface_of(support), inward=INWARD, near_side=HAZARD_NEAR_SIDE)
+        lay.place_on_surface(hp, support, surface_of(support), inward=INWARD, near_side=HAZARD_NEAR_SIDE)
         return
     fixtures = [p for p in lay.items if p.fixed]
     lay.place_on_floor(hp, relevant=True, face=False, clear_of=fixtures)
@@ -874,7 +766,7 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
     mujoco.mj_forward(model, data)
     spec = _scene_spec(task, seed, lay, placed, bindings, model, data)
     graph = scene_graph(model, data, spec)
-    hc = _kb().hazard_classes.get(task.hazard_class)
+    hc = load_kb().hazard_classes.get(task.hazard_class)
     report = val.validate(model, data, spec, graph, None if hazard_free else hc)
     if hazard_free and report.ok:
         report = _check_hazard_free(report, graph, task.hazard_class)
@@ -886,7 +778,7 @@ def _check_hazard_free(report: ValidationReport, graph, hazard_class: str) -> Va
     """A hazard-free variant must not show the task's hazard anywhere once settled."""
     from anomalygen.scene.truth import class_matches
 
-    still = sorted(obj for cls, obj, _ in class_matches(graph, _kb()) if cls == hazard_class)
+    still = sorted(obj for cls, obj, _ in class_matches(graph, load_kb()) if cls == hazard_class)
     check = ValidationCheck(name="hazard_free", passed=not still,
                             detail=f"{hazard_class} still holds for {', '.join(still)}" if still else "made safe")
     report.checks.append(check)
@@ -1041,7 +933,7 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_cla
             files[f"render_{cam}"] = f"render_{cam}.png"
     spec = built.spec.model_copy(update={"validation": built.report, "files": files})
     write_model(out_dir / "scene_graph.json", built.graph)
-    write_model(out_dir / TRUTH_FILE, hazard_manifest(spec, hazard_class, built.graph, _kb()))
+    write_model(out_dir / TRUTH_FILE, hazard_manifest(spec, hazard_class, built.graph, load_kb()))
     write_model(out_dir / "scene.json", spec)  # last: its presence marks the scene done
     return spec
 
