@@ -42,6 +42,7 @@ from anomalygen.scene.instances import (
     placed_support,
     surface_of,
 )
+from anomalygen.scene.judgement import check_hazard_free, place_hazard_safely, place_judgement_items
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.selection import (
     Selection,
@@ -52,7 +53,6 @@ from anomalygen.scene.selection import (
 )
 from anomalygen.scene.sensors import add_observation_sensors
 from anomalygen.schema import (
-    ENCLOSING_LABELS,
     AssetRef,
     AssetSource,
     JointState,
@@ -144,7 +144,7 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
 
     if hazard.name not in placed:
         if sel.hazard_free:
-            _place_hazard_safely(sel, lay, placed, support)
+            place_hazard_safely(sel, lay, placed, support)
         else:
             _place_hazard(sel, lay, placed, support, support_kind)
 
@@ -179,34 +179,11 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
 
     items = mix.choose_judgement_items(sel.task.id, sel.task.hazard_class, set(sel.by_catalogue) | set(clutter),
                                        sel.kb, settings, hazard_free=sel.hazard_free)
-    _place_judgement_items(sel, lay, placed, [s for s in (side, support) if s is not None], items)
+    place_judgement_items(sel, lay, placed, [s for s in (side, support) if s is not None], items)
 
     focus = placed[hazard.name]
     lay.fit_base(focus, holder=placed.get(focus.inside) if focus.inside else None)
     return lay, placed, support
-
-
-def _place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed], surfaces: list[Placed],
-                           items: mix.JudgementItems) -> None:
-    """Near-misses well inside a table top (any that find no room are left out); the second hazard
-    on the floor, with its bin when the scene has none."""
-    rng = items.rng
-    for cat in items.near_misses if surfaces else []:
-        asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng)
-        p = placed_instance(select.Chosen(instance_name(cat, sel.used), cat, ObjectRole.CLUTTER, asset))
-        holder = surfaces[int(rng.integers(len(surfaces)))]
-        try:
-            lay.place_on_surface(p, holder, surface_of(holder), inward=INWARD)
-        except ItemFailed:
-            continue
-        placed[p.name] = p
-    for cat, role, face in ((items.second_hazard, ObjectRole.HAZARD, False), (items.bin, ObjectRole.CONTAINER, True)):
-        if cat is None:
-            continue
-        asset = select.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng)
-        p = placed_instance(select.Chosen(instance_name(cat, sel.used), cat, role, asset))
-        lay.place_on_floor(p, relevant=True, face=face)
-        placed[p.name] = p
 
 
 def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None,
@@ -236,30 +213,6 @@ def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], suppor
             lay.place_on_surface(hp, ppl, surface_of(ppl), inward=0.0)
     else:
         raise ItemFailed(f"unsupported placement {sel.task.scenario.placement!r}")
-
-
-def _place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None) -> None:
-    """The task's object where it is no hazard: shut inside its container, else well inside the
-    surface, else on the floor away from the walkway (a second chance for the layout)."""
-    hazard, container = sel.hazard, sel.container
-    hp = placed[hazard.name] = placed_instance(hazard)
-    if container is not None and container is not hazard and container.asset.cavities:
-        holder = placed.get(container.name)
-        if holder is None:
-            holder = placed[container.name] = placed_instance(container)
-            lay.place_on_floor(holder, relevant=True, face=True)
-        lo, hi, _ = cavity_world(holder)
-        lay.place_in_cavity(hp, holder, (lo, hi))
-        for joint in container.asset.joints:  # shut every lid, door and drawer of the container
-            if select.kb_label(joint.label) in ENCLOSING_LABELS:
-                holder.joint_values[joint.name] = float(joint.closed_value)
-        holder.sweep = 0.0
-        return
-    if support is not None:
-        lay.place_on_surface(hp, support, surface_of(support), inward=INWARD, near_side=HAZARD_NEAR_SIDE)
-        return
-    fixtures = [p for p in lay.items if p.fixed]
-    lay.place_on_floor(hp, relevant=True, face=False, clear_of=fixtures)
 
 
 def _plan(task: TaskProposal, settings: Settings, rng, hints=None,
@@ -527,22 +480,9 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
     hc = load_kb().hazard_classes.get(task.hazard_class)
     report = val.validate(model, data, spec, graph, None if hazard_free else hc)
     if hazard_free and report.ok:
-        report = _check_hazard_free(report, graph, task.hazard_class)
+        report = check_hazard_free(report, graph, task.hazard_class)
     report.checks = notes + report.checks
     return Built(spec, mjspec, model, data, report, graph)
-
-
-def _check_hazard_free(report: ValidationReport, graph, hazard_class: str) -> ValidationReport:
-    """A hazard-free variant must not show the task's hazard anywhere once settled."""
-    from anomalygen.scene.truth import class_matches
-
-    still = sorted(obj for cls, obj, _ in class_matches(graph, load_kb()) if cls == hazard_class)
-    check = ValidationCheck(name="hazard_free", passed=not still,
-                            detail=f"{hazard_class} still holds for {', '.join(still)}" if still else "made safe")
-    report.checks.append(check)
-    if still:
-        report.ok, report.reason = False, check.detail
-    return report
 
 
 def _hint_notes(hints, lay: Layout) -> list[ValidationCheck]:
