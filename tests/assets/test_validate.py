@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from anomalygen.assets import generate, household_names, target_names
-from anomalygen.assets.core import Draft, finalize
+from anomalygen.assets.finalize import finalize
+from anomalygen.assets.model import Draft
 from anomalygen.assets.parts import Part
 from anomalygen.assets.validate import check_joints, check_rest, validate_asset
 from anomalygen.rng import item_rng

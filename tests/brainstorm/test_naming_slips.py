@@ -10,7 +10,8 @@ from __future__ import annotations
 import json
 import threading
 
-from anomalygen.brainstorm.llm_engine import LLMEngine, LLMProposal, reply_json
+from anomalygen.brainstorm.llm_engine import LLMEngine, reply_json
+from anomalygen.brainstorm.llm_reply import LLMProposal
 from anomalygen.knowledge import load_kb
 from anomalygen.llm import get_client
 from anomalygen.llm.schema_tools import reply_token_budget

@@ -6,17 +6,9 @@ Public API (stable; the scene builder, detection and skills stages build on it):
     asset = generate("Refrigerator", seed=3, size=1.7)
 """
 
-from anomalygen.assets.core import (
-    Asset,
-    AssetJoint,
-    Cavity,
-    Surface,
-    available_names,
-    generate,
-    household_names,
-    size_range,
-    target_names,
-)
+from anomalygen.assets.core import available_names, generate
+from anomalygen.assets.model import Asset, AssetJoint, Cavity, Surface
+from anomalygen.assets.names import household_names, size_range, target_names
 from anomalygen.assets.retrieval import CatalogueEntry
 from anomalygen.assets.validate import ValidationResult, validate_asset
 

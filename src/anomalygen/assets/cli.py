@@ -38,7 +38,7 @@ def list_cmd(
     json_out: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
 ) -> None:
     """Every asset name with its kind and plausible size range."""
-    from anomalygen.assets.core import group, household_names, size_range, target_names
+    from anomalygen.assets.names import group, household_names, size_range, target_names
 
     rows = [
         {"name": n, "kind": "target", "group": group(n), "size_range": size_range(n)} for n in target_names()
@@ -160,7 +160,7 @@ def validate(
 ) -> None:
     """Compile, rest on the floor for 2 s, sweep every joint, render: per name over seeds 0..n-1."""
     os.environ.setdefault("MUJOCO_GL", "egl")
-    from anomalygen.assets.core import household_names, target_names
+    from anomalygen.assets.names import household_names, target_names
 
     todo_names = (
         [_check_name(n) for n in names] if names else (household_names() if household else target_names())
@@ -245,7 +245,7 @@ def gallery(
 ) -> None:
     """Contact sheet of all 44 target categories (or the household objects), labelled."""
     os.environ.setdefault("MUJOCO_GL", "egl")
-    from anomalygen.assets.core import household_names, target_names
+    from anomalygen.assets.names import household_names, target_names
     from anomalygen.assets.render import gallery as make_gallery
     from anomalygen.assets.render import save_png
 

@@ -8,10 +8,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from anomalygen.assets.core import object_table, vocabulary
+from anomalygen.assets.names import object_table, vocabulary
 
 if TYPE_CHECKING:
-    from anomalygen.assets.core import Asset
+    from anomalygen.assets.model import Asset
 
 _TAG_TEXT = {
     "choking_size": "small enough for a toddler to put in the mouth and choke on",

@@ -22,7 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from anomalygen.assets.core import Asset, AssetJoint, new_spec, size_range
+from anomalygen.assets.finalize import new_spec
+from anomalygen.assets.model import Asset, AssetJoint
+from anomalygen.assets.names import size_range
 from anomalygen.errors import UserError
 from anomalygen.schema import AssetSource
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import partialmethod
 
 import numpy as np
 
@@ -136,23 +137,10 @@ class Part:
         self.geoms.append(g)
         return g
 
-    def box(
+    def _geom(
         self,
-        half,
-        pos=(0, 0, 0),
-        rgba=(0.7, 0.7, 0.7, 1),
-        density=700.0,
-        *,
-        quat=(1, 0, 0, 0),
-        collide=True,
-        name=None,
-    ):
-        return self._add("box", half, pos, quat, rgba, density, collide, name)
-
-    def cyl(
-        self,
-        r,
-        hh,
+        kind,
+        size,
         pos=(0, 0, 0),
         rgba=(0.7, 0.7, 0.7, 1),
         density=700.0,
@@ -162,38 +150,23 @@ class Part:
         collide=True,
         name=None,
     ):
-        return self._add("cylinder", (r, hh), pos, quat or _AXIS_QUAT[axis], rgba, density, collide, name)
+        """One primitive; ``quat`` (w, x, y, z) wins over ``axis``, the direction a cylinder or capsule runs along."""
+        return self._add(kind, size, pos, quat or _AXIS_QUAT[axis], rgba, density, collide, name)
 
-    def capsule(
-        self,
-        r,
-        hh,
-        pos=(0, 0, 0),
-        rgba=(0.7, 0.7, 0.7, 1),
-        density=700.0,
-        *,
-        axis="z",
-        quat=None,
-        collide=True,
-        name=None,
-    ):
-        return self._add("capsule", (r, hh), pos, quat or _AXIS_QUAT[axis], rgba, density, collide, name)
+    # box(half, pos, rgba, density, *, quat, collide, name); an ellipsoid takes the same arguments
+    box = partialmethod(_geom, "box", quat=(1, 0, 0, 0))
+    ellipsoid = partialmethod(_geom, "ellipsoid", quat=(1, 0, 0, 0))
+
+    def cyl(self, r, hh, *args, **kwargs):
+        """A cylinder of radius ``r`` and half height ``hh``; then pos, rgba, density, *, axis, quat, collide, name."""
+        return self._geom("cylinder", (r, hh), *args, **kwargs)
+
+    def capsule(self, r, hh, *args, **kwargs):
+        """A capsule, with the arguments of ``cyl``."""
+        return self._geom("capsule", (r, hh), *args, **kwargs)
 
     def sphere(self, r, pos=(0, 0, 0), rgba=(0.7, 0.7, 0.7, 1), density=700.0, *, collide=True, name=None):
         return self._add("sphere", (r,), pos, (1, 0, 0, 0), rgba, density, collide, name)
-
-    def ellipsoid(
-        self,
-        half,
-        pos=(0, 0, 0),
-        rgba=(0.7, 0.7, 0.7, 1),
-        density=700.0,
-        *,
-        quat=(1, 0, 0, 0),
-        collide=True,
-        name=None,
-    ):
-        return self._add("ellipsoid", half, pos, quat, rgba, density, collide, name)
 
     def segment(self, a, b, r, rgba=(0.7, 0.7, 0.7, 1), density=700.0, *, kind="capsule", collide=True):
         """A capsule/cylinder from point a to point b (for legs, handles, cable links)."""

@@ -14,14 +14,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from anomalygen.assets.core import Asset
+    from anomalygen.assets.model import Asset
 
 
 def showcase_spec(asset: Asset, *, free: bool = False, lift: float = 0.0):
     """A scene with a floor, lights and the asset at the origin (optionally on a free joint)."""
     import mujoco
 
-    from anomalygen.assets.core import new_spec
+    from anomalygen.assets.finalize import new_spec
 
     spec = new_spec()
     spec.option.timestep = 0.002

@@ -37,8 +37,9 @@ class CatalogueEntry:
 
 @functools.cache
 def _entries(variants_per_name: int) -> tuple[CatalogueEntry, ...]:
-    from anomalygen.assets.core import generate, household_names, target_names
+    from anomalygen.assets.core import generate
     from anomalygen.assets.describe import base_text, properties, variant_text
+    from anomalygen.assets.names import household_names, target_names
 
     out = []
     targets = set(target_names())

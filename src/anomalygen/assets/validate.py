@@ -17,7 +17,7 @@ import numpy as np
 from anomalygen.schema import ValidationCheck, ValidationReport
 
 if TYPE_CHECKING:
-    from anomalygen.assets.core import Asset
+    from anomalygen.assets.model import Asset
 
 REST_SECONDS = 2.0
 MAX_DRIFT = 0.01  # metres

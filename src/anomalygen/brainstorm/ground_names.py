@@ -10,13 +10,10 @@ class becomes ``other`` with the model's own words kept.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
+from anomalygen.brainstorm.llm_reply import LLMProposal
 from anomalygen.knowledge.grounding import NameGrounder
 from anomalygen.schema import GroundingMatch
-
-if TYPE_CHECKING:
-    from anomalygen.brainstorm.llm_engine import LLMProposal
 
 
 @dataclass

@@ -15,13 +15,13 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import ValidationError
 
 from anomalygen.brainstorm.ground_names import ground_llm_names
 from anomalygen.brainstorm.idea import ASPECTS, task_id
 from anomalygen.brainstorm.knowledge_engine import agent_roles, split_quota
+from anomalygen.brainstorm.llm_reply import LLMProposal
 from anomalygen.brainstorm.validate import proposal_problems
 from anomalygen.knowledge import PLACEMENTS, ROOMS, KnowledgeBase, load_kb
 from anomalygen.knowledge.grounding import NameGrounder, shared_grounder
@@ -32,7 +32,6 @@ from anomalygen.schema import (
     AuxiliaryItem,
     BrainstormMode,
     Engine,
-    HazardCategory,
     Provenance,
     Scenario,
     TaskProposal,
@@ -45,32 +44,6 @@ ROBOT_LIMITS = (
     "and switches. It cannot assemble or take apart anything, and it cannot clean: no wiping, mopping, "
     "sweeping or washing. Every task must be solvable with those skills."
 )
-
-
-class LLMProposal(BaseModel):
-    """What an agent writes for one idea: the task format plus grounding in catalogue names."""
-
-    model_config = ConfigDict(extra="forbid")
-
-    name: str = Field(description="short task name")
-    explanation: str = Field(description="why this is a hazard, who is at risk")
-    description: str = Field(description="the situation in two to four sentences")
-    hazard_class: str = Field(description="a hazard class id from the list, or 'other'")
-    hazard_other: str | None = Field(None, description="the hazard in words when hazard_class is 'other'")
-    category: HazardCategory
-    target_asset: str = Field(description="one of the target categories")
-    hazard_object: str = Field(description="catalogue name of the object that is the hazard")
-    room: str
-    placement: str
-    person_at_risk: str = ""
-    container: str | None = Field(None, description="catalogue name where the robot puts the object, if it does")
-    co_objects: list[str] = Field(default_factory=list, description="other catalogue objects in the scene")
-    articulated_part: str | None = Field(None, description="joint label involved, e.g. door, drawer, lid, knob")
-    part_initial_state: Literal["open", "closed", "on", "off", "other"] | None = None
-    solution: str = ""
-    success_condition: str = ""
-    builds_on: list[str] = Field(default_factory=list, description="ids of other participants' proposals used")
-    borrowed: list[str] = Field(default_factory=list, description="what was borrowed: mechanism, location, co_objects, person_at_risk")
 
 
 @dataclass

@@ -12,6 +12,7 @@ from __future__ import annotations
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
 from anomalygen.detect import rules
+from anomalygen.detect.asking import AskingDetector
 from anomalygen.detect.observation import observation_text
 from anomalygen.schema import Hypothesis, SceneGraph
 
@@ -47,14 +48,11 @@ def user_prompt(graph: SceneGraph, cands: list[rules.Candidate], k: int) -> str:
     return f"{observation_text(graph)}\n\nCandidates:\n{listing}\n\nReturn the {min(k, len(cands))} most important, best first."
 
 
-class HybridDetector:
+class HybridDetector(AskingDetector):
     name = "hybrid"
 
     def __init__(self, client, kb=None, *, temperature: float | None = 0.0, seed: int | None = 0):
-        self.client = client
-        self.kb = kb
-        self.temperature = temperature
-        self.seed = seed
+        super().__init__(client, kb, temperature=temperature, seed=seed)
         self.fell_back: str | None = None  # the reason of the last fallback, for the stage's summary
 
     def detect(self, graph: SceneGraph, k: int) -> list[Hypothesis]:
@@ -65,12 +63,7 @@ class HybridDetector:
         if not cands:
             return []
         try:
-            reply = self.client.complete(
-                [{"role": "system", "content": SYSTEM_PROMPT}, {"role": "user", "content": user_prompt(graph, cands, k)}],
-                schema=reply_schema(len(cands), k),
-                temperature=self.temperature,
-                seed=self.seed,
-            )
+            reply = self.ask(SYSTEM_PROMPT, user_prompt(graph, cands, k), reply_schema(len(cands), k))
         except LLMItemError as exc:
             self.fell_back = str(exc)
             hyps = rules.to_hypotheses(cands[:k])

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from pydantic import BaseModel, ConfigDict, Field, create_model, model_validator
 
+from anomalygen.detect.asking import AskingDetector
 from anomalygen.detect.observation import observation_text
 from anomalygen.schema import Hypothesis, SceneGraph
 
@@ -89,14 +90,8 @@ def user_prompt(graph: SceneGraph, kb, k: int) -> str:
     )
 
 
-class LLMDetector:
+class LLMDetector(AskingDetector):
     name = "llm"
-
-    def __init__(self, client, kb=None, *, temperature: float | None = 0.0, seed: int | None = 0):
-        self.client = client
-        self.kb = kb
-        self.temperature = temperature
-        self.seed = seed
 
     def detect(self, graph: SceneGraph, k: int) -> list[Hypothesis]:
         from anomalygen.knowledge.grounding import NameGrounder, shared_grounder
@@ -104,12 +99,7 @@ class LLMDetector:
         kb = self.kb if self.kb is not None else _kb()
         notes: list[str] = []
         schema = reply_schema(graph, shared_grounder() if self.kb is None else NameGrounder(kb), k, notes)
-        reply = self.client.complete(
-            [{"role": "system", "content": SYSTEM_PROMPT}, {"role": "user", "content": user_prompt(graph, kb, k)}],
-            schema=schema,
-            temperature=self.temperature,
-            seed=self.seed,
-        )
+        reply = self.ask(SYSTEM_PROMPT, user_prompt(graph, kb, k), schema)
         out: list[Hypothesis] = []
         seen: set[tuple[str, str | None]] = set()
         for h in reply.hypotheses[:k]:

@@ -189,13 +189,9 @@ def _child_reachable(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
     "A relation says the object is inside the container (or inside anything, for '*').",
 )
 def _inside(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
-    obj = ctx.obj(call)
-    holders = [_base(h) for h in ctx.relations(obj.name, "inside") if h]
-    want = str(call.args.get("container", "*"))
-    if want == "*":
-        return bool(holders), f"{obj.name} is {'inside ' + holders[0] if holders else 'not inside anything'}"
-    names = set(_resolve_many(ctx, call, "container"))
-    hit = [h for h in holders if h in names]
+    obj, hit, names = _related(ctx, call, "inside", "container")
+    if names is None:
+        return bool(hit), f"{obj.name} is {'inside ' + hit[0] if hit else 'not inside anything'}"
     return bool(hit), f"{obj.name} is {'inside ' + hit[0] if hit else 'not inside ' + '/'.join(sorted(names))}"
 
 
@@ -205,14 +201,21 @@ def _inside(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
     "A relation says the object rests on the support.",
 )
 def _on(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
-    obj = ctx.obj(call)
-    supports = [_base(s) for s in ctx.relations(obj.name, "on") if s]
-    want = str(call.args.get("support", "*"))
-    if want == "*":
-        return bool(supports), f"{obj.name} rests on {supports[0] if supports else 'nothing'}"
-    names = set(_resolve_many(ctx, call, "support"))
-    hit = [s for s in supports if s in names]
+    obj, hit, names = _related(ctx, call, "on", "support")
+    if names is None:
+        return bool(hit), f"{obj.name} rests on {hit[0] if hit else 'nothing'}"
     return bool(hit), f"{obj.name} is {'on ' + hit[0] if hit else 'not on ' + '/'.join(sorted(names))}"
+
+
+def _related(ctx: _Ctx, call: PredicateCall, relation: str, arg: str) -> tuple[GraphObject, list[str], set[str] | None]:
+    """The object, the instances it stands in ``relation`` to that ``arg`` names, and those names
+    (None for ``'*'``: then every instance it stands in that relation to counts)."""
+    obj = ctx.obj(call)
+    related = [_base(r) for r in ctx.relations(obj.name, relation) if r]
+    if str(call.args.get(arg, "*")) == "*":
+        return obj, related, None
+    names = set(_resolve_many(ctx, call, arg))
+    return obj, [r for r in related if r in names], names
 
 
 def _resolve_many(ctx: _Ctx, call: PredicateCall, arg: str) -> list[str]:

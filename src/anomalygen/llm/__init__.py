@@ -19,7 +19,7 @@ _EXPORTS = {
     "LLMItemError": "anomalygen.llm.client",
     "parse_reply": "anomalygen.llm.client",
     "get_client": "anomalygen.llm.factory",
-    "make_backend": "anomalygen.llm.factory",
+    "make_backend": "anomalygen.llm.backends.registry",
     "shared_client": "anomalygen.llm.factory",
     "record_usage": "anomalygen.llm.usage",
 }
@@ -35,8 +35,9 @@ __all__ = [
 ]
 
 if TYPE_CHECKING:  # pragma: no cover
+    from anomalygen.llm.backends.registry import make_backend
     from anomalygen.llm.client import LLMClient, LLMItemError, parse_reply
-    from anomalygen.llm.factory import get_client, make_backend, shared_client
+    from anomalygen.llm.factory import get_client, shared_client
     from anomalygen.llm.usage import record_usage
 
 

@@ -67,7 +67,7 @@ def schema_by_name(name: str):
         if (
             isinstance(value, type)
             and issubclass(value, BaseModel)
-            and value.__module__ == schema_module.__name__
+            and value.__module__.startswith(f"{schema_module.__name__}.")
         ):
             known.setdefault(attr, value)
     for key in (name, *(k for k in known if k.lower() == name.lower())):

@@ -24,6 +24,7 @@ from pydantic_core import PydanticSerializationError
 
 from anomalygen.errors import ItemFailed, UserError
 from anomalygen.llm.backends import Backend, PermanentError, RawReply, Request, TransientError
+from anomalygen.llm.backends.registry import make_backend
 from anomalygen.llm.cache import ReplyCache, cache_key
 from anomalygen.llm.jsonextract import JSONExtractError, extract_json
 from anomalygen.llm.schema_tools import bounded_schema, response_schema, schema_fingerprint
@@ -307,8 +308,6 @@ class LLMClient:
 
 
 def _rebuild_client(config, rng, backoff_base_s, backoff_max_s) -> LLMClient:
-    from anomalygen.llm.factory import make_backend
-
     return LLMClient(
         config, make_backend(config), rng=rng, backoff_base_s=backoff_base_s, backoff_max_s=backoff_max_s
     )

@@ -32,7 +32,7 @@ class Chosen:
     name: str  # instance name, e.g. kitchen_knife_0
     catalogue: str  # catalogue / vocabulary name
     role: ObjectRole
-    asset: object  # anomalygen.assets.core.Asset
+    asset: object  # anomalygen.assets.model.Asset
     joint_values: dict[str, float] = field(default_factory=dict)  # unprefixed joint -> value
 
     @property
@@ -112,7 +112,7 @@ def choose_size(
     """Largest dimension: uniform in the knowledge base's range (intersected with the generator's),
     clamped by ``cap`` (the spatial rule of a container opening or a support surface). A
     ``preferred`` size (an engine's, e.g. the LLM's) is used instead of the draw, clamped the same way."""
-    from anomalygen.assets.core import size_range
+    from anomalygen.assets.names import size_range
 
     lo, hi = size_range(catalogue)
     kb_range = kb_size_range(kb, catalogue)

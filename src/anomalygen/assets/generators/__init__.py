@@ -1,1 +1,1 @@
-"""Procedural generators, one function per vocabulary name, registered with ``core.register``."""
+"""Procedural generators, one function per vocabulary name, registered with ``registry.register``."""

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 
-from anomalygen.assets.core import Cavity, Draft, Surface, register
 from anomalygen.assets.generators.common import (
     APPLIANCE,
     BLACK_GLASS,
@@ -25,7 +24,9 @@ from anomalygen.assets.generators.common import (
     u,
 )
 from anomalygen.assets.generators.parts_lib import knob, side_door, top_lid
+from anomalygen.assets.model import Cavity, Draft, Surface
 from anomalygen.assets.parts import Part, axis_angle
+from anomalygen.assets.registry import register
 
 
 def button(parent: Part, name, pos, half, rgba, axis=(0, 0, -1), travel=0.004, label="button"):

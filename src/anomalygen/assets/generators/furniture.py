@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 
-from anomalygen.assets.core import Cavity, Draft, Surface, register
 from anomalygen.assets.generators.common import (
     APPLIANCE,
     BLACK_GLASS,
@@ -29,7 +28,9 @@ from anomalygen.assets.generators.common import (
     u,
 )
 from anomalygen.assets.generators.parts_lib import drawer, drop_door, knob, side_door, top_lid
+from anomalygen.assets.model import Cavity, Draft, Surface
 from anomalygen.assets.parts import Part
+from anomalygen.assets.registry import register
 
 
 def _cells(r: Part, hx, hy, z0, z1, cols: int, rows: int, t: float, rgba, density, rng, prefix=""):

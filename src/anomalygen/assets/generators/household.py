@@ -10,7 +10,6 @@ import math
 
 import numpy as np
 
-from anomalygen.assets.core import Cavity, Draft, Surface, register
 from anomalygen.assets.generators.common import (
     CERAMIC,
     D_CERAMIC,
@@ -32,7 +31,9 @@ from anomalygen.assets.generators.common import (
     pick,
     u,
 )
+from anomalygen.assets.model import Cavity, Draft, Surface
 from anomalygen.assets.parts import Part, axis_angle
+from anomalygen.assets.registry import register
 
 
 def _d(root, features=(), **params):

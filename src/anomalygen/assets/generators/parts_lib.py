@@ -9,8 +9,8 @@ their own cabinet.
 
 from __future__ import annotations
 
-from anomalygen.assets.core import Cavity
 from anomalygen.assets.generators.common import D_METAL, METAL, open_box
+from anomalygen.assets.model import Cavity
 from anomalygen.assets.parts import Part
 
 

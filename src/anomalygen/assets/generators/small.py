@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 
-from anomalygen.assets.core import Draft, Surface, register
 from anomalygen.assets.generators.appliances import button
 from anomalygen.assets.generators.common import (
     BLACK_GLASS,
@@ -24,7 +23,9 @@ from anomalygen.assets.generators.common import (
     pick,
     u,
 )
+from anomalygen.assets.model import Draft, Surface
 from anomalygen.assets.parts import Part, axis_angle
+from anomalygen.assets.registry import register
 
 
 @register("Camera")

@@ -10,12 +10,10 @@ from __future__ import annotations
 import base64
 import inspect
 import json
-import os
 from typing import Any
 
-from anomalygen.errors import UserError
 from anomalygen.llm.backends import PermanentError, RawReply, Request, TransientError
-from anomalygen.llm.backends.openai_backend import _origin, _short, image_mime
+from anomalygen.llm.backends.http import HTTPBackend, image_mime, short_error
 
 
 def split_system(messages: list[dict[str, Any]]) -> tuple[str, list[dict[str, Any]]]:
@@ -26,32 +24,29 @@ def split_system(messages: list[dict[str, Any]]) -> tuple[str, list[dict[str, An
     return system, rest
 
 
-class AnthropicBackend:
+class AnthropicBackend(HTTPBackend):
     name = "anthropic"
     prompt_schema_style = "full"
 
     def __init__(self, config):
         import anthropic
 
-        if not config.model:
-            raise UserError("llm.model is not set: pass --model NAME (e.g. an Anthropic model id)")
-        key = config.api_key.get_secret_value() if config.api_key else os.environ.get("ANTHROPIC_API_KEY")
-        if not key and not config.base_url:
-            raise UserError("no Anthropic API key: set ANTHROPIC_API_KEY or ANOMALYGEN_LLM__API_KEY")
+        super().__init__(
+            config,
+            "ANTHROPIC_API_KEY",
+            no_model="pass --model NAME (e.g. an Anthropic model id)",
+            no_key="no Anthropic API key: set ANTHROPIC_API_KEY or ANOMALYGEN_LLM__API_KEY",
+        )
         base = config.base_url.rstrip("/") if config.base_url else None
         if base and base.endswith("/v1"):
             base = base[: -len("/v1")]  # the SDK appends /v1/messages itself
-        self.model = config.model
-        self._where = _origin(config.base_url) if config.base_url else "the default endpoint"
-        self.api_key_in_use = key  # only so the client can scrub it from error text
-        self.supports_images = bool(config.vision)
         self._anthropic = anthropic
         # Recent SDKs dropped sampling parameters from ``messages.create``; send them only where accepted.
         self._accepts_temperature = (
             "temperature" in inspect.signature(anthropic.resources.messages.Messages.create).parameters
         )
         self._client = anthropic.Anthropic(
-            api_key=key or "not-needed", base_url=base, timeout=config.timeout_s, max_retries=0
+            api_key=self.api_key_in_use or "not-needed", base_url=base, timeout=config.timeout_s, max_retries=0
         )
 
     def complete_raw(self, request: Request) -> RawReply:
@@ -82,15 +77,15 @@ class AnthropicBackend:
         try:
             resp = self._client.messages.create(**kwargs)
         except (a.RateLimitError, a.InternalServerError) as exc:
-            raise TransientError(f"HTTP {exc.status_code}: {_short(exc)}") from None
+            raise TransientError(f"HTTP {exc.status_code}: {short_error(exc)}") from None
         except a.APITimeoutError:
             raise TransientError("request timed out") from None
         except a.APIConnectionError as exc:
             raise TransientError(f"cannot connect to {self._where}: {type(exc).__name__}") from None
         except a.APIStatusError as exc:
             if exc.status_code in (408, 409, 529) or exc.status_code >= 500:
-                raise TransientError(f"HTTP {exc.status_code}: {_short(exc)}") from None
-            raise PermanentError(f"HTTP {exc.status_code}: {_short(exc)}") from None
+                raise TransientError(f"HTTP {exc.status_code}: {short_error(exc)}") from None
+            raise PermanentError(f"HTTP {exc.status_code}: {short_error(exc)}") from None
         text = ""
         texts = []
         for block in getattr(resp, "content", None) or []:

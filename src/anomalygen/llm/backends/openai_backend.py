@@ -11,24 +11,13 @@ The SDK's own retries are off: ``anomalygen.llm.client`` owns retry, backoff and
 from __future__ import annotations
 
 import base64
-import os
 import threading
 from typing import Any
 
-from anomalygen.errors import UserError
 from anomalygen.llm.backends import PermanentError, RawReply, Request, TransientError
+from anomalygen.llm.backends.http import HTTPBackend, image_mime, short_error
 
 _MODES = ("json_schema", "json_object", "plain")
-
-
-def image_mime(data: bytes) -> str:
-    if data[:8] == b"\x89PNG\r\n\x1a\n":
-        return "image/png"
-    if data[:3] == b"\xff\xd8\xff":
-        return "image/jpeg"
-    if data[:4] == b"RIFF" and data[8:12] == b"WEBP":
-        return "image/webp"
-    return "application/octet-stream"
 
 
 def with_images_openai(messages: list[dict[str, Any]], images: list[bytes]) -> list[dict[str, Any]]:
@@ -47,27 +36,22 @@ def with_images_openai(messages: list[dict[str, Any]], images: list[bytes]) -> l
     return out
 
 
-class OpenAIBackend:
+class OpenAIBackend(HTTPBackend):
     name = "openai"
     prompt_schema_style = "full"
 
     def __init__(self, config):
         import openai
 
-        if not config.model:
-            raise UserError("llm.model is not set: pass --model NAME or set ANOMALYGEN_LLM__MODEL")
-        key = config.api_key.get_secret_value() if config.api_key else os.environ.get("OPENAI_API_KEY")
-        if not key and not config.base_url:
-            raise UserError(
-                "no OpenAI API key: set OPENAI_API_KEY or ANOMALYGEN_LLM__API_KEY (or --base-url for a local server)"
-            )
-        self.model = config.model
-        self._where = _origin(config.base_url) if config.base_url else "the default endpoint"
-        self.api_key_in_use = key  # only so the client can scrub it from error text
-        self.supports_images = bool(config.vision)
+        super().__init__(
+            config,
+            "OPENAI_API_KEY",
+            no_model="pass --model NAME or set ANOMALYGEN_LLM__MODEL",
+            no_key="no OpenAI API key: set OPENAI_API_KEY or ANOMALYGEN_LLM__API_KEY (or --base-url for a local server)",
+        )
         self._openai = openai
         self._client = openai.OpenAI(
-            api_key=key or "not-needed", base_url=config.base_url, timeout=config.timeout_s, max_retries=0
+            api_key=self.api_key_in_use or "not-needed", base_url=config.base_url, timeout=config.timeout_s, max_retries=0
         )
         self._mode_index = 0
         self._limit_param = "max_tokens"  # local servers know it; OpenAI's newer models want max_completion_tokens  # moves down _MODES when a server rejects a structured-output mode
@@ -107,23 +91,23 @@ class OpenAIBackend:
             try:
                 resp = self._client.chat.completions.create(**kwargs)
             except self._openai.BadRequestError as exc:
-                if "max_completion_tokens" in _short(exc) and self._limit_param == "max_tokens":
+                if "max_completion_tokens" in short_error(exc) and self._limit_param == "max_tokens":
                     self._limit_param = "max_completion_tokens"  # newer OpenAI models reject max_tokens
                     continue
                 if index + 1 < len(_MODES):  # maybe the server lacks this structured-output mode
                     index += 1
                     continue
-                raise PermanentError(f"HTTP 400 bad request: {_short(exc)}") from None
+                raise PermanentError(f"HTTP 400 bad request: {short_error(exc)}") from None
             except (self._openai.RateLimitError, self._openai.InternalServerError) as exc:
-                raise TransientError(f"HTTP {exc.status_code}: {_short(exc)}") from None
+                raise TransientError(f"HTTP {exc.status_code}: {short_error(exc)}") from None
             except self._openai.APITimeoutError:
                 raise TransientError("request timed out") from None
             except self._openai.APIConnectionError as exc:
                 raise TransientError(f"cannot connect to {self._where}: {type(exc).__name__}") from None
             except self._openai.APIStatusError as exc:
                 if exc.status_code in (408, 409) or exc.status_code >= 500:
-                    raise TransientError(f"HTTP {exc.status_code}: {_short(exc)}") from None
-                raise PermanentError(f"HTTP {exc.status_code}: {_short(exc)}") from None
+                    raise TransientError(f"HTTP {exc.status_code}: {short_error(exc)}") from None
+                raise PermanentError(f"HTTP {exc.status_code}: {short_error(exc)}") from None
             if structured and index > self._mode_index:
                 with self._lock:  # a weaker mode worked where a stronger one got 400: remember it
                     self._mode_index = max(self._mode_index, index)
@@ -142,24 +126,5 @@ class OpenAIBackend:
             models = self._client.models.list()
             first = next(iter(models), None)
         except self._openai.APIError as exc:
-            raise PermanentError(f"{type(exc).__name__}: {_short(exc)}") from None
+            raise PermanentError(f"{type(exc).__name__}: {short_error(exc)}") from None
         return first.id if first is not None else ""
-
-
-def _short(exc: Exception) -> str:
-    body = getattr(exc, "body", None)
-    msg = None
-    if isinstance(body, dict):
-        err = body.get("error", body)
-        msg = err.get("message") if isinstance(err, dict) else str(err)
-    text = str(msg or getattr(exc, "message", None) or exc)
-    return " ".join(text.split())[:200]
-
-
-def _origin(url: str) -> str:
-    """scheme://host:port of an endpoint, for error messages (no path, no user:password)."""
-    from urllib.parse import urlsplit
-
-    parts = urlsplit(url)
-    host = parts.hostname or "?"
-    return f"{parts.scheme}://{host}" + (f":{parts.port}" if parts.port else "")

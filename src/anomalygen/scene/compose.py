@@ -1,0 +1,230 @@
+"""One MjSpec from a placed layout: robot, room, cameras, lights and objects; joint tuning after compile.
+
+Loose objects get rolling friction and stiff contacts; after compiling, hinges that gravity would
+swing shut get friction and a button set to 'on' is latched, so the hazard state survives settling.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from anomalygen.scene import furniture, layout, robot, robot_model
+from anomalygen.scene.graph import FLOOR_GEOM
+from anomalygen.scene.layout import Layout, Placed
+from anomalygen.scene.sensors import add_observation_sensors
+from anomalygen.schema import ObjectRole
+
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
+
+
+LOOSE_SOLREF = 0.005  # s: contact time constant of loose objects (2.5 physics steps)
+
+
+def _look_at_xyaxes(eye, target) -> list[float]:
+    """Camera xyaxes (MuJoCo cameras look along -z) for a camera at ``eye`` looking at ``target``."""
+    fwd = np.asarray(target, float) - np.asarray(eye, float)
+    fwd /= np.linalg.norm(fwd)
+    right = np.cross(fwd, [0.0, 0.0, 1.0])
+    if np.linalg.norm(right) < 1e-6:
+        right = np.array([0.0, -1.0, 0.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, fwd)
+    return [*right.tolist(), *up.tolist()]
+
+
+def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rng):
+    import mujoco
+
+    spec = robot_model.build_robot_spec(tuple(lay.base))
+    spec.modelname = "anomalygen_scene"
+    spec.option.timestep = 0.002
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.visual.global_.offwidth = max(640, settings.build.render_width)
+    spec.visual.global_.offheight = max(480, settings.build.render_height)
+    spec.visual.quality.shadowsize = 512
+    tex = spec.add_texture(
+        name="floor_tex",
+        type=mujoco.mjtTexture.mjTEXTURE_2D,
+        builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
+        rgb1=[0.62, 0.58, 0.52],
+        rgb2=[0.55, 0.5, 0.45],
+        width=256,
+        height=256,
+    )
+    mat = spec.add_material(name="floor_mat", texrepeat=[6, 6], reflectance=0.05)
+    mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = tex.name
+    center = layout.ROOM_CENTER
+    half = layout.ROOM_HALF + 0.6
+    spec.worldbody.add_geom(
+        name=FLOOR_GEOM,
+        type=mujoco.mjtGeom.mjGEOM_PLANE,
+        size=[half[0], half[1], 0.05],
+        pos=[center[0], center[1], 0],
+        material="floor_mat",
+    )
+    wall_rgba = [0.86, 0.85, 0.8, 1]
+    spec.worldbody.add_geom(
+        name="wall_back",
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[0.05, half[1], 1.3],
+        pos=[center[0] + half[0] + 0.05, center[1], 1.3],
+        rgba=wall_rgba,
+    )
+    spec.worldbody.add_geom(
+        name="wall_left",
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[half[0], 0.05, 1.3],
+        pos=[center[0], center[1] + half[1] + 0.05, 1.3],
+        rgba=wall_rgba,
+    )
+    spec.worldbody.add_light(
+        name="sun",
+        pos=[center[0], center[1], 3.5],
+        dir=[0.2, 0.1, -1],
+        type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
+        diffuse=[0.6, 0.6, 0.6],
+        specular=[0.1, 0.1, 0.1],
+        castshadow=True,
+    )
+    spec.worldbody.add_light(
+        name="fill", pos=[-1.0, -1.0, 2.5], dir=[0.5, 0.4, -0.6], diffuse=[0.35, 0.35, 0.35], castshadow=False
+    )
+
+    focus = np.mean(
+        [p.world_center() for p in placed.values() if p.role != ObjectRole.CLUTTER]
+        or [np.array([1.0, 0, 0.4])],
+        axis=0,
+    )
+    focus[2] = min(max(focus[2], 0.2), 0.8)
+    # Front camera: behind the robot as seen from the task objects, raised, turned 30 degrees, so
+    # the robot stands in the foreground and the scene behind it.
+    away = lay.base[:2] - focus[:2]
+    dist = float(np.linalg.norm(away))
+    away = away / dist if dist > 1e-6 else np.array([-1.0, 0.0])
+    c, s = math.cos(0.5), math.sin(0.5)
+    away = np.array([c * away[0] - s * away[1], s * away[0] + c * away[1]])
+    eye = np.r_[focus[:2] + away * (dist + 1.0), 1.9]
+    spec.worldbody.add_camera(name="front", pos=eye.tolist(), xyaxes=_look_at_xyaxes(eye, focus), fovy=60)
+    top_eye = np.array([focus[0], focus[1] - 0.01, 3.3])
+    spec.worldbody.add_camera(name="top", pos=top_eye.tolist(), xyaxes=[0, -1, 0, 1, 0, 0], fovy=55)
+
+    loose, parts = [], []
+    for p in placed.values():
+        body = spec.worldbody.add_body(name=p.name, pos=p.pos.tolist(), quat=p.quat)
+        if p.support_geom is not None:
+            furniture.emit(p.support_geom, body, rng)
+            continue
+        root = p.asset.attach(body, f"{p.name}/")
+        if not p.fixed:
+            body.add_freejoint(name=f"{p.name}/free")
+            loose.append((p.name, root.name))
+        parts.extend(_articulated_bodies(root))
+        if not p.fixed:
+            # Rolling and torsional friction (condim 6): a needle or pencil must not roll for ever.
+            # A 1 mm contact margin stops needles and coins tunnelling into a table top. Their
+            # contacts are stiffer than the 20 ms default (priority makes theirs win): with it a
+            # needle set down in a box sank past the middle of the 8 mm bottom and was pushed out
+            # underneath.
+            for geom in _geoms_below(root):
+                geom.condim = 6
+                geom.friction = [max(geom.friction[0], 0.8), 0.01, 0.002]
+                geom.margin = max(geom.margin, 0.001)
+                geom.priority = 1
+                geom.solref = [LOOSE_SOLREF, 1.0]
+    # Suction can also hold a door, lid or drawer, so primitives can pull parts open or lift them shut.
+    robot_model.add_suction_welds(spec, [n for n, _ in loose] + parts, [r for _, r in loose] + parts)
+    task_objects = [p for p in placed.values() if p.role != ObjectRole.CLUTTER]
+    add_observation_sensors(
+        spec,
+        list(robot.ROBOT_JOINTS),
+        [p.name for p in task_objects],
+        [f"{p.name}/{j.name}" for p in task_objects if p.asset is not None for j in p.asset.joints],
+    )
+    spec.add_key(name="init")
+    return spec
+
+
+def _articulated_bodies(body) -> list[str]:
+    """Names of the bodies under ``body`` that move on a hinge or slide joint (doors, lids, drawers)."""
+    import mujoco
+
+    out = []
+    if any(j.type in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE) for j in body.joints):
+        out.append(body.name)
+    for child in body.bodies:
+        out.extend(_articulated_bodies(child))
+    return out
+
+
+def _geoms_below(body) -> list:
+    out = list(body.geoms)
+    for child in body.bodies:
+        out.extend(_geoms_below(child))
+    return out
+
+
+def latch_switched_on(model, placed: dict[str, Placed], mjspec) -> None:
+    """A spring-returned button set to 'on' is modelled as latched (a kettle's switch stays down):
+    its return spring is removed so the hazard state persists; friction keeps it where it is set."""
+    import mujoco
+
+    for p in placed.values():
+        if p.asset is None:
+            continue
+        for j in p.asset.joints:
+            value = p.joint_values.get(j.name)
+            if value is None or abs(value - j.closed_value) < 1e-9:
+                continue
+            jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{p.name}/{j.name}")
+            if jid < 0 or model.jnt_stiffness[jid] <= 0:
+                continue
+            stiffness = float(model.jnt_stiffness[jid])
+            model.jnt_stiffness[jid] = 0.0
+            dof = model.jnt_dofadr[jid]
+            hold = stiffness * abs(value - j.closed_value) * 1.5
+            model.dof_frictionloss[dof] = max(model.dof_frictionloss[dof], hold)
+            sj = mjspec.joint(f"{p.name}/{j.name}")
+            sj.stiffness = [0.0] * len(sj.stiffness) if hasattr(sj.stiffness, "__len__") else 0.0
+            sj.frictionloss = float(model.dof_frictionloss[dof])
+
+
+def hold_gravity_hinges(model, placed: dict[str, Placed], mjspec) -> None:
+    """Give horizontal-axis hinges (lids, laptop screens) enough friction to stay where they are set.
+
+    Real lids and oven doors are stiff enough to stay open; a frictionless model would slam shut
+    during settling and the hazard would vanish. The friction is 1.3x the gravity torque of the
+    moving part, so the robot can still close it.
+    """
+    import mujoco
+
+    g = abs(model.opt.gravity[2])
+    for p in placed.values():
+        if p.asset is None:
+            continue
+        for j in p.asset.joints:
+            vertical_slide = j.type == "slide" and abs(j.axis[2]) > 0.7
+            if not vertical_slide and (j.type != "hinge" or abs(j.axis[2]) > 0.7):
+                continue
+            jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{p.name}/{j.name}")
+            if jid < 0:
+                continue
+            body = model.jnt_bodyid[jid]
+            mass = model.body_subtreemass[body]
+            lever = (
+                float(np.linalg.norm(model.body_ipos[body]))
+                + 0.5 * float(np.max(model.body_inertia[body]) / max(mass, 1e-6)) ** 0.5
+            )
+            friction = 1.3 * mass * g * (1.0 if vertical_slide else max(lever, 0.02))
+            dof = model.jnt_dofadr[jid]
+            model.dof_frictionloss[dof] = max(model.dof_frictionloss[dof], friction)
+            mjspec.joint(f"{p.name}/{j.name}").frictionloss = float(model.dof_frictionloss[dof])
+
+
+def set_joints(model, data, placed: dict[str, Placed]) -> None:
+    for p in placed.values():
+        for jname, value in p.joint_values.items():
+            data.joint(f"{p.name}/{jname}").qpos[0] = value

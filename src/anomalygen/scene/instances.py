@@ -1,0 +1,128 @@
+"""One chosen object as a placed instance, and where other things can go on it.
+
+A ``select.Chosen`` becomes a ``layout.Placed`` (its box, front and the sweep of open doors); a holder's
+top surface and biggest cavity are given in world coordinates, and a container's room says what lies
+flat in it. The margins every placement keeps from a support's edge are defined here too.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from anomalygen.errors import ItemFailed
+from anomalygen.scene import furniture, layout, select
+from anomalygen.scene.layout import Placed
+from anomalygen.schema import CLOSURE_LABELS, SWINGING_CLOSURES, ObjectRole
+
+INWARD = 0.13  # m kept from a support's edge by things that are not the edge hazard
+HAZARD_NEAR_SIDE = 0.4  # m: the hazard's centre at most this far from the robot-facing edge (arm's reach)
+
+
+def instance_name(catalogue: str, used: set[str]) -> str:
+    base = catalogue.lower()
+    i = 0
+    while f"{base}_{i}" in used:
+        i += 1
+    name = f"{base}_{i}"
+    used.add(name)
+    return name
+
+
+def _front(asset) -> np.ndarray | None:
+    """Local direction the asset's doors/drawers open to (the catalogue convention is -y)."""
+    if any(j.label in CLOSURE_LABELS for j in asset.joints) or asset.cavities:
+        return np.array([0.0, -1.0])
+    return None
+
+
+def _sweep(asset, values: dict[str, float]) -> float:
+    """How far open doors/drawers reach out of the closed bounding box, conservatively."""
+    ext = asset.aabb[1] - asset.aabb[0]
+    out = 0.0
+    for j in asset.joints:
+        v = values.get(j.name)
+        if v is None or abs(v - j.closed_value) < 1e-6:
+            continue
+        if j.type == "slide":
+            out = max(out, abs(v - j.closed_value) + 0.02)
+        elif j.label in SWINGING_CLOSURES:
+            out = max(out, min(float(max(ext[0], ext[2] if abs(j.axis[2]) < 0.5 else ext[0])), 1.0))
+    return out
+
+
+def placed_instance(chosen: select.Chosen) -> Placed:
+    lo, hi = (np.asarray(v, float) for v in chosen.asset.aabb)
+    p = Placed(
+        name=chosen.name,
+        catalogue=chosen.catalogue,
+        role=chosen.role,
+        lo=lo,
+        hi=hi,
+        fixed=chosen.fixed,
+        asset=chosen.asset,
+        joint_values=dict(chosen.joint_values),
+        front=_front(chosen.asset),
+    )
+    p.sweep = _sweep(chosen.asset, chosen.joint_values)
+    return p
+
+
+def placed_support(kind: str, name: str, rng, role=ObjectRole.SUPPORT) -> Placed:
+    sup = furniture.sample_support(kind, rng)
+    lo, hi = sup.aabb()
+    return Placed(
+        name=name,
+        catalogue=sup.category,
+        role=role,
+        lo=lo,
+        hi=hi,
+        fixed=True,
+        support_geom=sup,
+        front=np.array([-1.0, 0.0]),
+    )
+
+
+def surface_of(holder: Placed):
+    """The top surface of a holder in world coordinates: (lo_xy, hi_xy, top_z)."""
+    if holder.support_geom is not None:
+        s = holder.support_geom
+        return layout.surface_world(holder, (0.0, 0.0, s.top), s.half)
+    surfaces = list(holder.asset.surfaces)
+    if not surfaces:
+        lo, hi = holder.asset.aabb
+        return layout.surface_world(
+            holder, (0.0, 0.0, float(hi[2])), (float(hi[0] - lo[0]) / 2 * 0.8, float(hi[1] - lo[1]) / 2 * 0.8)
+        )
+    best = max(surfaces, key=lambda s: s.half_size[0] * s.half_size[1])
+    return layout.surface_world(holder, best.center, best.half_size)
+
+
+def cavity_world(holder: Placed):
+    asset = holder.asset
+    if not asset.cavities:
+        raise ItemFailed(f"{holder.catalogue} has no interior to put things in")
+    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+    center = np.asarray(cav.center, float).copy()
+    if cav.joint is not None:
+        j = asset.joint(cav.joint)
+        if j.type == "slide":
+            v = holder.joint_values.get(j.name, j.closed_value)
+            center += np.asarray(j.axis) * (v - 0.0)
+    c, s = math.cos(holder.yaw), math.sin(holder.yaw)
+    wc = holder.pos + np.array([c * center[0] - s * center[1], s * center[0] + c * center[1], center[2]])
+    h = np.asarray(cav.half_extents, float)
+    wh = np.array([abs(c) * h[0] + abs(s) * h[1], abs(s) * h[0] + abs(c) * h[1], h[2]])
+    return wc - wh, wc + wh, cav
+
+
+def container_room(asset) -> float:
+    """Longest thing that lies flat in the container's biggest cavity (along its long side)."""
+    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+    return 0.95 * 2 * float(max(cav.half_extents[0], cav.half_extents[1]))
+
+
+def cavity_cap(asset) -> float:
+    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+    return 0.8 * 2 * float(min(cav.half_extents))
