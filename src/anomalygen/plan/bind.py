@@ -19,7 +19,7 @@ import math
 from anomalygen.errors import ItemFailed
 from anomalygen.schema import CHILD_REACH, ENCLOSING_LABELS, GraphObject, Relation, SceneGraph
 
-REACH_TOP_M = 1.6  # a container whose top is higher than this is out of the arm's comfortable reach
+REACH_BOTTOM_M = 1.2  # a container standing higher than this is out of the arm's comfortable reach
 AFTER_PLACE_LIFT_M = 0.02  # predicted height of a placed object above its container's base
 
 
@@ -54,7 +54,7 @@ def bind_fix(hc, fault: str, graph: SceneGraph, kb) -> dict[str, str]:
 def choose_container(hc, obj: GraphObject, graph: SceneGraph, kb) -> str:
     kinds = kb.containers_for(hc, obj.category)
     fits = [o for o in graph.objects if o.name != obj.name and o.category in kinds and _fits(obj, o)
-            and o.position[2] + o.size[2] / 2 <= REACH_TOP_M]
+            and o.height_above_floor <= REACH_BOTTOM_M]  # a tall fridge is reachable: its lower shelves are
     if not fits:
         raise ItemFailed(f"no reachable container for {obj.name} in the scene (wanted: {', '.join(kinds) or 'none'})")
     ending = [o for o in fits if ends_hazard(hc, obj, o, graph)]

@@ -142,6 +142,8 @@ def select_objects(task: TaskProposal, rng, hints=None) -> Selection:
                     break
                 sel.forget(container)
                 container = sel.choose(container_name, ObjectRole.CONTAINER)
+            if hazard.size > container_room(container.asset) and container is not target:
+                container = _roomier_kind(sel, hc, container, container_name, hazard.size)
             room = container_room(container.asset)
             if hazard.size > room and hazard is not target:
                 sel.forget(hazard)
@@ -196,6 +198,24 @@ def _open_as_the_fix_would(chosen: select.Chosen, label: str, hc) -> None:
         closed = joint.closed_value
         far = hi if abs(hi - closed) >= abs(lo - closed) else lo
         chosen.joint_values[joint.name] = float(closed + fraction * (far - closed))
+
+
+def _roomier_kind(sel: Selection, hc, container, name: str, size: float):
+    """Another of the class's usual containers that the hazard fits (a plastic bag too big for any
+    bucket goes to the trash can), or the container as it was."""
+    for alt in hc.default_containers:
+        if alt == name:
+            continue
+        for _ in range(CONTAINER_REDRAWS):
+            try:
+                cand = sel.choose(alt, ObjectRole.CONTAINER)
+            except ItemFailed:
+                break
+            if cand.asset.cavities and size <= container_room(cand.asset):
+                sel.forget(container)
+                return cand
+            sel.forget(cand)
+    return container
 
 
 def set_initial_joints(sel: Selection) -> None:
