@@ -29,6 +29,7 @@ from anomalygen.schema import (
 
 ACCESS_LABELS = (*ENCLOSING_LABELS, "flap")  # parts that open a way into a container
 NEARLY_CLOSED_TOL = 0.1  # open fraction under which a part still blocks the way in
+OPEN_FRACTION = 0.6  # how far an opened part goes unless the recipe says (a window for air: a crack)
 
 
 def _joint_for(spec, obj: str, part: str | None) -> tuple[str | None, float | None]:
