@@ -21,8 +21,8 @@ def test_a_choking_hazard_goes_behind_a_drawer_not_into_the_nearer_open_carton()
     hc = kb.hazard_classes["remove_choking_hazards"]
     marble = next(o for o in g.objects if o.name == "marble_0")
     by = {o.name: o for o in g.objects}
-    assert not ends_hazard(hc, marble, by["box_0"], g)  # flaps do not keep a toddler out
-    assert ends_hazard(hc, marble, by["storagefurniture_0"], g)
+    assert not ends_hazard([hc], marble, by["box_0"], g)  # flaps do not keep a toddler out
+    assert ends_hazard([hc], marble, by["storagefurniture_0"], g)
     assert choose_container(hc, marble, g, kb) == "storagefurniture_0"
 
 
@@ -30,5 +30,18 @@ def test_litter_is_done_with_once_in_the_nearest_bin():
     kb, g = load_kb(), _scene()
     hc = kb.hazard_classes["pick_up_floor_litter"]
     paper = next(o for o in g.objects if o.name == "paper_ball_0")
-    assert ends_hazard(hc, paper, next(o for o in g.objects if o.name == "trashcan_0"), g)
+    assert ends_hazard([hc], paper, next(o for o in g.objects if o.name == "trashcan_0"), g)
     assert choose_container(hc, paper, g, kb) == "trashcan_0"
+
+
+def test_stored_shears_go_where_no_other_class_fires_on_them():
+    """Inside an open carton, shears are stored (store_sharp_objects ends) yet within a child's reach."""
+    kb, g = load_kb(), _scene()
+    shears = obj("scissors_0", "Scissors", at="table", xy=(0.1, -0.2), size=(0.18, 0.06, 0.02))
+    g = g.model_copy(update={"objects": [*g.objects, shears]})
+    by = {o.name: o for o in g.objects}
+    store = kb.hazard_classes["store_sharp_objects"]
+    assert {"Box", "StorageFurniture"} <= set(kb.containers_for(store, "Scissors"))
+    assert choose_container(store, shears, g, kb) == "storagefurniture_0"  # the carton is nearer
+    assert not ends_hazard(list(kb.hazard_classes.values()), shears, by["box_0"], g)
+    assert ends_hazard(list(kb.hazard_classes.values()), shears, by["storagefurniture_0"], g)

@@ -57,16 +57,19 @@ def choose_container(hc, obj: GraphObject, graph: SceneGraph, kb) -> str:
             and o.height_above_floor <= REACH_BOTTOM_M]  # a tall fridge is reachable: its lower shelves are
     if not fits:
         raise ItemFailed(f"no reachable container for {obj.name} in the scene (wanted: {', '.join(kinds) or 'none'})")
-    ending = [o for o in fits if ends_hazard(hc, obj, o, graph)]
+    classes = list(kb.hazard_classes.values())
+    safe = [o for o in fits if ends_hazard(classes, obj, o, graph)]  # no hazard of any kind afterwards
+    ending = safe or [o for o in fits if ends_hazard([hc], obj, o, graph)]
     return _nearest(obj, ending or fits)
 
 
-def ends_hazard(hc, obj: GraphObject, container: GraphObject, graph: SceneGraph) -> bool:
-    """Would the class stop holding for ``obj`` once it is shut inside ``container``?
+def ends_hazard(classes, obj: GraphObject, container: GraphObject, graph: SceneGraph) -> bool:
+    """Would none of ``classes`` hold for ``obj`` once it is shut inside ``container``?
 
     Why: "inside a box" ends a litter hazard but not a choking one when the box is an open carton on
-    the floor. The robot predicts the scene after its fix (the object low inside the container, the
-    container's doors, drawers and lids shut) and checks the class's own preconditions on it.
+    the floor, and shears stored in a low open box are a child's hazard instead. The robot predicts
+    the scene after its fix (the object low inside the container, the container's doors, drawers and
+    lids shut) and checks the classes' own preconditions on it.
     """
     from anomalygen.knowledge.predicates import PredicateError, match_class
 
@@ -82,10 +85,13 @@ def ends_hazard(hc, obj: GraphObject, container: GraphObject, graph: SceneGraph)
         "relations": [r for r in graph.relations if obj.name not in (r.subject, r.object)]
         + [Relation(subject=obj.name, predicate="inside", object=container.name)],
     })
-    try:
-        return not match_class(hc, after, fixed={hc.hazard_variable: obj.name})
-    except PredicateError:
-        return True
+    for hc in classes:
+        try:
+            if match_class(hc, after, fixed={hc.hazard_variable: obj.name}):
+                return False
+        except PredicateError:
+            continue
+    return True
 
 
 def choose_support(hc, obj: GraphObject, graph: SceneGraph) -> str:
