@@ -12,7 +12,7 @@ and build, single-hazard); make them with ``--make`` (brainstorm 300 tasks with 
 seed 1 for held-out, build the switch-off ones).
 
     .venv/bin/python benchmarks/train_warm_start.py --make --train /tmp/ws/train --held-out /tmp/ws/test \\
-        [--steps 6000] [--n-envs 4] [--seed 0] [--out src/anomalygen/data/policies/switch_off.zip]
+        [--steps 6000] [--n-envs 4] [--seed 0] [--demos 0] [--out src/anomalygen/data/policies/switch_off.zip]
 
 Prints one JSON line: steps, wall time, training curve, held-out success per start and overall.
 """
@@ -85,6 +85,48 @@ def starts_of(run: Path, log=print) -> list:
     return out
 
 
+def demonstrations(starts, episodes: int, seed: int) -> dict:
+    """Transitions of the scripted reference (``part_skill.reference_action``) on the training starts."""
+    import numpy as np
+
+    from anomalygen.rl.part_env import PartTurnEnv
+    from anomalygen.rl.part_skill import reference_action
+
+    env = PartTurnEnv(starts)
+    cols = {k: [] for k in ("obs", "next_obs", "action", "reward", "done")}
+    wins = 0
+    for k in range(episodes):
+        obs, _ = env.reset(seed=seed + k)
+        done = False
+        while not done:
+            a = reference_action(obs)
+            nxt, r, term, trunc, info = env.step(a)
+            for key, v in zip(cols, (obs, nxt, a, r, term)):
+                cols[key].append(v)
+            obs, done = nxt, term or trunc
+        wins += bool(info.get("is_success"))
+    env.close()
+    out = {k: np.asarray(v, dtype=np.float32 if k != "done" else np.float32) for k, v in cols.items()}
+    out["success"] = wins / max(1, episodes)
+    return out
+
+
+def seeded_with(demos: dict, bc_steps: int, seed: int):
+    """A ``train_sac`` pretrain hook: behaviour cloning on the demos, and the demos in the replay buffer."""
+    from anomalygen.rl.sac import behaviour_clone
+
+    def pretrain(model) -> None:
+        nll = behaviour_clone(model, demos["obs"], demos["action"], steps=bc_steps, seed=seed)
+        print(f"behaviour cloning: {len(demos['obs'])} transitions, final NLL {nll:.2f}", file=sys.stderr)
+        n = model.n_envs
+        for i in range(0, len(demos["obs"]) - n + 1, n):
+            sl = slice(i, i + n)
+            model.replay_buffer.add(demos["obs"][sl], demos["next_obs"][sl], demos["action"][sl],
+                                    demos["reward"][sl], demos["done"][sl], [{} for _ in range(n)])
+
+    return pretrain
+
+
 def held_out_success(policy, starts, seeds: int) -> list[dict]:
     from anomalygen.rl.part_env import PartTurnEnv
     from anomalygen.rl.sac import evaluate_policy
@@ -109,6 +151,8 @@ def main() -> int:
     ap.add_argument("--eval-every", type=int, default=1000)
     ap.add_argument("--eval-seeds", type=int, default=3)
     ap.add_argument("--out", default=str(DEFAULT_OUT))
+    ap.add_argument("--demos", type=int, default=0, help="episodes of the scripted reference to seed SAC with (0: none)")
+    ap.add_argument("--bc-steps", type=int, default=2000)
     a = ap.parse_args()
 
     from anomalygen.rl.part_env import PartTurnEnv
@@ -123,10 +167,15 @@ def main() -> int:
     t_collect = time.perf_counter() - t0
     print(f"{len(train)} training starts, {len(test)} held-out starts ({t_collect:.0f} s)", file=sys.stderr)
     starts = [s for _, s in train]
+    demos, pretrain = None, None
+    if a.demos > 0:
+        demos = demonstrations(starts, a.demos, a.seed)
+        pretrain = seeded_with(demos, a.bc_steps, a.seed)
+        print(f"reference: success {demos['success']:.2f} on {a.demos} training episodes", file=sys.stderr)
     eval_env = PartTurnEnv([s for _, s in test])
     policy, res = train_sac(lambda: PartTurnEnv(starts), a.steps, seed=a.seed, eval_every=a.eval_every,
                             eval_episodes=max(5, len(test)), learning_starts=500, net_arch=(64, 64),
-                            n_envs=a.n_envs, eval_env=eval_env, stop_at=None,
+                            n_envs=a.n_envs, eval_env=eval_env, stop_at=None, pretrain=pretrain,
                             log=lambda m: print(m, file=sys.stderr, flush=True))
     out = Path(a.out)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -134,7 +183,8 @@ def main() -> int:
     rows = held_out_success(policy, test, a.eval_seeds)
     scenes = sorted({r["task"] for r in rows})
     per_scene = {t: all(r["success"] >= 0.5 for r in rows if r["task"] == t) for t in scenes}
-    summary = {"steps": res.steps, "n_envs": a.n_envs, "train_starts": len(train), "held_out_starts": len(test),
+    summary = {"demos": a.demos, "reference_success": None if demos is None else demos["success"],
+               "steps": res.steps, "n_envs": a.n_envs, "train_starts": len(train), "held_out_starts": len(test),
                "held_out_scenes": len(scenes), "train_wall_s": round(res.wall_s, 1), "collect_s": round(t_collect, 1),
                "best_eval_success": res.best_success, "best_step": res.best_step,
                "held_out_start_success": round(sum(r["success"] for r in rows) / max(1, len(rows)), 3),

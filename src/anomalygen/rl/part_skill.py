@@ -169,3 +169,14 @@ class PartReadout:
 
     def at_off(self, data) -> bool:
         return abs(self.fraction(data)) <= CLOSED_TOL
+
+
+def reference_action(obs: np.ndarray) -> np.ndarray:
+    """A scripted turn from the observation alone: move the held point along its towards-off direction
+    and pull the cup back onto it, suction on. Used for demonstrations that seed the warm start's
+    training (``benchmarks/train_warm_start.py --demos``); on the built scenes it turns a held knob to
+    off in 15-26 steps, but it has no notion of a hold that slips or a part that jams."""
+    a = np.zeros(7)
+    a[:3] = np.clip(0.6 * obs[3:6] + 0.5 * obs[0:3], -1.0, 1.0)
+    a[6] = 1.0
+    return a

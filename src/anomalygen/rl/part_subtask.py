@@ -39,6 +39,17 @@ def warm_start_path(family: str = FAMILY) -> Path | None:
     return p if p.is_file() else None
 
 
+def is_switch_off(drv, st: SubTask) -> bool:
+    """A sub-task of the family: planned so (``params["family"]``), or, from the LLM planner, one
+    that drives a knob or switch of the scene to its off value."""
+    if st.params.get("family") == FAMILY:
+        return True
+    js = _joint_state(drv, str(st.params.get("joint", "")))
+    target = st.params.get("target")
+    return js is not None and js.label in ("knob", "switch") and (
+        target is None or abs(float(target) - js.closed_value) < 1e-6)
+
+
 def _joint_state(drv, joint: str):
     for o in drv.spec.objects:
         for js in o.joint_states:

@@ -98,7 +98,7 @@ def train_sac(make_env, steps: int, *, seed: int = 0, eval_every: int = 1000, ev
               learning_starts: int = 500, threads: int = 1, stop_at: float | None = None, ent_coef: str = "auto_0.1",
               learning_rate: float = 3e-4, net_arch: tuple[int, ...] = (256, 256, 256), batch_size: int = 256,
               train_freq: int = 1, gradient_steps: int = 1, log=None, n_envs: int = 1, subproc: bool = False,
-              init_model: str | None = None, eval_env=None) -> tuple[object, SACResult]:
+              init_model: str | None = None, eval_env=None, pretrain=None) -> tuple[object, SACResult]:
     """Train SAC for ``steps`` env steps; return the model loaded with the best-success checkpoint.
 
     The defaults are the paper's settings (module docstring). With ``stop_at``, training ends at the
@@ -107,7 +107,8 @@ def train_sac(make_env, steps: int, *, seed: int = 0, eval_every: int = 1000, ev
     untrained. ``n_envs`` > 1 collects experience from that many envs at once (SB3 ``DummyVecEnv``, or
     ``SubprocVecEnv`` with ``subproc``: one process per env, worth it only with free cores, and
     ``make_env`` must then pickle); ``steps`` counts the transitions of all envs together. Evaluation
-    runs on one more env from ``make_env`` (or ``eval_env``: held-out scenes).
+    runs on one more env from ``make_env`` (or ``eval_env``: held-out scenes). ``pretrain(model)``
+    runs before the step-0 evaluation (e.g. :func:`behaviour_clone`, demonstrations in the buffer).
     """
     import torch
     from stable_baselines3 import SAC
@@ -123,6 +124,8 @@ def train_sac(make_env, steps: int, *, seed: int = 0, eval_every: int = 1000, ev
     else:
         env = DummyVecEnv([make_env] * n_envs)
     eval_env = eval_env if eval_env is not None else make_env()
+    # SB3 makes one call to train() per n_envs transitions: keep one gradient step per transition
+    gradient_steps = gradient_steps * n_envs
     starts = min(learning_starts, max(1, steps // 4))
     if init_model is not None:
         # a warm start keeps its weights and entropy coefficient; its replay buffer starts empty, so a
@@ -139,6 +142,8 @@ def train_sac(make_env, steps: int, *, seed: int = 0, eval_every: int = 1000, ev
     callback = success_eval_callback(eval_env, eval_every=eval_every, episodes=eval_episodes,
                                      seed=10_000 + seed * 100, result=result, stop_at=stop_at, log=log)
     callback.init_callback(model)
+    if pretrain is not None:
+        pretrain(model)
     callback.evaluate(0)
     if init_model is not None and stop_at is not None and result.curve[0]["success"] >= stop_at:
         result.steps = 0
@@ -150,3 +155,33 @@ def train_sac(make_env, steps: int, *, seed: int = 0, eval_every: int = 1000, ev
         model.policy.load_state_dict(result.policy_state)
     result.wall_s = time.perf_counter() - callback.t0
     return model, result
+
+
+def behaviour_clone(model, obs: np.ndarray, actions: np.ndarray, *, steps: int = 2000, batch_size: int = 256,
+                    seed: int = 0) -> float:
+    """Pre-train a SAC actor on demonstrations: maximise the log-likelihood of the demonstrated
+    actions under the squashed Gaussian policy (so the spread shrinks too, not only the mean).
+
+    Why: a suction hold is lost by any step whose last action entry is <= 0, so a freshly initialised
+    policy (half its steps release) rarely keeps a knob long enough to learn from it; starting SAC
+    from a policy that holds and turns makes its data informative from the first episode. Actions are
+    clipped to +-0.97 (tanh never reaches 1). Returns the final mean negative log-likelihood.
+    """
+    import torch
+
+    rng = np.random.default_rng(seed)
+    x = torch.as_tensor(obs, dtype=torch.float32)
+    y = torch.as_tensor(np.clip(actions, -0.97, 0.97), dtype=torch.float32)
+    actor = model.actor
+    opt = torch.optim.Adam(actor.parameters(), lr=1e-3)
+    loss_v = float("nan")
+    for _ in range(steps):
+        idx = torch.as_tensor(rng.integers(0, len(x), size=min(batch_size, len(x))))
+        mean, log_std, _ = actor.get_action_dist_params(x[idx])
+        dist = actor.action_dist.proba_distribution(mean, log_std)
+        loss = -dist.log_prob(y[idx]).mean()
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+        loss_v = float(loss.detach())
+    return loss_v

@@ -143,10 +143,10 @@ def run_sac_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, thre
     from anomalygen.rl.sac import train_sac
     from anomalygen.rl.subtask_env import FRAMESKIP, HORIZON, SubTaskEnv, SubTaskReadout, control_step
 
-    if st.params.get("family") == "switch_off" and reward_mode == "spec":
-        # the family with a shipped warm start and a scene-independent observation (rl/part_subtask.py)
-        from anomalygen.rl.part_subtask import run_part_subtask
+    from anomalygen.rl.part_subtask import is_switch_off, run_part_subtask
 
+    if reward_mode == "spec" and is_switch_off(drv, st):
+        # the family with a shipped warm start and a scene-independent observation (rl/part_subtask.py)
         return run_part_subtask(drv, st, plan, steps=steps, seed=seed, n_envs=n_envs, threads=threads, log=log)
     if steps <= 0:
         return PrimitiveResult(False, 0, "not executed: sac_steps is 0")
