@@ -44,7 +44,7 @@ def make_run(run: Path, seed: int, n: int = 300) -> None:
                    check=True, env=env)
 
 
-def starts_of(run: Path, log=print) -> list:
+def starts_of(run: Path, log=lambda m: print(m, file=sys.stderr)) -> list:
     """One PartStart per knob/switch that is on, in every switch-off scene of the run folder."""
     import numpy as np
 

@@ -7,7 +7,8 @@ that reads world coordinates or raw joint values learns one scene. :class:`PartR
 quantities relative to the cup and the part, so the shipped warm start
 (``anomalygen/data/policies/switch_off.zip``) transfers across built scenes:
 
-- the grasped point (where suction took hold) minus the cup, in dm: how far the hold is stretched;
+- the grasped point (where suction took hold) minus the cup body's origin (where the weld anchors
+  it), in dm: how far the hold is stretched;
 - the direction in which the grasped point moves when the joint goes *towards off* (a knob's tangent
   at the grasped point, a button's axis), a unit vector;
 - the lever: grasped point minus the joint axis, perpendicular to the axis, in dm (0 for a slide);
@@ -148,7 +149,7 @@ class PartReadout:
         return data.xpos[self.body] + r @ model.eq_data[self.eq, 0:3]
 
     def observation(self, model, data, t: int, horizon: int) -> np.ndarray:
-        cup = data.site_xpos[self.robot.cup_site]
+        cup = data.xpos[self.robot.cup]  # the cup body: the suction weld anchors the part at its origin
         held = self.held_point(model, data)
         point = cup.copy() if held is None else held
         axis = data.xaxis[self.jid] / np.linalg.norm(data.xaxis[self.jid])

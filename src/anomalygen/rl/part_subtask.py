@@ -8,7 +8,7 @@ planned by the knowledge planner because the KB marks the recipe step ``"method"
 2. The warm start (``anomalygen/data/policies/switch_off.zip``, trained over many built scenes by
    ``benchmarks/train_warm_start.py``) is evaluated on a snapshot of this scene
    (:class:`~anomalygen.rl.part_env.PartTurnEnv`, 5 seeded episodes); if it does not already reach
-   90 % it is fine-tuned with SAC for at most ``steps`` transitions, ``n_envs`` envs at once,
+   90 % it is fine-tuned with SAC for at most ``steps`` (capped at ``FINETUNE_MAX``) transitions, ``n_envs`` envs at once,
    keeping the best checkpoint by success.
 3. The policy is replayed once, deterministically, on the Driver's own data from the snapshot
    (through the env's own :func:`~anomalygen.rl.part_env.part_control_step`), so the video shows it.
@@ -30,6 +30,9 @@ from anomalygen.schema import Plan, SubTask
 
 FAMILY = "switch_off"
 EVAL_EPISODES = 5
+# Fine-tuning budget per part, at most: an oven has up to five knobs on and `make demo` runs 20 tasks
+# in < 15 min on 2 cores; ~1000 steps of a 64x64 SAC take 20-40 s there (figures in docs/learn.md).
+FINETUNE_MAX = 1000
 BACK_OFF = 0.08  # m the cup retreats along the face normal after letting go
 
 
@@ -109,6 +112,7 @@ def run_part_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, n_e
     def make_env() -> PartTurnEnv:
         return PartTurnEnv([start])
 
+    steps = min(steps, FINETUNE_MAX)
     eval_every = max(1, min(steps, 500)) if steps > 0 else 1
     policy, res = train_sac(make_env, max(0, steps), seed=seed, eval_every=eval_every, eval_episodes=EVAL_EPISODES,
                             learning_starts=200, threads=threads, stop_at=0.9, log=log, n_envs=n_envs,
