@@ -221,10 +221,15 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
 
                 res = run_sac_subtask(drv, st, plan, steps=sac_steps, seed=seed, reward_mode=reward_mode,
                                       n_envs=n_envs)
-                if not res.success and st.primitive and not res.detail.startswith("not executed: sac_steps is 0"):
-                    # the learned policy failed (or could not start): the primitive behind the step
-                    # gets its turn, and the result says both what SAC did and that it fell back
-                    drv.settle(10)
+                drv.settle(10)
+                held = res.success and all(p.holds for p in _evaluate(st.success.predicates, model, data, spec,
+                                                                      plan.bindings))
+                if not held and st.primitive and not res.detail.startswith("not executed: sac_steps is 0"):
+                    # the learned policy failed, could not start, or its result did not last: the
+                    # primitive behind the step gets its turn, and the result says both what SAC
+                    # did and that it fell back
+                    if res.success:
+                        res.detail += "; its check failed afterwards"
                     prim = run_subtask(drv, st, plan)
                     res = PrimitiveResult(prim.success, res.steps + prim.steps,
                                          f"SAC failed ({res.detail}); fell back to the {st.primitive} primitive: {prim.detail}")
