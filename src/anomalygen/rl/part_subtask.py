@@ -135,14 +135,9 @@ def run_part_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, n_e
         drv.frameskip = fs
         view.task.close()
     q = float(drv.data.joint(joint).qpos[0])
-    # let go without pressing: the target comes to where the cup is first (the policy's last target
-    # may lie inside the appliance, and a latched button released under that push clicks back on)
-    drv.goto(drv.site, max_steps=3, tol=0.0)
     robot.suction_off(drv.model, drv.data)
     normal = part_geometry(drv.model, drv.data, joint)["normal"]
-    dp, drv.dp = drv.dp, 0.004  # back off gently, straight out along the face normal
     drv.goto(drv.site + BACK_OFF * normal, max_steps=40)
-    drv.dp = dp
     drv.straighten_wrist(lift=0.1, lift_steps=30)
     after = float(drv.data.joint(joint).qpos[0])
     ok = ok and js.open_fraction_at(after) <= 0.05
