@@ -71,9 +71,10 @@ def part_geometry(model, data, joint: str) -> dict:
             "normal": normal, "face": face, "radius": radius}
 
 
-def grasp_point(model, data, joint: str) -> tuple[np.ndarray, np.ndarray]:
+def grasp_point(model, data, joint: str, k: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """(point on the part's front face to hold, outward normal): off the axis for a knob, so that
-    leading the held point round the axis turns it; the face centre for a button."""
+    leading the held point round the axis turns it; the face centre for a button. ``k`` picks the
+    side of the axis (0: above it, then the two sides, then below), for when a first one is blocked."""
     g = part_geometry(model, data, joint)
     p = g["face"]
     if g["hinge"]:
@@ -84,8 +85,13 @@ def grasp_point(model, data, joint: str) -> tuple[np.ndarray, np.ndarray]:
         # above the axis when it is horizontal: the cup comes from the front and above
         up = np.cross(side, g["axis"])
         up = up if up[2] >= 0 else -up
-        p = p + OFF_AXIS * g["radius"] * (up if abs(g["axis"][2]) < 0.7 else side)
+        first = up if abs(g["axis"][2]) < 0.7 else side
+        other = side if abs(g["axis"][2]) < 0.7 else up
+        p = p + OFF_AXIS * g["radius"] * (first, other, -other, -first)[k % 4]
     return p, g["normal"]
+
+
+GRASP_TRIES = 2  # sides of the knob axis tried (above it, then beside it) before giving up
 
 
 def grasp_part(drv, joint: str) -> tuple[bool, str]:
@@ -94,23 +100,27 @@ def grasp_part(drv, joint: str) -> tuple[bool, str]:
     from anomalygen.scene import robot
 
     m, d = drv.model, drv.data
-    p, n = grasp_point(m, d, joint)
-    quat = quat_z_to(-n)
-    pre = p + n * PRE_CONTACT
-    if not (drv.place_base_near(p, side=n, reach_poses=[(pre, quat)]) or drv.place_base_near(p, side=n)
-            or drv.place_base_near(p)):
-        return False, f"no collision-free base pose near {joint}"
-    if not drv.reach_planned((pre, pre + n * 0.10), quat):
-        drv.goto(pre + n * 0.10, quat, max_steps=200, tol=0.02)
-    drv.goto(pre, quat, max_steps=120, tol=0.01)
     body = m.body(int(m.jnt_bodyid[m.joint(joint).id])).name
-    for k in range(24):
-        p, n = grasp_point(m, d, joint)
-        drv.goto(p + n * (PRE_CONTACT - 0.0025 * k), quat, max_steps=10, tol=0.004)
-        if robot.object_distance_to_cup(m, d, body) < robot.SUCTION_RANGE * 0.8:
-            if robot.suction_on(m, d, body, torquescale=0.0):
-                return True, f"cup holds {body}"
-    return False, f"cup did not reach the face of {body}"
+    why = f"cup did not reach the face of {body}"
+    for side in range(GRASP_TRIES):
+        p, n = grasp_point(m, d, joint, side)
+        quat = quat_z_to(-n)
+        pre = p + n * PRE_CONTACT
+        if not (drv.place_base_near(p, side=n, reach_poses=[(pre, quat)]) or drv.place_base_near(p, side=n)
+                or drv.place_base_near(p)):
+            why = f"no collision-free base pose near {joint}"
+            continue
+        if not drv.reach_planned((pre, pre + n * 0.10), quat):
+            drv.goto(pre + n * 0.10, quat, max_steps=200, tol=0.02)
+        drv.goto(pre, quat, max_steps=120, tol=0.01)
+        for k in range(24):
+            p, n = grasp_point(m, d, joint, side)
+            drv.goto(p + n * (PRE_CONTACT - 0.0025 * k), quat, max_steps=10, tol=0.004)
+            if robot.object_distance_to_cup(m, d, body) < robot.SUCTION_RANGE * 0.8:
+                if robot.suction_on(m, d, body, torquescale=0.0):
+                    return True, f"cup holds {body}" + (" (second side)" if side else "")
+        drv.goto(drv.site + n * 0.08, max_steps=40)  # back out before trying the other side
+    return False, why
 
 
 class PartReadout:
