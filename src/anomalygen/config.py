@@ -99,6 +99,10 @@ class LearnConfig(Section):
         1, ge=0, description="times a primitive sub-task whose success check fails right after it is run again"
     )
     video: bool = True
+    n_envs: int = Field(
+        1, ge=1, description="environments a SAC sub-task collects experience from at once (SB3 DummyVecEnv); "
+        "more than 1 helps only with idle cores"
+    )
     reward_mode: Literal["spec", "code"] = Field(
         "spec", description="code: SAC sub-tasks learn from reward code run in the sandbox (rl/sandbox.py), "
         "the plan's own or its reward terms rendered as code; spec: the terms evaluated in-process"

@@ -7,6 +7,7 @@ are SceneSpec JSON written directly (the planner reads names and joints, never M
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 
@@ -241,7 +242,20 @@ def test_every_in_context_example_is_a_valid_plan_of_its_own_scene():
         reply = P.reply_schema(scene).model_validate(ex.answer)
         plan = P.to_plan(reply, scene, ex.spec.task_id)
         methods |= {st.method for st in plan.subtasks}
-    assert methods == {SkillMethod.PRIMITIVE, SkillMethod.SAC, SkillMethod.CEM}
+    assert methods == {SkillMethod.PRIMITIVE, SkillMethod.SAC}
+
+
+def test_cem_is_not_offered_to_the_llm_planner():
+    """CEM runs only on the Gymnasium Ant: the prompt does not offer it and a reply using it is refused."""
+    assert not re.search(r"\bcem\b", Prompt.SYSTEM_PROMPT.lower())
+    assert all(st["method"] != "cem" for ex in Prompt.load_examples() for st in ex.answer["subtasks"])
+    ex = Prompt.load_examples()[0]
+    scene = P.PlanScene(ex.spec, dict(ex.spec.bindings))
+    bad = {**ex.answer, "subtasks": [{**ex.answer["subtasks"][0], "method": "cem"}, *ex.answer["subtasks"][1:]]}
+    with pytest.raises(Exception, match="primitive"):
+        P.reply_schema(scene).model_validate(bad)
+    schema = P.reply_schema(scene).model_json_schema()
+    assert "cem" not in json.dumps(schema["$defs"]["ReplySubTask"]["properties"]["method"])
 
 
 def test_a_binding_outside_the_scene_fails_before_asking():

@@ -11,8 +11,11 @@ def test_every_kb_class_plans():
         plan = plan_from_kb("t", cid, {"$hazard": "knife_0", "$container": "drawer_0", "$target": "fridge_0", "$support": "shelf_0"})
         assert isinstance(plan, Plan) and plan.subtasks
         assert plan.success.predicates == list(kb.hazard_classes[cid].success)
+        sac_steps = {step.action for step in kb.hazard_classes[cid].recipe if step.method == "sac"}
         for st in plan.subtasks:
-            assert st.method == SkillMethod.PRIMITIVE and st.reward is not None
+            learned = any(st.id.startswith(f"s{i + 1}_{a}") for i, step in enumerate(kb.hazard_classes[cid].recipe)
+                          for a in sac_steps if step.action == a)
+            assert st.method == (SkillMethod.SAC if learned else SkillMethod.PRIMITIVE) and st.reward is not None
             assert not any(str(v).startswith("$") for v in st.params.values())
 
 
@@ -139,3 +142,25 @@ def test_a_fix_with_no_container_in_the_scene_fails_with_the_reason(tmp_path):
 
     with pytest.raises(ItemFailed, match="no reachable container for knife_0"):
         bind_fix(kb.hazard_classes["dispose_spoiled_food"], "knife_0", graph, kb)
+
+
+def test_offline_planner_picks_sac_for_switch_off_per_knob_that_is_on():
+    """The KB marks switch_off as a SAC step: one sub-task per knob that is on, most on first, each with
+    a reward on its travel to off (scaled by 1 / travel) and the cup near the knob."""
+    from anomalygen.schema import AssetRef, JointState, ObjectRole, PlacedObject, SceneSpec
+
+    knobs = [JointState(name=f"oven_0/knob_{k}_joint", label="knob", value=v, range=(0.0, 4.7), closed_value=0.0)
+             for k, v in enumerate((3.5, 0.0, 4.2))]
+    oven = PlacedObject(name="oven_0", asset=AssetRef(category="Oven", asset_id="oven"),
+                        role=ObjectRole.TARGET, size=0.9, pos=(0.0, 0.0, 0.0), joint_states=knobs)
+    spec = SceneSpec(scene_id="t", task_id="t", room="kitchen", seed=0, objects=[oven])
+    plan = plan_from_kb("t", "switch_off_appliance", {"$target": "oven_0"}, spec=spec)
+    assert [st.method for st in plan.subtasks] == [SkillMethod.SAC, SkillMethod.SAC]
+    assert [st.params["joint"] for st in plan.subtasks] == ["oven_0/knob_2_joint", "oven_0/knob_0_joint"]
+    joint = plan.subtasks[0].reward.terms[0]
+    assert joint.kind == "joint" and joint.target == 0.0 and abs(joint.scale - 1 / 4.7) < 1e-9
+    assert plan.subtasks[0].reward.terms[1].b == "oven_0/knob_2_joint"
+    assert plan.subtasks[-1].success.predicates and not plan.subtasks[0].success.predicates
+    # other classes stay primitive unless the user lists their actions
+    assert all(st.method == SkillMethod.PRIMITIVE for st in plan_from_kb(
+        "t", "close_open_refrigerator", {"$target": "fridge_0"}).subtasks)

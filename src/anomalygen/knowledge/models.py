@@ -106,6 +106,11 @@ class RecipeStep(KBModel):
 
     action: RecipeAction
     args: dict[str, str] = Field(default_factory=dict)
+    method: Literal["primitive", "sac"] = Field(
+        "primitive",
+        description="how the offline planner executes the step: a motion-planned primitive, or SAC for a "
+        "contact-rich part motion the package ships a warm-start policy for (data/policies/<action>.zip)",
+    )
 
     def __str__(self) -> str:
         inner = ", ".join(f"{k}={v}" for k, v in self.args.items())

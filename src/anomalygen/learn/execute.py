@@ -154,7 +154,7 @@ def _evaluate(calls, model, data, spec, bindings) -> list[PredicateResult]:
 def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: str | Path | None = None,
                  max_wall_s: float = 600.0, sac_steps: int = 0, isolate: bool = True,
                  retries: int = 1, reward_mode: str = "spec",
-                 final_graph_path: str | Path | None = None) -> SkillResult:
+                 final_graph_path: str | Path | None = None, n_envs: int = 1) -> SkillResult:
     """Load the scene, run the plan's sub-tasks in order, check success, optionally record a video.
 
     Execution is closed-loop: a primitive sub-task whose success check fails on the scene right after
@@ -180,13 +180,13 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
         with ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn")) as pool:
             return pool.submit(_execute_here, str(scene_dir), plan, seed, None if video_path is None else
                                str(video_path), max_wall_s, sac_steps, retries, reward_mode,
-                               None if final_graph_path is None else str(final_graph_path)).result()
+                               None if final_graph_path is None else str(final_graph_path), n_envs).result()
     return _execute_here(scene_dir, plan, seed, video_path, max_wall_s, sac_steps, retries, reward_mode,
-                         final_graph_path)
+                         final_graph_path, n_envs)
 
 
 def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float, sac_steps: int,
-                  retries: int = 1, reward_mode: str = "spec", final_graph_path=None) -> SkillResult:
+                  retries: int = 1, reward_mode: str = "spec", final_graph_path=None, n_envs: int = 1) -> SkillResult:
     from anomalygen.control.driver import Driver
     from anomalygen.rng import item_rng
     from anomalygen.scene.graph import load_scene
@@ -221,7 +221,20 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
             if st.method == SkillMethod.SAC:
                 from anomalygen.rl.sac_subtask import run_sac_subtask
 
-                res = run_sac_subtask(drv, st, plan, steps=sac_steps, seed=seed, reward_mode=reward_mode)
+                res = run_sac_subtask(drv, st, plan, steps=sac_steps, seed=seed, reward_mode=reward_mode,
+                                      n_envs=n_envs)
+                drv.settle(10)
+                held = res.success and all(p.holds for p in _evaluate(st.success.predicates, model, data, spec,
+                                                                      plan.bindings))
+                if not held and st.primitive and not res.detail.startswith("not executed: sac_steps is 0"):
+                    # the learned policy failed, could not start, or its result did not last: the
+                    # primitive behind the step gets its turn, and the result says both what SAC
+                    # did and that it fell back
+                    if res.success:
+                        res.detail += "; its check failed afterwards"
+                    prim = run_subtask(drv, st, plan)
+                    res = PrimitiveResult(prim.success, res.steps + prim.steps,
+                                         f"SAC failed ({res.detail}); fell back to the {st.primitive} primitive: {prim.detail}")
             else:
                 res = run_subtask(drv, st, plan)
             drv.settle(10)

@@ -1,7 +1,8 @@
 """The LLM planning engine: an LLM decomposes a hazard fix into sub-tasks and picks each one's method.
 
 As in the paper, the model is shown the scene, the hazard and in-context examples of choosing a
-method (a motion-planned primitive, SAC or CEM), and answers with sub-tasks, reward terms and success
+method (a motion-planned primitive or SAC; CEM, which runs only on a legged body, is not
+offered: household scenes carry a wheeled arm), and answers with sub-tasks, reward terms and success
 predicates. Its reply is untrusted. The reply schema is small and flat (a tiny local model's grammar
 must be able to write it) and advertises this scene's names as enums; a validator bound to the scene
 then checks what JSON cannot: every object, region and joint exists, predicates are known and take
@@ -91,7 +92,8 @@ class ReplySubTask(BaseModel):
 
     id: str = Field(description="s<position>_<verb>, e.g. s1_pick")
     description: str = Field(min_length=1)
-    method: SkillMethod
+    # CEM (rl/cem.py) plans a legged body's motion and runs only on the Gymnasium Ant: not offered here
+    method: Literal["primitive", "sac"]
     primitive: str | None = Field(None, description="a primitive from the menu (required for method primitive)")
     params: ReplyParams = Field(default_factory=ReplyParams)
     reward: list[ReplyRewardTerm] = Field(default_factory=list)
@@ -224,7 +226,7 @@ class _Checker:
 
     def reward(self, where: str, st: ReplySubTask) -> None:
         if st.method != SkillMethod.PRIMITIVE and not any(t.kind != "action_penalty" for t in st.reward):
-            self.bad(where, f"method {st.method.value} learns from its reward: give at least one reward term besides action_penalty")
+            self.bad(where, f"method {st.method} learns from its reward: give at least one reward term besides action_penalty")
         for k, t in enumerate(st.reward):
             w = f"{where}.reward[{k}]"
             needs = {"distance": ("a", "b"), "inside": ("a", "b"), "lifted": ("a", "target"),
@@ -435,7 +437,7 @@ def to_plan(reply: TaskPlan, scene: PlanScene, task_id: str, *, source: str = "g
             terms.append(RewardTerm.model_validate(data))
         subtasks.append(
             SubTask(
-                id=st.id, description=st.description, method=st.method, primitive=st.primitive, params=params,
+                id=st.id, description=st.description, method=SkillMethod(st.method), primitive=st.primitive, params=params,
                 reward=RewardSpec(terms=terms) if terms else None,
                 success=SuccessSpec(predicates=[PredicateCall(name=c.name, args=_args(c), negate=c.negate) for c in st.success]),
             )

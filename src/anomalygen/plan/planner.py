@@ -98,6 +98,51 @@ def step_to_subtask(index: int, action: str, args: dict[str, str], bindings: dic
     raise ItemFailed(f"recipe action {action!r} has no sub-task mapping")
 
 
+SWITCH_LABELS = ("knob", "switch")  # the parts a switch_off step turns (KB labels: a button is a switch)
+
+
+def switch_off_subtasks(index: int, args: dict[str, str], bindings: dict[str, str], spec: SceneSpec | None,
+                        final_success: list[PredicateCall], method: SkillMethod) -> list[SubTask]:
+    """A switch_off step -> one sub-task per knob or switch of the appliance that is on, most on first.
+
+    The learned skill turns one part (``rl/part_skill.py``), and an oven has up to five knobs on; the
+    scene spec (perceived joint values) says which. Each sub-task's reward is the part's travel to off
+    as a fraction (the joint term scaled by 1 / travel, so a 4.7 rad knob and a 4 mm button weigh the
+    same) plus the cup near the part; the class's predicates check the last one, earlier ones are
+    checked by their joint term. With no part on in the spec (a plan from a wrong detection) the first
+    part is planned, as for the other joint steps.
+    """
+    target_obj = _resolve(args.get("object", "$target"), bindings)
+    label = args.get("label", "|".join(SWITCH_LABELS))
+    wanted = {x.strip() for x in label.split("|")}
+    joints = [js for obj in (spec.objects if spec else []) if obj.name == target_obj
+              for js in obj.joint_states if js.label in wanted]
+    on = sorted([js for js in joints if js.open_fraction > 0.05], key=lambda js: -js.open_fraction)
+    chosen = on or joints[:1]
+    vars_here = set(args.values())
+    own = [p for p in final_success if vars_here & {str(v) for v in p.args.values()}]
+    if not chosen:
+        st = step_to_subtask(index, "switch_off", args, bindings, spec, final_success)
+        return [st.model_copy(update={"method": method})]
+    out = []
+    for k, js in enumerate(chosen):
+        lo, hi = js.range
+        travel = max(abs(hi - lo), 1e-6)
+        part = js.name.split("/")[-1]
+        sid = f"s{index + 1}_switch_off" + (f"_{k + 1}" if len(chosen) > 1 else "")
+        last = k == len(chosen) - 1
+        out.append(SubTask(
+            id=sid, description=f"switch off {target_obj}: turn {part} to off", method=method, primitive="push",
+            params={"object": target_obj, "joint": js.name, "target": float(js.closed_value), "part": js.label,
+                    "family": "switch_off"},
+            reward=RewardSpec(terms=[RewardTerm(kind="joint", joint=js.name, target=float(js.closed_value), weight=2.0,
+                                                scale=1.0 / travel),
+                                     RewardTerm(kind="distance", a="ee", b=js.name, weight=0.5),
+                                     RewardTerm(kind="action_penalty", weight=0.01)]),
+            success=SuccessSpec(predicates=own if last else [])))
+    return out
+
+
 def closed_closures(spec: SceneSpec | None, instance: str) -> list[str]:
     """Labels of the container's lids, flaps, drawers and doors that are shut in the scene."""
     if spec is None:
@@ -133,11 +178,17 @@ def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, s
     cls = kb.hazard_classes.get(hazard_class)
     if cls is None:
         raise ItemFailed(f"hazard class {hazard_class!r} is not in the knowledge base; no recipe to plan from")
-    subtasks = [step_to_subtask(i, step.action, dict(step.args), bindings, spec, list(cls.success))
-                for i, step in enumerate(cls.recipe)]
-    # Steps the user wants learned rather than scripted keep their reward spec and go to SAC.
-    subtasks = [st.model_copy(update={"method": SkillMethod.SAC}) if step.action in sac_actions else st
-                for st, step in zip(subtasks, cls.recipe, strict=True)]
+    # A step goes to SAC when the knowledge base says so (``"method": "sac"``: a contact-rich part
+    # motion with a shipped warm start, such as switch_off) or the user lists its action in
+    # ``learn.sac_actions``; it keeps its reward spec either way.
+    subtasks = []
+    for i, step in enumerate(cls.recipe):
+        method = SkillMethod.SAC if step.method == "sac" or step.action in sac_actions else SkillMethod.PRIMITIVE
+        if step.action == "switch_off":
+            subtasks += switch_off_subtasks(i, dict(step.args), bindings, spec, list(cls.success), method)
+            continue
+        st = step_to_subtask(i, step.action, dict(step.args), bindings, spec, list(cls.success))
+        subtasks.append(st.model_copy(update={"method": method}) if method != st.method else st)
     for step in cls.recipe:
         if step.action == "place_inside":
             container = _resolve(step.args.get("container", "$container"), bindings)

@@ -126,12 +126,16 @@ def pre_position(drv, st: SubTask, plan: Plan, readout) -> str:
 
 def run_sac_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, threads: int = 1,
                     eval_every: int | None = None, eval_episodes: int = 5, learning_starts: int = 500,
-                    approach: bool = True, log=None, reward_mode: str = "spec") -> PrimitiveResult:
+                    approach: bool = True, log=None, reward_mode: str = "spec", n_envs: int = 1) -> PrimitiveResult:
     """Train SAC for ``st`` from the Driver's current state and execute the best policy on the Driver.
 
     ``reward_mode="code"`` (``learn.reward_mode``) trains on reward code run in the sandbox: the
     sub-task's own code when its RewardSpec has mode "code", else its terms rendered as code
     (``reward.spec_to_code``, the same values).
+
+    ``n_envs`` (``learn.n_envs``) envs collect experience at once (SB3 ``DummyVecEnv``). A sub-task
+    of the switch-off family goes to :func:`~anomalygen.rl.part_subtask.run_part_subtask` (warm start,
+    fine-tuning, replay) instead.
 
     ``result.steps`` counts the Driver's control steps (pre-positioning plus the rollout); the
     detail says the training budget, best evaluation success and what the rollout did.
@@ -139,6 +143,11 @@ def run_sac_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, thre
     from anomalygen.rl.sac import train_sac
     from anomalygen.rl.subtask_env import FRAMESKIP, HORIZON, SubTaskEnv, SubTaskReadout, control_step
 
+    from anomalygen.rl.part_subtask import is_switch_off, run_part_subtask
+
+    if reward_mode == "spec" and is_switch_off(drv, st):
+        # the family with a shipped warm start and a scene-independent observation (rl/part_subtask.py)
+        return run_part_subtask(drv, st, plan, steps=steps, seed=seed, n_envs=n_envs, threads=threads, log=log)
     if steps <= 0:
         return PrimitiveResult(False, 0, "not executed: sac_steps is 0")
     s0 = drv.steps
@@ -159,7 +168,7 @@ def run_sac_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, thre
 
     policy, res = train_sac(make_env, steps, seed=seed, eval_every=eval_every or min(steps, 1000),
                             eval_episodes=eval_episodes, learning_starts=learning_starts, threads=threads,
-                            stop_at=0.9, log=log)
+                            stop_at=0.9, log=log, n_envs=n_envs)
 
     restore(drv.model, drv.data, snap)
     ee0 = drv.data.site_xpos[readout.robot.cup_site].copy()

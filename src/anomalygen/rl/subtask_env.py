@@ -146,7 +146,12 @@ class SubTaskReadout:
         if s >= 0:
             self._sites[name] = s
             return name
-        raise ValueError(f"sub-task {self.sub_task.id}: reward names {ref!r}, which is no object, link or site")
+        j = mj.mj_name2id(model, mj.mjtObj.mjOBJ_JOINT, name)
+        if j >= 0:  # a joint stands for the part it moves (a knob: the planner knows joints, not bodies)
+            b = int(model.jnt_bodyid[j])
+            self._boxes[name] = (b, _collision_geoms(model, b))
+            return name
+        raise ValueError(f"sub-task {self.sub_task.id}: reward names {ref!r}, which is no object, link, site or joint")
 
     # ------------------------------------------------------------------ readout
     def state(self, model, data, action=None) -> dict:
