@@ -8,6 +8,11 @@ Prints the detection scores and, per mode, the table by class (hazards present, 
 resolved; runs that created a hazard or acted on a safe object), then one JSON line.
 
     .venv/bin/python benchmarks/bench_loop.py [--n 111] [--seed 0] [--seeds 1] [--workers 2] [--out DIR]
+        [--compare-detectors N] [--skip-learn]
+
+``--compare-detectors N`` also runs the LLM and hybrid detectors (the configured LLM backend; by
+default the bundled tiny GGUF, which measures the mechanics, not judgement) on the first N scenes
+and scores all three detectors on those same N scenes.
 """
 
 from __future__ import annotations
@@ -51,6 +56,9 @@ def main() -> int:
     ap.add_argument("--seeds", type=int, default=1, help="executions per scene")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", default=None, help="folder for the runs (default: a temporary one)")
+    ap.add_argument("--compare-detectors", type=int, default=0, metavar="N",
+                    help="score rules, llm and hybrid detection on the first N scenes")
+    ap.add_argument("--skip-learn", action="store_true", help="stop after detection")
     a = ap.parse_args()
     root = Path(a.out or tempfile.mkdtemp(prefix="bench_loop_"))
     base = root / "detected"
@@ -71,7 +79,9 @@ def main() -> int:
     out["detection"] = {"recall": scores.recall, "precision": scores.precision, "f1": scores.f1,
                         "false_alarm_rate": scores.false_alarm_rate, "hit_at_1_single": scores.hit_at_k.get(1),
                         "hazards": scores.hazards, "scenes": scores.scenes, "hazard_free": scores.hazard_free_scenes}
-    for mode, folder in (("detected", base), ("ground_truth", root / "oracle")):
+    if a.compare_detectors:
+        out["detectors"] = _compare_detectors(root, base, ids, a.compare_detectors, env)
+    for mode, folder in (() if a.skip_learn else (("detected", base), ("ground_truth", root / "oracle"))):
         t = time.perf_counter()
         menv = {**env, "ANOMALYGEN_LEARN__PLAN_SOURCE": mode}
         _cli("plan", "--run", str(folder), env=menv)
@@ -88,6 +98,34 @@ def main() -> int:
     out["wall_s"] = round(time.perf_counter() - t0, 1)
     print(json.dumps(out))
     return 0
+
+
+def _compare_detectors(root: Path, base: Path, ids: list[str], n: int, env: dict) -> dict:
+    """Rules, LLM and hybrid detection scored against truth.json on the same first ``n`` built scenes."""
+    from anomalygen.detect.score import score_detections
+    from anomalygen.evaluate.run_metrics import load_detections, load_manifests
+    from anomalygen.runfolder import RunFolder
+
+    built = [t for t in ids if (base / "scenes" / t / "scene.xml").exists()][:n]
+    only = [x for t in built for x in ("--only", t)]
+    res = {}
+    env = {"ANOMALYGEN_LLM__BACKEND": "llamacpp", **env}  # the bundled GGUF unless a backend is configured
+    for det in ("rules", "llm", "hybrid"):
+        folder = root / f"detector_{det}"
+        _copy_run(base, folder)
+        (folder / "detections.jsonl").unlink(missing_ok=True)
+        t = time.perf_counter()
+        _cli("detect", "--run", str(folder), "--detector", det, "--force", *only, env=env)
+        run = RunFolder(folder)
+        wanted = set(built)
+        dets = [d for d in load_detections(run) if d.task_id in wanted]
+        manifests = load_manifests(run, [x for x in run.load_tasks() if x.id in wanted])
+        sc = score_detections(dets, manifests, 3)
+        res[det] = {"scenes": sc.scenes, "recall": sc.recall, "precision": sc.precision, "f1": sc.f1,
+                    "false_alarm_rate": sc.false_alarm_rate, "hit_at_1_single": sc.hit_at_k.get(1),
+                    "wall_s": round(time.perf_counter() - t, 1)}
+        print(f"detector {det} on {len(built)} scenes: {json.dumps(res[det])}")
+    return res
 
 
 if __name__ == "__main__":

@@ -98,6 +98,10 @@ class LearnConfig(Section):
     retries: int = Field(
         1, ge=0, description="times a primitive sub-task whose success check fails right after it is run again"
     )
+    recheck: bool = Field(
+        True, description="after the plan, look at the scene again and fix hazards the robot's own actions "
+        "created (a knob nudged on, a drawer left open); one pass, from perception (learn/recheck.py)"
+    )
     video: bool = True
     n_envs: int = Field(
         1, ge=1, description="environments a SAC sub-task collects experience from at once (SB3 DummyVecEnv); "

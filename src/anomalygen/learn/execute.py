@@ -154,7 +154,7 @@ def _evaluate(calls, model, data, spec, bindings) -> list[PredicateResult]:
 def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: str | Path | None = None,
                  max_wall_s: float = 600.0, sac_steps: int = 0, isolate: bool = True,
                  retries: int = 1, reward_mode: str = "spec",
-                 final_graph_path: str | Path | None = None, n_envs: int = 1) -> SkillResult:
+                 final_graph_path: str | Path | None = None, n_envs: int = 1, recheck_fixes: int = 0) -> SkillResult:
     """Load the scene, run the plan's sub-tasks in order, check success, optionally record a video.
 
     Execution is closed-loop: a primitive sub-task whose success check fails on the scene right after
@@ -172,6 +172,9 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
 
     ``final_graph_path`` receives the scene graph of the final, settled state: what the referee
     judges against the hidden truth (the robot's own verdict is ``success``).
+
+    ``recheck_fixes`` > 0: after the plan the robot looks again and fixes up to that many hazards its
+    own actions created (:mod:`anomalygen.learn.recheck`); their steps are listed with ids ``recheck_*``.
     """
     if isolate:
         from concurrent.futures import ProcessPoolExecutor
@@ -180,16 +183,37 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
         with ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn")) as pool:
             return pool.submit(_execute_here, str(scene_dir), plan, seed, None if video_path is None else
                                str(video_path), max_wall_s, sac_steps, retries, reward_mode,
-                               None if final_graph_path is None else str(final_graph_path), n_envs).result()
+                               None if final_graph_path is None else str(final_graph_path), n_envs,
+                               recheck_fixes).result()
     return _execute_here(scene_dir, plan, seed, video_path, max_wall_s, sac_steps, retries, reward_mode,
-                         final_graph_path, n_envs)
+                         final_graph_path, n_envs, recheck_fixes)
+
+
+def _look_again(drv, before, plan: Plan, max_fixes: int, run_steps) -> list[SubTaskResult]:
+    """One pass of :mod:`anomalygen.learn.recheck`: fix the hazards the plan's actions created."""
+    from anomalygen.knowledge import load_kb
+    from anomalygen.learn.recheck import new_hazards, repair_plan, spec_as_it_stands
+    from anomalygen.scene.graph import scene_graph
+
+    kb = load_kb()
+    after = scene_graph(drv.model, drv.data, drv.spec)
+    found = new_hazards(before, after, kb)
+    if not found:
+        return []
+    repair, problems = repair_plan(plan.task_id, found, after, spec_as_it_stands(drv.spec, drv.data), kb,
+                                   max_fixes=max_fixes)
+    out = [SubTaskResult(id=f"recheck_{cls}", method=SkillMethod.PRIMITIVE, success=False,
+                         detail=f"seen after the plan, cannot fix: {why}")
+           for why, cls in ((p, p.split(" on ")[0]) for p in problems)]
+    return (run_steps(repair.subtasks, repair) if repair is not None else []) + out
 
 
 def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float, sac_steps: int,
-                  retries: int = 1, reward_mode: str = "spec", final_graph_path=None, n_envs: int = 1) -> SkillResult:
+                  retries: int = 1, reward_mode: str = "spec", final_graph_path=None, n_envs: int = 1,
+                  recheck_fixes: int = 0) -> SkillResult:
     from anomalygen.control.driver import Driver
     from anomalygen.rng import item_rng
-    from anomalygen.scene.graph import load_scene
+    from anomalygen.scene.graph import load_scene, scene_graph
 
     t0 = time.perf_counter()
     from anomalygen.perception import perceived_spec
@@ -204,58 +228,67 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
         rec = VideoRecorder(model)
     drv = Driver(model, data, spec, rng=item_rng(seed, plan.task_id),
                  on_step=(lambda d: rec.capture(d.data)) if rec else None)
-    results: list[SubTaskResult] = []
-    for st in plan.subtasks:
-        ts = time.perf_counter()
-        if st.method == SkillMethod.CEM:
-            results.append(SubTaskResult(id=st.id, method=st.method, success=False, detail=(
-                "not executed: CEM plans the motion of a legged robot (rl/cem.py, the Gymnasium Ant); "
-                "household scenes carry the wheeled arm")))
-            continue
-        if time.perf_counter() - t0 > max_wall_s:
-            results.append(SubTaskResult(id=st.id, method=st.method, success=False, detail="not executed: time budget spent"))
-            continue
-        s0 = drv.steps
-        details: list[str] = []
-        for attempt in range(1, 2 + (retries if st.method == SkillMethod.PRIMITIVE else 0)):
-            if st.method == SkillMethod.SAC:
-                from anomalygen.rl.sac_subtask import run_sac_subtask
+    before = scene_graph(model, data, spec) if recheck_fixes else None
 
-                res = run_sac_subtask(drv, st, plan, steps=sac_steps, seed=seed, reward_mode=reward_mode,
-                                      n_envs=n_envs)
+    def run_steps(steps, plan: Plan) -> list[SubTaskResult]:
+        results: list[SubTaskResult] = []
+        for st in steps:
+            ts = time.perf_counter()
+            if st.method == SkillMethod.CEM:
+                results.append(SubTaskResult(id=st.id, method=st.method, success=False, detail=(
+                    "not executed: CEM plans the motion of a legged robot (rl/cem.py, the Gymnasium Ant); "
+                    "household scenes carry the wheeled arm")))
+                continue
+            if time.perf_counter() - t0 > max_wall_s:
+                results.append(SubTaskResult(id=st.id, method=st.method, success=False, detail="not executed: time budget spent"))
+                continue
+            s0 = drv.steps
+            details: list[str] = []
+            for attempt in range(1, 2 + (retries if st.method == SkillMethod.PRIMITIVE else 0)):
+                if st.method == SkillMethod.SAC:
+                    from anomalygen.rl.sac_subtask import run_sac_subtask
+
+                    res = run_sac_subtask(drv, st, plan, steps=sac_steps, seed=seed, reward_mode=reward_mode,
+                                          n_envs=n_envs)
+                    drv.settle(10)
+                    held = res.success and all(p.holds for p in _evaluate(st.success.predicates, model, data, spec,
+                                                                          plan.bindings))
+                    if not held and st.primitive and not res.detail.startswith("not executed: sac_steps is 0"):
+                        # the learned policy failed, could not start, or its result did not last: the
+                        # primitive behind the step gets its turn, and the result says both what SAC
+                        # did and that it fell back
+                        if res.success:
+                            res.detail += "; its check failed afterwards"
+                        prim = run_subtask(drv, st, plan)
+                        res = PrimitiveResult(prim.success, res.steps + prim.steps,
+                                             f"SAC failed ({res.detail}); fell back to the {st.primitive} primitive: {prim.detail}")
+                else:
+                    res = run_subtask(drv, st, plan)
                 drv.settle(10)
-                held = res.success and all(p.holds for p in _evaluate(st.success.predicates, model, data, spec,
-                                                                      plan.bindings))
-                if not held and st.primitive and not res.detail.startswith("not executed: sac_steps is 0"):
-                    # the learned policy failed, could not start, or its result did not last: the
-                    # primitive behind the step gets its turn, and the result says both what SAC
-                    # did and that it fell back
-                    if res.success:
-                        res.detail += "; its check failed afterwards"
-                    prim = run_subtask(drv, st, plan)
-                    res = PrimitiveResult(prim.success, res.steps + prim.steps,
-                                         f"SAC failed ({res.detail}); fell back to the {st.primitive} primitive: {prim.detail}")
-            else:
-                res = run_subtask(drv, st, plan)
-            drv.settle(10)
-            ok = res.success
-            detail = res.detail
-            if st.success.predicates:
-                preds = _evaluate(st.success.predicates, model, data, spec, plan.bindings)
-                ok = all(p.holds for p in preds)
-                detail += "; " + "; ".join(f"{p.call.name}: {'yes' if p.holds else 'no'}" for p in preds)
-            details.append(detail if attempt == 1 else f"attempt {attempt}: {detail}")
-            if ok or time.perf_counter() - t0 > max_wall_s:
-                break
-        results.append(SubTaskResult(id=st.id, method=st.method, success=ok, steps=drv.steps - s0,
-                                     wall_s=round(time.perf_counter() - ts, 3), detail=" | ".join(details),
-                                     attempts=attempt))
+                ok = res.success
+                detail = res.detail
+                if st.success.predicates:
+                    preds = _evaluate(st.success.predicates, model, data, spec, plan.bindings)
+                    ok = all(p.holds for p in preds)
+                    detail += "; " + "; ".join(f"{p.call.name}: {'yes' if p.holds else 'no'}" for p in preds)
+                details.append(detail if attempt == 1 else f"attempt {attempt}: {detail}")
+                if ok or time.perf_counter() - t0 > max_wall_s:
+                    break
+            results.append(SubTaskResult(id=st.id, method=st.method, success=ok, steps=drv.steps - s0,
+                                         wall_s=round(time.perf_counter() - ts, 3), detail=" | ".join(details),
+                                         attempts=attempt))
+        return results
+
+    results = run_steps(plan.subtasks, plan)
+    if before is not None and plan.subtasks:
+        drv.settle(25)
+        results += _look_again(drv, before, plan, recheck_fixes, run_steps)
+
     drv.settle(25)
     final = _evaluate(plan.success.predicates, model, data, spec, plan.bindings)
     if final_graph_path is not None:
         from anomalygen.runfolder import write_model
-        from anomalygen.scene.graph import scene_graph
-
+        
         write_model(Path(final_graph_path), scene_graph(model, data, spec))
     timings["execute_s"] = round(time.perf_counter() - t0 - timings["load_s"], 3)
     timings["control_steps"] = float(drv.steps)

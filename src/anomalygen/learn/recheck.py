@@ -1,0 +1,64 @@
+"""Look again after acting: hazards the robot's own fix created are seen and fixed before it leaves.
+
+Why: a fix is physical. Closing an oven door can nudge a knob on; a drawer the arm opened for access
+can jam half open; a bottle that slips from the cup lands on the floor within a child's reach. A
+careful person glances back at the scene before walking away, and so does the robot: it reads the
+scene graph of the simulator state after the plan (what it perceives, never the truth file), runs the
+same rules it detected with, and plans a fix (from the knowledge base, roles bound from perception)
+for each hazard that was not there before it started. One such pass; what is still wrong after it is
+left for the referee to count.
+"""
+
+from __future__ import annotations
+
+from anomalygen.errors import ItemFailed
+from anomalygen.schema import Plan, SceneGraph, SceneSpec
+
+
+def hazards_seen(graph: SceneGraph, kb) -> dict[tuple[str, str], float]:
+    """(object, class) -> severity for every class the rules find on the perceived graph."""
+    from anomalygen.detect.rules import candidates
+
+    return {(c.object, c.hazard_class): c.severity for c in candidates(graph, kb)}
+
+
+def new_hazards(before: SceneGraph, after: SceneGraph, kb) -> list[tuple[str, str]]:
+    """Hazards on ``after`` that were not on ``before``, most severe first (one per object)."""
+    seen = hazards_seen(before, kb)
+    now = hazards_seen(after, kb)
+    out: list[tuple[str, str]] = []
+    for (obj, cls), _sev in sorted(now.items(), key=lambda kv: (-kv[1], kv[0])):
+        if (obj, cls) not in seen and all(obj != o for o, _ in out):
+            out.append((obj, cls))
+    return out
+
+
+def spec_as_it_stands(spec: SceneSpec, data) -> SceneSpec:
+    """The perceived spec with every joint value read from the live simulation: the planner picks
+    which knob to turn or door to shut from joint states, and the scene file holds the start."""
+    objects = []
+    for o in spec.objects:
+        states = [js.model_copy(update={"value": float(data.joint(js.name).qpos[0])}) for js in o.joint_states]
+        objects.append(o.model_copy(update={"joint_states": states}))
+    return spec.model_copy(update={"objects": objects})
+
+
+def repair_plan(task_id: str, found: list[tuple[str, str]], graph: SceneGraph, spec: SceneSpec, kb, *,
+                max_fixes: int, sac_actions=()) -> tuple[Plan | None, list[str]]:
+    """One plan fixing the new hazards (at most ``max_fixes``); the problems of those it cannot plan."""
+    from anomalygen.plan.bind import bind_fix
+    from anomalygen.plan.planner import merge_plans, plan_from_kb
+
+    plans, problems = [], []
+    for obj, cls in found[:max_fixes]:
+        hc = kb.hazard_classes[cls]
+        try:
+            bindings = bind_fix(hc, obj, graph, kb)
+            plans.append(plan_from_kb(task_id, cls, bindings, spec=spec, source="detected", sac_actions=sac_actions))
+        except ItemFailed as exc:
+            problems.append(f"{cls} on {obj}: {exc}")
+    if not plans:
+        return None, problems
+    merged = merge_plans(plans)  # run with this plan: its bindings resolve a single fix's variables
+    steps = [st.model_copy(update={"id": f"recheck_{st.id}"}) for st in merged.subtasks]
+    return merged.model_copy(update={"subtasks": steps}), problems
