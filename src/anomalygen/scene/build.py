@@ -60,6 +60,7 @@ MAX_AUX = 3
 CONTAINER_REDRAWS = 4  # other container sizes drawn before a smaller hazard is tried
 INWARD = 0.13  # m kept from a support's edge by things that are not the edge hazard
 HAZARD_NEAR_SIDE = 0.4  # m: the hazard's centre at most this far from the robot-facing edge (arm's reach)
+FACING_TRIES = 16  # draws of a parent's spot on its support until its door faces the robot
 LOOSE_ON_SUPPORT_MAX = 0.35  # m: a loose task object smaller than this goes on the support, not the floor
 CLUTTER_MAX_SIZE = 0.3
 SAFE_STATE = {"open": "closed", "on": "off"}  # a part's state in a hazard-free scene
@@ -525,7 +526,7 @@ def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], suppor
         ppl = placed.get(parent.name)
         if ppl is None:
             ppl = placed[parent.name] = _placed(parent)
-            lay.place_on_floor(ppl, relevant=True, face=True)
+            _stand_parent(sel, lay, placed, ppl)
         if kind == "inside":
             lo, hi, _ = _cavity_world(ppl)
             lay.place_in_cavity(hp, ppl, (lo, hi))
@@ -533,6 +534,29 @@ def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], suppor
             lay.place_on_surface(hp, ppl, _surface_of(ppl), inward=0.0)
     else:
         raise ItemFailed(f"unsupported placement {sel.task.scenario.placement!r}")
+
+
+def _stand_parent(sel: Selection, lay: Layout, placed: dict[str, Placed], ppl: Placed) -> None:
+    """The object the hazard is in or on: on the scene's support when the knowledge base says it
+    stands on that kind of surface and not on the floor (a microwave sits on the counter), else on
+    the floor facing the robot."""
+    info = sel.kb.objects.get(sel.parent.catalogue)
+    holder = placed.get(sel.support_var.name) if sel.support_var is not None else None
+    if info is not None and "floor" not in info.supports and holder is not None:
+        kind = next((k for k, c in furniture.CATEGORY.items() if c == sel.support_var.catalogue), None)
+        if kind in info.supports:
+            for _ in range(FACING_TRIES):  # the surface draws a random yaw: keep one whose door faces the robot
+                lay.place_on_surface(ppl, holder, _surface_of(holder), inward=INWARD)
+                if ppl.front is None:
+                    return
+                c, s_ = np.cos(ppl.yaw), np.sin(ppl.yaw)
+                front = np.array([c * ppl.front[0] - s_ * ppl.front[1], s_ * ppl.front[0] + c * ppl.front[1]])
+                to_base = lay.base[:2] - ppl.pos[:2]
+                if float(np.dot(front, to_base)) > 0.6 * float(np.linalg.norm(to_base)):
+                    return
+                lay.items.remove(ppl)
+            raise ItemFailed(f"{ppl.name} found no spot on {holder.name} with its door towards the room")
+    lay.place_on_floor(ppl, relevant=True, face=True)
 
 
 def _place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None) -> None:
