@@ -128,7 +128,7 @@ def run_subtask(drv, st: SubTask, plan: Plan):
         into = any(c.name == "inside" and not c.negate for c in st.success.predicates) or prim == "place_inside"
         res = P.move_to(drv, obj, region, release_after=bool(prm.get("release", True)), into=into)
         shut = [lab for lab in _closed_parts(drv, region) if lab != "door" or not drv.opened.get(region)]
-        if shut and not drv.opened.get(region):  # say why an 'inside' will fail
+        if shut and into and not drv.opened.get(region):  # say why an 'inside' will fail
             res.detail += f"; {region}'s {', '.join(shut)} closed and the plan did not open it"
         return res
     if prim == "push_to":  # slide a free object over the floor beside a piece of furniture
