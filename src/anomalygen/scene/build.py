@@ -434,6 +434,8 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
     for ch in task_objects:
         if ch is None or ch.name in placed or not ch.fixed or ch is hazard:
             continue
+        if ch is parent and _on_a_support(sel):  # a big microwave the hazard is in: onto the counter, below
+            continue
         p = placed[ch.name] = _placed(ch)
         lay.place_on_floor(p, relevant=True, face=True)
     if hazard.fixed and hazard.name not in placed:
@@ -536,26 +538,35 @@ def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], suppor
         raise ItemFailed(f"unsupported placement {sel.task.scenario.placement!r}")
 
 
+def _on_a_support(sel: Selection) -> bool:
+    """Does the object the hazard is in or on stand on the scene's support rather than the floor?
+    (the knowledge base says it never stands on the floor, and the support is of a kind it stands on)"""
+    if sel.parent is None or sel.support_var is None:
+        return False
+    info = sel.kb.objects.get(sel.parent.catalogue)
+    kind = next((k for k, c in furniture.CATEGORY.items() if c == sel.support_var.catalogue), None)
+    return info is not None and "floor" not in info.supports and kind in info.supports
+
+
 def _stand_parent(sel: Selection, lay: Layout, placed: dict[str, Placed], ppl: Placed) -> None:
     """The object the hazard is in or on: on the scene's support when the knowledge base says it
     stands on that kind of surface and not on the floor (a microwave sits on the counter), else on
-    the floor facing the robot."""
-    info = sel.kb.objects.get(sel.parent.catalogue)
+    the floor facing the robot. On a support it is welded there: the asset's hollow shell weighs a
+    fraction of a real microwave on its rubber feet, and a door pull dragged it across the counter."""
     holder = placed.get(sel.support_var.name) if sel.support_var is not None else None
-    if info is not None and "floor" not in info.supports and holder is not None:
-        kind = next((k for k, c in furniture.CATEGORY.items() if c == sel.support_var.catalogue), None)
-        if kind in info.supports:
-            for _ in range(FACING_TRIES):  # the surface draws a random yaw: keep one whose door faces the robot
-                lay.place_on_surface(ppl, holder, _surface_of(holder), inward=INWARD)
-                if ppl.front is None:
-                    return
-                c, s_ = np.cos(ppl.yaw), np.sin(ppl.yaw)
-                front = np.array([c * ppl.front[0] - s_ * ppl.front[1], s_ * ppl.front[0] + c * ppl.front[1]])
-                to_base = lay.base[:2] - ppl.pos[:2]
-                if float(np.dot(front, to_base)) > 0.6 * float(np.linalg.norm(to_base)):
-                    return
-                lay.items.remove(ppl)
-            raise ItemFailed(f"{ppl.name} found no spot on {holder.name} with its door towards the room")
+    if holder is not None and _on_a_support(sel):
+        ppl.fixed = True
+        for _ in range(FACING_TRIES):  # the surface draws a random yaw: keep one whose door faces the robot
+            lay.place_on_surface(ppl, holder, _surface_of(holder), inward=INWARD)
+            if ppl.front is None:
+                return
+            c, s_ = np.cos(ppl.yaw), np.sin(ppl.yaw)
+            front = np.array([c * ppl.front[0] - s_ * ppl.front[1], s_ * ppl.front[0] + c * ppl.front[1]])
+            to_base = lay.base[:2] - ppl.pos[:2]
+            if float(np.dot(front, to_base)) > 0.6 * float(np.linalg.norm(to_base)):
+                return
+            lay.items.remove(ppl)
+        raise ItemFailed(f"{ppl.name} found no spot on {holder.name} with its door towards the room")
     lay.place_on_floor(ppl, relevant=True, face=True)
 
 
