@@ -21,6 +21,7 @@ from anomalygen.control.driver import PRE_CONTACT, Driver, PrimitiveResult
 from anomalygen.control.geometry import grasp_points, rim_z
 from anomalygen.control.primitives import grasp
 
+BACK_OUT_CLEAR = 0.1  # m the cup backs out beyond the container's box with the object
 IN_FRONT = 0.2  # m in front of the opening where the cup lines up before going in
 INSIDE_LIFT = 0.02  # m the object is lifted inside a compartment (its ceiling is close)
 RIM_CLEAR = 0.05  # m the object's bottom rises above an open-topped container's rim
@@ -41,10 +42,8 @@ def take_out_of(drv: Driver, obj: str, container: str) -> PrimitiveResult:
     s0 = drv.steps
     if drv.held == obj:  # a retry: it was grasped but is not out yet
         if container in drv.compartments:
-            lo, hi, out = drv.compartments[container]
-            k = int(np.argmax(np.abs(out[:2])))
-            mouth = hi[k] if out[k] > 0 else lo[k]
-            _back_out(drv, drv.site + out * (abs(mouth - drv.site[k]) + IN_FRONT))
+            out = drv.compartments[container][2]
+            _back_out(drv, _outside(drv, container, out, int(np.argmax(np.abs(out[:2])))))
         return PrimitiveResult(True, drv.steps - s0, f"already holding {obj}; moved it clear of {container}")
     if container not in drv.compartments:
         g = grasp(drv, obj, lift=0.12)
@@ -86,8 +85,8 @@ def take_out_of(drv: Driver, obj: str, container: str) -> PrimitiveResult:
                 drv.goto(point - v * (PRE_CONTACT - 0.0025 * j), quat, max_steps=12, tol=0.004)
                 if robot.object_distance_to_cup(m, d, obj) < robot.SUCTION_RANGE * 0.8 and robot.suction_on(m, d, obj):
                     break
-            if drv.held == obj:
-                _back_out(drv, front)
+            if drv.held == obj:  # straight out along the opening's normal (back along h can clip the side)
+                _back_out(drv, _outside(drv, container, out, k))
                 return PrimitiveResult(drv.held == obj, drv.steps - s0,
                                        f"{obj} taken out of {container} through its opening (cup tilted {np.degrees(tilt):.0f} deg)")
             tried.append(f"{np.degrees(tilt):.0f} deg: stopped {short:.2f} m short, suction did not catch")
@@ -111,6 +110,14 @@ def _swing_door_wide(drv: Driver, container: str) -> None:
         goal = far - np.sign(far - js.closed_value) * DOOR_STOP_MARGIN
         if abs(float(drv.data.joint(js.name).qpos[0]) - goal) > DOOR_WIDE_TOL:
             actuate_part(drv, js.name, goal, closed=js.closed_value, tol=DOOR_WIDE_TOL)
+
+
+def _outside(drv: Driver, container: str, out: np.ndarray, k: int) -> np.ndarray:
+    """A cup point straight out from where it is, past the container's whole box (an open door
+    folded back reaches out beside the opening; until the object is past it, it counts as inside)."""
+    clo, chi = drv.aabb(container)
+    face = chi[k] if out[k] > 0 else clo[k]
+    return drv.site + out * (abs(face - drv.site[k]) + BACK_OUT_CLEAR)
 
 
 def _back_out(drv: Driver, front: np.ndarray) -> None:
