@@ -49,6 +49,12 @@ POSITIVE = {
     "move_heavy_from_edge": lambda: graph(obj("hammer_0", "hammer", at="table", edge=0.05)),
     "keep_fire_starters_from_children": lambda: graph(obj("lighter_0", "Lighter", at="table")),
     "close_toilet_lid": lambda: graph(furniture("toilet_0", "Toilet", joints=[joint("lid", 0.9)]), room="bathroom"),
+    "push_heavy_item_out_of_walkway": lambda: graph(obj("dumbbell_0", "dumbbell", at="floor"), furniture("table_0", "Table")),
+    "close_open_portable_container": lambda: graph(furniture("box_0", "Box", size=(0.4, 0.3, 0.3), joints=[joint("lid", 0.8)])),
+    "remove_item_from_appliance": lambda: graph(
+        obj("fork_0", "fork", at="counter"), furniture("mw_0", "Microwave", joints=[joint("door", 0.0)]), counter(),
+        relations=[inside("fork_0", "mw_0")]),
+    "pick_item_off_floor_onto_desk": lambda: graph(obj("phone_0", "Phone", at="floor"), furniture("table_0", "Table")),
 }
 
 NEGATIVE = {
@@ -80,6 +86,12 @@ NEGATIVE = {
     "move_heavy_from_edge": lambda: graph(obj("hammer_0", "hammer", at="table", edge=0.4)),
     "keep_fire_starters_from_children": lambda: graph(obj("lighter_0", "Lighter", at="shelf", reachable=False)),
     "close_toilet_lid": lambda: graph(furniture("toilet_0", "Toilet", joints=[joint("lid", 0.0)]), room="bathroom"),
+    "push_heavy_item_out_of_walkway": lambda: graph(obj("dumbbell_0", "dumbbell", at="floor", xy=(1.5, 2.0)), furniture("table_0", "Table")),
+    "close_open_portable_container": lambda: graph(furniture("box_0", "Box", size=(0.4, 0.3, 0.3), joints=[joint("lid", 0.02)])),
+    "remove_item_from_appliance": lambda: graph(
+        obj("fork_0", "fork", at="counter"), furniture("mw_0", "Microwave", joints=[joint("door", 0.0)]), counter(),
+        relations=[on("fork_0", "counter_0")]),
+    "pick_item_off_floor_onto_desk": lambda: graph(obj("phone_0", "Phone", at="table")),
 }
 
 
@@ -132,6 +144,39 @@ def test_success_predicates_hold_after_the_fix():
     cable = kb.hazard_classes["clear_cable_from_walkway"]
     laid = graph(obj("cable_0", "power_cable", at="table"), furniture("table_0", "Table"), relations=[on("cable_0", "table_0")])
     assert all(evaluate(c, laid, {"$hazard": "cable_0", "$support": "table_0"}).holds for c in cable.success)
+
+
+def test_new_classes_success_predicates_judge_the_fix():
+    """The four classes of the push/lid/take-out/place-on actions: their success holds on the fixed
+    scene, not on the hazardous one, and the class no longer fires after the fix."""
+    kb = load_kb()
+    table = furniture("table_0", "Table")
+    cases = {
+        "push_heavy_item_out_of_walkway": (
+            {"$hazard": "dumbbell_0", "$support": "table_0"},
+            graph(obj("dumbbell_0", "dumbbell", at="floor"), table),
+            graph(obj("dumbbell_0", "dumbbell", at="floor", xy=(1.5, 2.0)), table)),
+        "close_open_portable_container": (
+            {"$target": "box_0"}, PUSHED_OPEN(), graph(furniture("box_0", "Box", joints=[joint("lid", 0.0)]))),
+        "remove_item_from_appliance": (
+            {"$hazard": "fork_0", "$target": "mw_0", "$support": "counter_0"},
+            POSITIVE["remove_item_from_appliance"](),
+            graph(obj("fork_0", "fork", at="counter"), furniture("mw_0", "Microwave", joints=[joint("door", 0.0)]), counter(),
+                  relations=[on("fork_0", "counter_0")])),
+        "pick_item_off_floor_onto_desk": (
+            {"$hazard": "phone_0", "$support": "table_0"},
+            graph(obj("phone_0", "Phone", at="floor"), table),
+            graph(obj("phone_0", "Phone", at="table"), table, relations=[on("phone_0", "table_0")])),
+    }
+    for cid, (b, before, after) in cases.items():
+        hc = kb.hazard_classes[cid]
+        assert not all(evaluate(c, before, b).holds for c in hc.success), cid
+        assert all(evaluate(c, after, b).holds for c in hc.success), cid
+        assert match_class(hc, after) == [], cid
+
+
+def PUSHED_OPEN():  # noqa: N802 - a scene factory like POSITIVE's
+    return graph(furniture("box_0", "Box", joints=[joint("lid", 0.8)]))
 
 
 def test_predicate_details():

@@ -64,6 +64,9 @@ _ACTION_VERBS = {
     "open_joint": ["Open", "Crack open", "Prop open"],
     "switch_off": ["Switch off", "Turn off", "Power down"],
     "move_away_from_edge": ["Move back", "Push back", "Re-centre", "Secure"],
+    "push_to": ["Push aside", "Slide away", "Move"],
+    "close_lid": ["Close", "Shut", "Lower the lid of"],
+    "place_on": ["Put away", "Lift up", "Pick up"],
 }
 
 _EXPLANATION_FRAMES = [

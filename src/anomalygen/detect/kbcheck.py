@@ -91,7 +91,17 @@ def _hazard_objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObject]
     if placement in ("floor", "walkway"):
         return [_obj(name, obj, props, pos=(1.0, -0.8, 0.03), size=(0.1, 0.1, 0.06), height=0.0, on_floor=True)], [], name
     if placement.startswith("inside:"):
-        holder = "refrigerator_0" if placement.endswith("Refrigerator") else "storage_0"
+        parent = placement.split(":", 1)[1]
+        info = kb.objects.get(parent)
+        if info is not None and info.supports and "floor" not in info.supports:
+            # a counter-top appliance (a microwave): it stands on the counter, door shut, the item inside
+            holder = f"{parent.lower()}_0"
+            box = _obj(holder, parent, _props(kb, parent), pos=(0.9, 1.6, 1.05), size=(0.5, 0.4, 0.3), height=0.9,
+                       on_floor=False, edge=0.1, joints=[_joint(f"{holder}_door", "door", 0.0)])
+            o = _obj(name, obj, props, pos=(0.9, 1.6, 0.95), size=(0.18, 0.03, 0.02), height=0.92, on_floor=False)
+            return [box, o], [Relation(subject=name, predicate="inside", object=holder),
+                              Relation(subject=holder, predicate="on", object="counter_0")], name
+        holder = "refrigerator_0" if parent == "Refrigerator" else "storage_0"
         o = _obj(name, obj, props, pos=(-0.6, 1.6, 0.5), size=(0.1, 0.1, 0.06), height=0.5, on_floor=False, reach=False)
         return [o], [Relation(subject=name, predicate="inside", object=holder)], name
     top = SURFACE_TOP.get(placement.split(":", 1)[-1], 0.75)

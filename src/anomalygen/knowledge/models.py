@@ -83,6 +83,10 @@ RecipeAction = Literal[
     "close_joint",
     "switch_off",
     "move_away_from_edge",
+    "push_to",
+    "close_lid",
+    "open_lid",
+    "take_out_of",
 ]
 
 #: Arguments each recipe action takes (all values are role variables or literal labels).
@@ -94,6 +98,10 @@ RECIPE_ARGS: dict[str, tuple[str, ...]] = {
     "close_joint": ("object", "label"),
     "switch_off": ("object", "label"),
     "move_away_from_edge": ("object",),
+    "push_to": ("object", "support"),  # slide over the floor until it stands beside the support
+    "close_lid": ("object",),  # every lid or flap of a portable container
+    "open_lid": ("object",),
+    "take_out_of": ("object", "container"),  # lift it out (through an opened door) and keep holding it
 }
 
 

@@ -127,12 +127,23 @@ def run_subtask(drv, st: SubTask, plan: Plan):
             g = P.grasp(drv, obj)
             if not g.success:
                 return g
-        into = any(c.name == "inside" for c in st.success.predicates) or prim == "place_inside"
+        into = any(c.name == "inside" and not c.negate for c in st.success.predicates) or prim == "place_inside"
         res = P.move_to(drv, obj, region, release_after=bool(prm.get("release", True)), into=into)
         shut = [lab for lab in _closed_parts(drv, region) if lab != "door" or not drv.opened.get(region)]
-        if shut and not drv.opened.get(region):  # say why an 'inside' will fail
+        if shut and into and not drv.opened.get(region):  # say why an 'inside' will fail
             res.detail += f"; {region}'s {', '.join(shut)} closed and the plan did not open it"
         return res
+    if prim == "push_to":  # slide a free object over the floor beside a piece of furniture
+        from anomalygen.control.push import push_to
+
+        return push_to(drv, obj, str(prm.get("region") or prm.get("support") or ""))
+    if prim == "take_out_of":  # lift it out of a container or appliance; it stays held
+        from anomalygen.control.transfer import take_out_of
+
+        return take_out_of(drv, obj, str(prm.get("region") or prm.get("container") or ""))
+    if prim in ("close_lid", "open_lid"):  # every lid or flap of a portable container
+        prm.setdefault("part", "lid|flap")
+        return _drive_joints(drv, st, obj, "push" if prim == "close_lid" else "pull", prm)
     if prim in ("push", "pull") and prm.get("access"):  # open a container to put something in / shut it again
         from anomalygen.control import parts
 

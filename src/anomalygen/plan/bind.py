@@ -21,6 +21,8 @@ from anomalygen.schema import CHILD_REACH, ENCLOSING_LABELS, GraphObject, Relati
 
 REACH_BOTTOM_M = 1.2  # a container standing higher than this is out of the arm's comfortable reach
 AFTER_PLACE_LIFT_M = 0.02  # predicted height of a placed object above its container's base
+REACH_TOP_M = 1.6  # a surface whose top is higher than this is out of the arm's comfortable reach
+STABLE_TOPS = ("Table", "counter", "shelf", "StorageFurniture")  # categories with a flat, level top board
 
 
 def bind_fix(hc, fault: str, graph: SceneGraph, kb) -> dict[str, str]:
@@ -95,8 +97,14 @@ def ends_hazard(classes, obj: GraphObject, container: GraphObject, graph: SceneG
 
 
 def choose_support(hc, obj: GraphObject, graph: SceneGraph) -> str:
+    """The nearest perceived surface of a kind the class lays things on; when the scene has none of
+    those, the nearest stable top of any kind (a table, counter, shelf or cabinet) that is within
+    reach and wider than the object: a phone can go on a counter when the room has no desk."""
     kinds = set(hc.default_supports)
     cands = [o for o in graph.objects if o.name != obj.name and o.category in kinds]
+    if not cands:
+        cands = [o for o in graph.objects if o.name != obj.name and o.category in STABLE_TOPS
+                 and o.position[2] + o.size[2] / 2 <= REACH_TOP_M and min(o.size[:2]) > max(obj.size[:2])]
     if not cands:
         raise ItemFailed(f"no surface for {obj.name} in the scene (wanted: {', '.join(sorted(kinds)) or 'none'})")
     return _nearest(obj, cands)

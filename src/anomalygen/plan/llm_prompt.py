@@ -23,6 +23,11 @@ PRIMITIVES: dict[str, tuple[str, str]] = {
     "release": ("", "let go of what is held"),
     "push": ("object, joint or part", "press a part towards joint value `target` (its closed value closes it)"),
     "pull": ("object, joint or part", "draw a part open towards `target`"),
+    "place_on": ("object, region", "set the held object down on the top of support `region`"),
+    "push_to": ("object, region", "slide a floor object until it stands beside furniture `region`"),
+    "take_out_of": ("object, region", "lift the object out of container `region` (opened first); it stays held"),
+    "close_lid": ("object", "shut every lid or flap of a box or suitcase"),
+    "open_lid": ("object", "open every lid or flap of a box or suitcase"),
 }
 
 

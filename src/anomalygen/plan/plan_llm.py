@@ -60,7 +60,7 @@ class ReplyParams(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     object: str | None = Field(None, description="object acted on")
-    region: str | None = Field(None, description="move_to destination: object name or 'surface_centre'")
+    region: str | None = Field(None, description="move_to/place_on/push_to destination, take_out_of source: object name or 'surface_centre'")
     joint: str | None = Field(None, description="full joint name for push/pull")
     target: float | None = Field(None, description="goal joint value for push/pull")
     part: str | None = Field(None, description="joint label (door, drawer, lid, knob, ...) instead of a joint name")

@@ -24,6 +24,8 @@ from anomalygen.schema import (
 
 LIFT_HEIGHT = 0.12  # metres above the start height for a pick
 CLOSURES = ("lid", "flap", "drawer", "door")  # part labels that can shut a container
+LID_LABELS = "lid|flap"  # the parts close_lid / open_lid act on (a cardboard box has flaps, not a lid)
+_LIFTED_OUT = 1.0  # m: reward target height for an object taken out of a counter-top appliance
 
 
 def _resolve(value: str, bindings: dict[str, str]) -> str:
@@ -95,6 +97,8 @@ def step_to_subtask(index: int, action: str, args: dict[str, str], bindings: dic
                        primitive="move_to", params={"object": obj, "region": "surface_centre", "release": True},
                        reward=RewardSpec(terms=[RewardTerm(kind="action_penalty", weight=0.01)]),
                        success=SuccessSpec(predicates=own))
+    if action in ("push_to", "take_out_of", "close_lid", "open_lid"):
+        return _handling_subtask(sid, action, obj, args, bindings, own)
     raise ItemFailed(f"recipe action {action!r} has no sub-task mapping")
 
 
@@ -141,6 +145,35 @@ def switch_off_subtasks(index: int, args: dict[str, str], bindings: dict[str, st
                                      RewardTerm(kind="action_penalty", weight=0.01)]),
             success=SuccessSpec(predicates=own if last else [])))
     return out
+
+
+def _handling_subtask(sid: str, action: str, obj: str, args: dict[str, str], bindings: dict[str, str],
+                      own: list[PredicateCall]) -> SubTask:
+    """Sub-tasks of the actions that move whole objects along the floor, out of containers, or shut
+    a portable container's lid. Each is a primitive of the same name (``learn/execute.py``)."""
+    if action in ("close_lid", "open_lid"):
+        verb = "close" if action == "close_lid" else "open"
+        return SubTask(id=sid, description=f"{verb} the lid of {obj}", method=SkillMethod.PRIMITIVE, primitive=action,
+                       params={"object": obj, "part": LID_LABELS},
+                       reward=RewardSpec(terms=[RewardTerm(kind="distance", a="ee", b=obj, weight=0.5),
+                                                RewardTerm(kind="action_penalty", weight=0.01)]),
+                       success=SuccessSpec(predicates=own))
+    key = "support" if action == "push_to" else "container"
+    dest = _resolve(args.get(key, f"${key}"), bindings)
+    if action == "push_to":
+        return SubTask(id=sid, description=f"slide {obj} over the floor until it stands beside {dest}",
+                       method=SkillMethod.PRIMITIVE, primitive="push_to", params={"object": obj, "region": dest},
+                       reward=RewardSpec(terms=[RewardTerm(kind="distance", a=obj, b=dest, weight=2.0),
+                                                RewardTerm(kind="action_penalty", weight=0.01)]),
+                       success=SuccessSpec(predicates=own))
+    # take_out_of: its own check is only that the object is out (it is still held afterwards).
+    out = [p for p in own if p.name == "inside" and p.negate]
+    return SubTask(id=sid, description=f"take {obj} out of {dest} and keep holding it", method=SkillMethod.PRIMITIVE,
+                   primitive="take_out_of", params={"object": obj, "region": dest},
+                   reward=RewardSpec(terms=[RewardTerm(kind="distance", a="ee", b=obj, weight=1.0),
+                                            RewardTerm(kind="lifted", a=obj, target=_LIFTED_OUT, weight=2.0),
+                                            RewardTerm(kind="action_penalty", weight=0.01)]),
+                   success=SuccessSpec(predicates=out))
 
 
 def closed_closures(spec: SceneSpec | None, instance: str) -> list[str]:
@@ -190,7 +223,8 @@ def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, s
         st = step_to_subtask(i, step.action, dict(step.args), bindings, spec, list(cls.success))
         subtasks.append(st.model_copy(update={"method": method}) if method != st.method else st)
     for step in cls.recipe:
-        if step.action == "place_inside":
+        # A container shut in the scene is opened before the object goes in (or comes out) and shut after.
+        if step.action in ("place_inside", "take_out_of"):
             container = _resolve(step.args.get("container", "$container"), bindings)
             labels = closed_closures(spec, container)
             if labels:

@@ -32,6 +32,7 @@ if TYPE_CHECKING:
 
 SURFACE_PLACEMENTS = {"table", "low_table", "table_edge", "counter", "counter_edge", "shelf"}
 LOOSE_ON_SUPPORT_MAX = 0.35  # m: a loose task object smaller than this goes on the support, not the floor
+FACING_TRIES = 16  # draws of a parent's spot on its support until its door faces the robot
 
 
 def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed], Placed | None]:
@@ -78,6 +79,8 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
     # Fixed (furniture-sized) objects stand on the floor facing the robot.
     for ch in task_objects:
         if ch is None or ch.name in placed or not ch.fixed or ch is hazard:
+            continue
+        if ch is parent and _on_a_support(sel):  # a big microwave the hazard is in: onto the counter, below
             continue
         p = placed[ch.name] = placed_instance(ch)
         lay.place_on_floor(p, relevant=True, face=True)
@@ -148,7 +151,7 @@ def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], suppor
         ppl = placed.get(parent.name)
         if ppl is None:
             ppl = placed[parent.name] = placed_instance(parent)
-            lay.place_on_floor(ppl, relevant=True, face=True)
+            _stand_parent(sel, lay, placed, ppl)
         if kind == "inside":
             lo, hi, _ = cavity_world(ppl)
             lay.place_in_cavity(hp, ppl, (lo, hi))
@@ -156,6 +159,38 @@ def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], suppor
             lay.place_on_surface(hp, ppl, surface_of(ppl), inward=0.0)
     else:
         raise ItemFailed(f"unsupported placement {sel.task.scenario.placement!r}")
+
+
+def _on_a_support(sel: Selection) -> bool:
+    """Does the object the hazard is in or on stand on the scene's support rather than the floor?
+    (the knowledge base says it never stands on the floor, and the support is of a kind it stands on)"""
+    if sel.parent is None or sel.support_var is None:
+        return False
+    info = sel.kb.objects.get(sel.parent.catalogue)
+    kind = next((k for k, c in furniture.CATEGORY.items() if c == sel.support_var.catalogue), None)
+    return info is not None and "floor" not in info.supports and kind in info.supports
+
+
+def _stand_parent(sel: Selection, lay: Layout, placed: dict[str, Placed], ppl: Placed) -> None:
+    """The object the hazard is in or on: on the scene's support when the knowledge base says it
+    stands on that kind of surface and not on the floor (a microwave sits on the counter), else on
+    the floor facing the robot. On a support it is welded there: the asset's hollow shell weighs a
+    fraction of a real microwave on its rubber feet, and a door pull dragged it across the counter."""
+    holder = placed.get(sel.support_var.name) if sel.support_var is not None else None
+    if holder is not None and _on_a_support(sel):
+        ppl.fixed = True
+        for _ in range(FACING_TRIES):  # the surface draws a random yaw: keep one whose door faces the robot
+            lay.place_on_surface(ppl, holder, surface_of(holder), inward=INWARD)
+            if ppl.front is None:
+                return
+            c, s_ = np.cos(ppl.yaw), np.sin(ppl.yaw)
+            front = np.array([c * ppl.front[0] - s_ * ppl.front[1], s_ * ppl.front[0] + c * ppl.front[1]])
+            to_base = lay.base[:2] - ppl.pos[:2]
+            if float(np.dot(front, to_base)) > 0.6 * float(np.linalg.norm(to_base)):
+                return
+            lay.items.remove(ppl)
+        raise ItemFailed(f"{ppl.name} found no spot on {holder.name} with its door towards the room")
+    lay.place_on_floor(ppl, relevant=True, face=True)
 
 
 def _table_height_ok(asset) -> bool:
