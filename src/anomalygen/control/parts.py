@@ -374,7 +374,7 @@ def best_door(drv, obj: str, doors: list):
         if abs(float(drv.data.joint(js.name).qpos[0]) - js.closed_value) > 0.1:
             continue  # only shut doors have a known compartment behind them
         lo, hi, _ = compartment_behind(drv, obj, js)
-        if hi[2] - lo[2] >= 0.18 and 0.15 < lo[2] < 1.0:
+        if hi[2] - lo[2] >= 0.18 and lo[2] < 1.0:  # low doors too: the object then goes in sideways
             ok.append((float(lo[2]), js))
     return max(ok, key=lambda t: t[0])[1] if ok else None
 
