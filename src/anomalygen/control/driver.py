@@ -48,6 +48,9 @@ class Driver:
         self.steps = 0
         self.opened: dict[str, list[str]] = {}  # container -> joints opened to put something in
         self.compartments: dict[str, tuple] = {}  # container -> (lo, hi, outward normal) behind its opened door
+        # container -> its root body's position when the compartment was measured: a light safe on the
+        # floor slides while its door is pulled, and the compartment moves with it
+        self.compartment_anchor: dict[str, np.ndarray] = {}
         self.planned_motion = planned_motion  # reach pre-contact poses by IK + OMPL paths
         self.reaches = True  # did the last base placement satisfy its reach poses?
         self.plan_seed = int(rng.integers(2**31)) if rng is not None else 0

@@ -398,6 +398,7 @@ def open_for_access(drv, obj: str, labels):
             return PrimitiveResult(False, 0, f"{obj} has no lid, flap, drawer or door with a reachable "
                                              "compartment behind it")
         drv.compartments[obj] = compartment_behind(drv, obj, door)
+        drv.compartment_anchor[obj] = drv.data.xpos[drv.body_id(obj)].copy()
         chosen = [door]
     drv.opened[obj] = [js.name for js in chosen]
     ok, details = True, []

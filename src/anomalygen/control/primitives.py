@@ -274,6 +274,16 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     return PrimitiveResult(ok, drv.steps - s0, f"{obj} {'lowered' if ok else 'not fully lowered'} over {region}")
 
 
+def _compartment(drv: Driver, region: str):
+    """(lo, hi, outward normal) of the compartment behind ``region``'s opened door, where the container
+    stands now (it was measured with the door shut; pulling the door can slide a light safe)."""
+    lo, hi, out = drv.compartments[region]
+    anchor = drv.compartment_anchor.get(region)
+    shift = np.zeros(3) if anchor is None else drv.data.xpos[drv.body_id(region)] - anchor
+    shift[2] = 0.0
+    return lo + shift, hi + shift, out
+
+
 def place_through_door(drv: Driver, obj: str, region: str, *, release_after: bool = True) -> PrimitiveResult:
     """Slide the held object into the compartment behind an opened door and set it on its floor.
 
@@ -283,16 +293,15 @@ def place_through_door(drv: Driver, obj: str, region: str, *, release_after: boo
     from anomalygen.control.ik import quat_z_to
 
     s0 = drv.steps
-    lo, hi, out = drv.compartments[region]
+    lo, hi, out = _compartment(drv, region)
     centre = (lo + hi) / 2
-    floor = floor_below(drv, np.array([centre[0], centre[1], hi[2] - 0.01]), obj)
+    # the floor seen from the compartment's middle: a ray started just under the door's top edge starts
+    # inside a safe's 3 cm top wall and reports the wall's underside as the floor (the object then
+    # ended on the safe's top)
+    floor = floor_below(drv, centre, obj)
     floor = float(lo[2]) if floor is None else floor
     if hi[2] - lo[2] < FACE_DOWN_ROOM:
-        # the floor seen from the compartment's middle: a ray started just under the door's top edge
-        # starts inside a safe's 3 cm top wall and reports the wall's underside as the floor
-        low_floor = floor_below(drv, centre, obj)
-        return _place_sideways(drv, obj, region, float(lo[2]) if low_floor is None else low_floor,
-                               release_after=release_after)
+        return _place_sideways(drv, obj, region, floor, release_after=release_after)
     olo, ohi = drv.aabb(obj)
     below = drv.site[2] - olo[2]
     quat = quat_z_to(np.array([0.0, 0.0, -1.0]))
@@ -334,7 +343,7 @@ def _place_sideways(drv: Driver, obj: str, region: str, floor: float, *, release
     from anomalygen.control.ik import quat_z_to
 
     s0 = drv.steps
-    lo, hi, out = drv.compartments[region]
+    lo, hi, out = _compartment(drv, region)
     centre = (lo + hi) / 2
     down = quat_z_to(np.array([0.0, 0.0, -1.0]))
     across = 0.0 if abs(out[0]) > abs(out[1]) else np.pi / 2
