@@ -392,6 +392,10 @@ def open_for_access(drv, obj: str, labels):
     if not chosen:
         drawer = best_drawer(drv, obj, closure_joints(drv, obj, ["drawer"]))
         chosen = [drawer] if drawer is not None else []
+    if not chosen and obj in drv.compartments:
+        # a second attempt on a door left part open: the door and its compartment were chosen and
+        # measured (shut) the first time; now it is open, best_door would not know it any more
+        chosen = [js for js in closure_joints(drv, obj, ["door"]) if js.name in drv.opened.get(obj, [])]
     if not chosen:
         door = best_door(drv, obj, closure_joints(drv, obj, ["door"]))
         if door is None:
