@@ -28,6 +28,7 @@ class PrimitiveResult:
     detail: str = ""
 
 
+MIN_STAY = 0.4  # m: a target nearer the base centre than this makes the base move (base radius 0.22 + the hand)
 BASE_REACH = (0.55, 0.45, 0.65, 0.75)  # base-to-target horizontal distances tried, in order
 
 
@@ -48,6 +49,9 @@ class Driver:
         self.steps = 0
         self.opened: dict[str, list[str]] = {}  # container -> joints opened to put something in
         self.compartments: dict[str, tuple] = {}  # container -> (lo, hi, outward normal) behind its opened door
+        # container -> its root body's position when the compartment was measured: a light safe on the
+        # floor slides while its door is pulled, and the compartment moves with it
+        self.compartment_anchor: dict[str, np.ndarray] = {}
         self.planned_motion = planned_motion  # reach pre-contact poses by IK + OMPL paths
         self.reaches = True  # did the last base placement satisfy its reach poses?
         self.plan_seed = int(rng.integers(2**31)) if rng is not None else 0
@@ -183,7 +187,9 @@ class Driver:
         on_side = (lambda b: True) if sd is None else (
             lambda b: float(np.dot(b - p[:2], sd)) > 0.34 * float(np.linalg.norm(b - p[:2])))
         lift0 = robot.lift(m)
-        if (np.hypot(*(p[:2] - cur[:2])) < 0.62 and self._facing(cur, p) and on_side(cur[:2])
+        # stay put only at a comfortable distance: 0.33 m from a spot low in a bin the IK still says
+        # yes, but the wrist tips before the cup gets down and the base already leans on the bin
+        if (MIN_STAY <= np.hypot(*(p[:2] - cur[:2])) < 0.62 and self._facing(cur, p) and on_side(cur[:2])
                 and (lift0 < 0.01 or reach_poses) and self._reaches(reach_poses)):
             return True
         saved = (d.qpos.copy(), d.qvel.copy(), d.mocap_pos.copy(), d.mocap_quat.copy())

@@ -374,7 +374,7 @@ def best_door(drv, obj: str, doors: list):
         if abs(float(drv.data.joint(js.name).qpos[0]) - js.closed_value) > 0.1:
             continue  # only shut doors have a known compartment behind them
         lo, hi, _ = compartment_behind(drv, obj, js)
-        if hi[2] - lo[2] >= 0.18 and 0.15 < lo[2] < 1.0:
+        if hi[2] - lo[2] >= 0.18 and lo[2] < 1.0:  # low doors too: the object then goes in sideways
             ok.append((float(lo[2]), js))
     return max(ok, key=lambda t: t[0])[1] if ok else None
 
@@ -392,12 +392,17 @@ def open_for_access(drv, obj: str, labels):
     if not chosen:
         drawer = best_drawer(drv, obj, closure_joints(drv, obj, ["drawer"]))
         chosen = [drawer] if drawer is not None else []
+    if not chosen and obj in drv.compartments:
+        # a second attempt on a door left part open: the door and its compartment were chosen and
+        # measured (shut) the first time; now it is open, best_door would not know it any more
+        chosen = [js for js in closure_joints(drv, obj, ["door"]) if js.name in drv.opened.get(obj, [])]
     if not chosen:
         door = best_door(drv, obj, closure_joints(drv, obj, ["door"]))
         if door is None:
             return PrimitiveResult(False, 0, f"{obj} has no lid, flap, drawer or door with a reachable "
                                              "compartment behind it")
         drv.compartments[obj] = compartment_behind(drv, obj, door)
+        drv.compartment_anchor[obj] = drv.data.xpos[drv.body_id(obj)].copy()
         chosen = [door]
     drv.opened[obj] = [js.name for js in chosen]
     ok, details = True, []

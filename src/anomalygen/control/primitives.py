@@ -274,6 +274,16 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     return PrimitiveResult(ok, drv.steps - s0, f"{obj} {'lowered' if ok else 'not fully lowered'} over {region}")
 
 
+def _compartment(drv: Driver, region: str):
+    """(lo, hi, outward normal) of the compartment behind ``region``'s opened door, where the container
+    stands now (it was measured with the door shut; pulling the door can slide a light safe)."""
+    lo, hi, out = drv.compartments[region]
+    anchor = drv.compartment_anchor.get(region)
+    shift = np.zeros(3) if anchor is None else drv.data.xpos[drv.body_id(region)] - anchor
+    shift[2] = 0.0
+    return lo + shift, hi + shift, out
+
+
 def place_through_door(drv: Driver, obj: str, region: str, *, release_after: bool = True) -> PrimitiveResult:
     """Slide the held object into the compartment behind an opened door and set it on its floor.
 
@@ -283,10 +293,15 @@ def place_through_door(drv: Driver, obj: str, region: str, *, release_after: boo
     from anomalygen.control.ik import quat_z_to
 
     s0 = drv.steps
-    lo, hi, out = drv.compartments[region]
+    lo, hi, out = _compartment(drv, region)
     centre = (lo + hi) / 2
-    floor = floor_below(drv, np.array([centre[0], centre[1], hi[2] - 0.01]), obj)
+    # the floor seen from the compartment's middle: a ray started just under the door's top edge starts
+    # inside a safe's 3 cm top wall and reports the wall's underside as the floor (the object then
+    # ended on the safe's top)
+    floor = floor_below(drv, centre, obj)
     floor = float(lo[2]) if floor is None else floor
+    if hi[2] - lo[2] < FACE_DOWN_ROOM:
+        return _place_sideways(drv, obj, region, floor, release_after=release_after)
     olo, ohi = drv.aabb(obj)
     below = drv.site[2] - olo[2]
     quat = quat_z_to(np.array([0.0, 0.0, -1.0]))
@@ -309,6 +324,64 @@ def place_through_door(drv: Driver, obj: str, region: str, *, release_after: boo
         drv.goto(drv.site + np.array([0, 0, 0.01]), final, max_steps=20)
         drv.goto(np.array([*front[:2], drv.site[2]]), final, max_steps=150)
     return PrimitiveResult(ok, drv.steps - s0, f"{obj} {'slid into' if ok else 'not fully into'} {region} through its door")
+
+
+FACE_DOWN_ROOM = 0.35  # m of headroom over a compartment's floor below which a face-down hand does not fit
+# (the wrist and forearm stand ~0.2 m above the cup: a pill bottle carried face-down into a 0.25 m safe
+# dragged along its top and ended on the safe)
+
+
+def _place_sideways(drv: Driver, obj: str, region: str, floor: float, *, release_after: bool = True) -> PrimitiveResult:
+    """Put the held object through a low door (a safe, a medicine cabinet) with the cup pointing in.
+
+    The object, turned so its long side runs across the opening, is tipped 90 degrees about that
+    side's axis in free space, so it lies ahead of a horizontal cup and only the object (not the
+    wrist) has to fit under the compartment's top; it is carried in level just clear of the floor,
+    lowered until it touches, released, and the cup backs out the way it came."""
+    import mujoco
+
+    from anomalygen.control.ik import quat_z_to
+
+    s0 = drv.steps
+    lo, hi, out = _compartment(drv, region)
+    centre = (lo + hi) / 2
+    down = quat_z_to(np.array([0.0, 0.0, -1.0]))
+    across = 0.0 if abs(out[0]) > abs(out[1]) else np.pi / 2
+    turn = (across + np.pi / 2 - long_axis_yaw(drv, obj) + np.pi / 2) % np.pi - np.pi / 2
+    level = _yawed(down, turn)
+    axis = np.cross(np.array([0.0, 0.0, 1.0]), out)  # tipping about it turns 'down' into 'in' (-out)
+    tip = np.array([np.cos(np.pi / 4), *(np.sin(np.pi / 4) * axis)])
+    side = np.zeros(4)
+    mujoco.mju_mulQuat(side, tip, level)
+    # tip over in free space, high in front of the door
+    front_hi = np.array([*(centre[:2] + out[:2] * 0.45), max(drv.site[2], hi[2] + 0.2)])
+    drv.goto(np.array([*drv.site[:2], front_hi[2]]), down, max_steps=150)
+    if not drv.place_base_near(front_hi, side=out, reach_poses=[(front_hi, side)]):
+        return PrimitiveResult(False, drv.steps - s0, f"no base pose in front of {region}'s open door")
+    drv.goto(front_hi, level, max_steps=200)
+    for f in np.linspace(0.25, 1.0, 4):
+        q = np.zeros(4)
+        mujoco.mju_mulQuat(q, np.array([np.cos(f * np.pi / 4), *(np.sin(f * np.pi / 4) * axis)]), level)
+        drv.goto(front_hi, q, max_steps=40)
+    _let_swing_die(drv, obj)
+    olo, ohi = drv.aabb(obj)
+    below = drv.site[2] - olo[2]
+    off = (olo[:2] + ohi[:2]) / 2 - drv.site[:2]  # the object lies ahead of the cup
+    z = floor + below + 0.015
+    inside = np.array([*(centre[:2] - off), z])
+    front = inside + out * (float(np.dot(hi - lo, np.abs(out))) / 2 + 0.2)
+    if not drv.place_base_near(front, side=out, reach_poses=[(front, side), (inside, side)]):
+        return PrimitiveResult(False, drv.steps - s0, f"no base pose that reaches into {region} sideways")
+    drv.goto(np.array([*front[:2], max(drv.site[2], z)]), side, max_steps=250)
+    drv.goto(front, side, max_steps=150)
+    ok = drv.goto(inside, side, max_steps=200, tol=0.02)
+    lower_until_contact(drv, obj, inside - np.array([0, 0, 0.05]), side)
+    if release_after:
+        release(drv)
+        drv.goto(drv.site + out * 0.01, side, max_steps=20)
+        drv.goto(np.array([*front[:2], drv.site[2]]), side, max_steps=150)
+    return PrimitiveResult(ok, drv.steps - s0, f"{obj} {'slid into' if ok else 'not fully into'} {region} "
+                                               "through its door, cup pointing in")
 
 
 def _let_swing_die(drv: Driver, obj: str, max_steps: int = 40) -> None:

@@ -41,9 +41,12 @@ class Chosen:
 
     @property
     def fixed(self) -> bool:
-        return self.size >= FIXED_SIZE or self.catalogue in _ALWAYS_FIXED
+        return (self.size >= FIXED_SIZE or self.catalogue in _ALWAYS_FIXED) and self.catalogue not in _NEVER_FIXED
 
 
+# long but light things a person picks up: a 2 m cable across a walkway is the hazard, and welded in
+# place the robot could never lift it (suction found no free body to hold)
+_NEVER_FIXED = {"power_cable", "extension_cord", "phone_charger"}
 _ALWAYS_FIXED = {
     "Refrigerator",
     "StorageFurniture",
