@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from anomalygen.scene.robot import ARM_JOINTS
-from support.testbed_scene import scene_with_obstacle
+from support.testbed import scene_with_obstacle
 
 DOWN = np.array([0.0, 0.0, -1.0])
 

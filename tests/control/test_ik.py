@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from anomalygen.control.ik import quat_z_to, site_pose, solve_ik
-from anomalygen.rl.testbed import build
 from anomalygen.scene.robot import ARM_JOINTS
+from support.testbed import build
 
 
 @pytest.fixture(scope="module")

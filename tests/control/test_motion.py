@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from anomalygen.scene.robot import ARM_JOINTS
-from support.testbed_scene import scene_with_obstacle
+from support.testbed import scene_with_obstacle
 
 _scene = scene_with_obstacle
 

@@ -46,7 +46,7 @@ def door_driver(q: float = 1.0, *, approach: bool = True):
     from anomalygen.control.driver import Driver
     from anomalygen.rl.sac_subtask import pre_position
     from anomalygen.rl.subtask_env import SubTaskReadout
-    from anomalygen.rl.testbed import build
+    from support.testbed import build
 
     tb = build(with_objects=False, door_open=q)
     drv = Driver(tb.model, tb.data, door_spec(q), rng=np.random.default_rng(0))
@@ -167,8 +167,8 @@ def test_suction_action_grabs_and_releases():
     from anomalygen.control import primitives as P
     from anomalygen.control.driver import Driver
     from anomalygen.rl.subtask_env import MAX_DELTA_POS, MAX_DELTA_ROT
-    from anomalygen.rl.testbed import build
     from anomalygen.scene import robot
+    from support.testbed import build
 
     tb = build(with_cabinet=False)
     drv = Driver(tb.model, tb.data, SceneSpec(scene_id="tb", task_id="t", room="kitchen", seed=0, objects=[]))

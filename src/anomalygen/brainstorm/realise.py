@@ -81,6 +81,20 @@ _EXPLANATION_FRAMES = [
 
 
 FIX_LEAD_P = 0.3
+# How a description orders its opening, scene and harm: the sentences of each layout, and the single
+# sentence a layout becomes when the role's sentence joins it (None: no change). ``{When}`` is drawn
+# from _WHEN; capitalised keys are the capitalised words.
+_LAYOUTS: tuple[tuple[tuple[str, ...], tuple[str, ...] | None], ...] = (
+    (("{opening} {scene}, so {harm}.",), None),
+    (("{Scene}.", "{Harm}."), ("{Scene}; {harm}.",)),
+    (("{Harm}: {scene}.",), None),
+    (("{opening} {scene} and {harm}.",), None),
+    (("Because {scene}, {harm}.",), None),
+    (("{Harm}, since {scene}.",), None),
+    (("{Scene}, which means {harm}.",), None),
+    (("{When} {scene}, {harm}.",), None),
+)
+_WHEN = ["if", "as long as", "while", "now that"]
 
 
 def nice(name: str) -> str:
@@ -329,23 +343,11 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
         view = _choice(rng, views).format(obj=hazard)
         role_sentence = f"{lead} {view}"
 
-    layout = int(rng.integers(8))
-    if layout == 0:
-        body = [f"{opening} {scene}, so {harm}."]
-    elif layout == 1:
-        body = [f"{cap(scene)}.", f"{cap(harm)}."] if not role_sentence else [f"{cap(scene)}; {harm}."]
-    elif layout == 2:
-        body = [f"{cap(harm)}: {scene}."]
-    elif layout == 3:
-        body = [f"{opening} {scene} and {harm}."]
-    elif layout == 4:
-        body = [f"Because {scene}, {harm}."]
-    elif layout == 5:
-        body = [f"{cap(harm)}, since {scene}."]
-    elif layout == 6:
-        body = [f"{cap(scene)}, which means {harm}."]
-    else:
-        body = [f"{cap(_pick(rng, ['if', 'as long as', 'while', 'now that']))} {scene}, {harm}."]
+    plain, with_role = _LAYOUTS[int(rng.integers(len(_LAYOUTS)))]
+    templates = with_role if role_sentence and with_role else plain
+    when = cap(_pick(rng, _WHEN)) if any("{When}" in tpl for tpl in templates) else ""
+    words = {"opening": opening, "scene": scene, "Scene": cap(scene), "harm": harm, "Harm": cap(harm), "When": when}
+    body = [tpl.format(**words) for tpl in templates]
     if role_sentence:
         if rng.random() < 0.5:
             body = [f"{cap(role_sentence)}."] + body
@@ -383,25 +385,18 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
 
 def place_phrase_bank(placement: str, room: str, rng: np.random.Generator) -> str:
     """Where the object is, from the phrase bank (containers/supports name the catalogue object)."""
-    if placement.startswith("inside:"):
-        return _choice(
-            rng,
-            [
-                "inside the {x}",
-                "at the back of the {x}",
-                "tucked into the {x}",
-                "deep in the {x}",
-                "in the {x}",
-            ],
-        ).format(x=nice(placement.split(":", 1)[1]))
-    if placement.startswith("on:"):
-        return _choice(rng, ["on top of the {x}", "on the {x}", "atop the {x}", "perched on the {x}"]).format(
-            x=nice(placement.split(":", 1)[1])
-        )
+    for prefix, options in _HOLDER_PLACES.items():
+        if placement.startswith(prefix):
+            return _choice(rng, options).format(x=nice(placement[len(prefix) :]))
     options = bank()["place"].get(placement, ["in the {room}"])
     if room != "kitchen":  # sinks, hobs and kettles only stand in kitchens
         options = [o for o in options if not any(w in o for w in _KITCHEN_ONLY)] or options
     return _choice(rng, options).format(room=room)
 
 
+# placements in or on another object ("inside:Refrigerator"): the object is {x}
+_HOLDER_PLACES = {
+    "inside:": ["inside the {x}", "at the back of the {x}", "tucked into the {x}", "deep in the {x}", "in the {x}"],
+    "on:": ["on top of the {x}", "on the {x}", "atop the {x}", "perched on the {x}"],
+}
 _KITCHEN_ONLY = ("sink", "hob", "chopping", "kettle", "toaster", "bread bin")

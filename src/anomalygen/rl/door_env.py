@@ -43,10 +43,10 @@ class DoorCloseEnv(gym.Env):
                  near_start: bool = True, start_noise: float = 0.02, terminate_on_success: bool = True):
         import mujoco
 
-        from anomalygen.rl.testbed import build
+        from anomalygen.rl.door_scene import build
 
         self._mj = mujoco
-        tb = build(with_objects=False, door_open=open_range[1])
+        tb = build(door_open=open_range[1])
         self.model, self.data = tb.model, tb.data
         m = self.model
         for name in (f"panda_joint{i}" for i in range(1, 8)):

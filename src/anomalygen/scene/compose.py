@@ -24,7 +24,7 @@ if TYPE_CHECKING:
 LOOSE_SOLREF = 0.005  # s: contact time constant of loose objects (2.5 physics steps)
 
 
-def _look_at_xyaxes(eye, target) -> list[float]:
+def look_at_xyaxes(eye, target) -> list[float]:
     """Camera xyaxes (MuJoCo cameras look along -z) for a camera at ``eye`` looking at ``target``."""
     fwd = np.asarray(target, float) - np.asarray(eye, float)
     fwd /= np.linalg.norm(fwd)
@@ -108,7 +108,7 @@ def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rn
     c, s = math.cos(0.5), math.sin(0.5)
     away = np.array([c * away[0] - s * away[1], s * away[0] + c * away[1]])
     eye = np.r_[focus[:2] + away * (dist + 1.0), 1.9]
-    spec.worldbody.add_camera(name="front", pos=eye.tolist(), xyaxes=_look_at_xyaxes(eye, focus), fovy=60)
+    spec.worldbody.add_camera(name="front", pos=eye.tolist(), xyaxes=look_at_xyaxes(eye, focus), fovy=60)
     top_eye = np.array([focus[0], focus[1] - 0.01, 3.3])
     spec.worldbody.add_camera(name="top", pos=top_eye.tolist(), xyaxes=[0, -1, 0, 1, 0, 0], fovy=55)
 
