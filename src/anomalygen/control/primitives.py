@@ -313,17 +313,27 @@ def place_through_door(drv: Driver, obj: str, region: str, *, release_after: boo
     inside = np.array([centre[0], centre[1], z])
     front = inside + out * (depth / 2 + 0.2)
     drv.goto(np.array([*drv.site[:2], max(drv.site[2], z + 0.1)]), quat, max_steps=150)
-    if not drv.place_base_near(front, side=out, reach_poses=[(front, final), (inside, final)]):
+    ok = _enter_and_set_down(drv, obj, front, inside, final, out, np.array([0, 0, 0.01]), release_after)
+    if ok is None:
         return PrimitiveResult(False, drv.steps - s0, f"no base pose in front of {region}'s open door")
-    drv.goto(np.array([*front[:2], max(drv.site[2], z)]), final, max_steps=250)
-    drv.goto(front, final, max_steps=150)
-    ok = drv.goto(inside, final, max_steps=200, tol=0.02)
-    lower_until_contact(drv, obj, inside - np.array([0, 0, 0.05]), final)
+    return PrimitiveResult(ok, drv.steps - s0, f"{obj} {'slid into' if ok else 'not fully into'} {region} through its door")
+
+
+def _enter_and_set_down(drv: Driver, obj: str, front, inside, quat, out, backoff, release_after: bool) -> bool | None:
+    """Through an opening: base in front of it, the held object carried level from ``front`` to
+    ``inside``, lowered until it touches, let go (``backoff``: the cup's first move off it) and the cup
+    out the way it came. True when the object got all the way in; None when no base pose reaches."""
+    if not drv.place_base_near(front, side=out, reach_poses=[(front, quat), (inside, quat)]):
+        return None
+    drv.goto(np.array([*front[:2], max(drv.site[2], inside[2])]), quat, max_steps=250)
+    drv.goto(front, quat, max_steps=150)
+    ok = drv.goto(inside, quat, max_steps=200, tol=0.02)
+    lower_until_contact(drv, obj, inside - np.array([0, 0, 0.05]), quat)
     if release_after:
         release(drv)
-        drv.goto(drv.site + np.array([0, 0, 0.01]), final, max_steps=20)
-        drv.goto(np.array([*front[:2], drv.site[2]]), final, max_steps=150)
-    return PrimitiveResult(ok, drv.steps - s0, f"{obj} {'slid into' if ok else 'not fully into'} {region} through its door")
+        drv.goto(drv.site + backoff, quat, max_steps=20)
+        drv.goto(np.array([*front[:2], drv.site[2]]), quat, max_steps=150)
+    return ok
 
 
 FACE_DOWN_ROOM = 0.35  # m of headroom over a compartment's floor below which a face-down hand does not fit
@@ -370,16 +380,9 @@ def _place_sideways(drv: Driver, obj: str, region: str, floor: float, *, release
     z = floor + below + 0.015
     inside = np.array([*(centre[:2] - off), z])
     front = inside + out * (float(np.dot(hi - lo, np.abs(out))) / 2 + 0.2)
-    if not drv.place_base_near(front, side=out, reach_poses=[(front, side), (inside, side)]):
+    ok = _enter_and_set_down(drv, obj, front, inside, side, out, out * 0.01, release_after)
+    if ok is None:
         return PrimitiveResult(False, drv.steps - s0, f"no base pose that reaches into {region} sideways")
-    drv.goto(np.array([*front[:2], max(drv.site[2], z)]), side, max_steps=250)
-    drv.goto(front, side, max_steps=150)
-    ok = drv.goto(inside, side, max_steps=200, tol=0.02)
-    lower_until_contact(drv, obj, inside - np.array([0, 0, 0.05]), side)
-    if release_after:
-        release(drv)
-        drv.goto(drv.site + out * 0.01, side, max_steps=20)
-        drv.goto(np.array([*front[:2], drv.site[2]]), side, max_steps=150)
     return PrimitiveResult(ok, drv.steps - s0, f"{obj} {'slid into' if ok else 'not fully into'} {region} "
                                                "through its door, cup pointing in")
 
