@@ -43,7 +43,11 @@ def _class_targets(kb: KnowledgeBase, hc: HazardClass) -> list[str]:
     for name in [*kb.hazard_candidates(hc), *hc.default_containers, *hc.default_supports]:
         if name in targets and name not in out:
             out.append(name)
-    return out
+    # a class whose preconditions name the target's category (the microwave metal is left in) is built
+    # around that category only: a table as the target of such a scene cannot be built
+    pinned = {c for call in hc.preconditions if call.name == "category_is" and not call.negate
+              and call.args.get("object") == "$target" for c in str(call.args.get("category", "")).split("|")}
+    return [t for t in out if t in pinned] or out if pinned else out
 
 
 def classes_for_target(kb: KnowledgeBase, target: str) -> list[HazardClass]:

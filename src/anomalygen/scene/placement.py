@@ -105,7 +105,10 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
                 continue
             except ItemFailed:
                 pass
-        lay.place_beside(p, room_fixtures(sel.kb, lay))
+        if ch.role in (ObjectRole.CONTAINER, ObjectRole.SUPPORT):
+            lay.place_on_floor(p, relevant=True, face=True)  # the arm must reach into it from any side
+        else:  # an ordinary object on the open floor would be a tripping hazard the scene never meant
+            lay.place_beside(p, room_fixtures(sel.kb, lay))
 
     # Clutter on the side table, away from its edges; an item that does not fit is left out.
     if side is not None:
@@ -128,8 +131,24 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
     place_judgement_items(sel, lay, placed, [s for s in (side, support) if s is not None], items)
 
     focus = placed[hazard.name]
-    lay.fit_base(focus, holder=placed.get(focus.inside) if focus.inside else None)
+    holder = placed.get(focus.inside) if focus.inside else None
+    try:
+        lay.fit_base(focus, holder=holder)
+    except ItemFailed:
+        if holder is None or holder.support == "floor" or holder.support_geom is not None:
+            raise
+        _floor_the_holder(lay, holder, focus)  # a deep counter put the appliance out of reach
+        lay.fit_base(focus, holder=holder)
     return lay, placed, support
+
+
+def _floor_the_holder(lay: Layout, holder: Placed, inside: Placed) -> None:
+    """Stand an appliance that sits on a support on the floor instead, with what is inside it: on a
+    deep counter the arm cannot reach past the counter's edge into it (welded, it stays put)."""
+    lay.items = [p for p in lay.items if p is not holder and p is not inside]
+    lay.place_on_floor(holder, relevant=True, face=True)
+    lo, hi, _ = cavity_world(holder)
+    lay.place_in_cavity(inside, holder, (lo, hi))
 
 
 def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None,
@@ -180,7 +199,7 @@ def _stand_parent(sel: Selection, lay: Layout, placed: dict[str, Placed], ppl: P
     if holder is not None and _on_a_support(sel):
         ppl.fixed = True
         for _ in range(FACING_TRIES):  # the surface draws a random yaw: keep one whose door faces the robot
-            lay.place_on_surface(ppl, holder, surface_of(holder), inward=INWARD)
+            lay.place_on_surface(ppl, holder, surface_of(holder), inward=INWARD, near_side=HAZARD_NEAR_SIDE)
             if ppl.front is None:
                 return
             c, s_ = np.cos(ppl.yaw), np.sin(ppl.yaw)
