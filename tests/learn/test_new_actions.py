@@ -22,7 +22,7 @@ def make_task(task_id, hazard_class, target, hazard, placement, *, room):
 TASKS = {
     "push": make_task("t-push", "push_heavy_item_out_of_walkway", "Table", "dumbbell", "walkway", room="living_room"),
     "lid": make_task("t-lid", "close_open_portable_container", "Box", "Box", "floor", room="bedroom"),
-    "micro": make_task("t-micro-b", "remove_item_from_appliance", "Microwave", "fork", "inside:Microwave", room="kitchen"),
+    "micro": make_task("t-micro-c", "remove_item_from_appliance", "Microwave", "fork", "inside:Microwave", room="kitchen"),
     "desk": make_task("t-desk", "pick_item_off_floor_onto_desk", "Table", "Phone", "floor", room="office"),
 }
 

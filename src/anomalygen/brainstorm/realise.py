@@ -47,7 +47,7 @@ _ROOM_WORDS = {"living_room": "living room", "laundry_room": "laundry room"}
 
 _VERBS = {
     "dispose_spoiled_food": ["Throw out", "Bin", "Dispose of", "Get rid of", "Discard"],
-    "store_perishable_food": ["Refrigerate", "Chill", "Put back in the fridge", "Cool down"],
+    "store_perishable_food": ["Refrigerate", "Chill", "Put away", "Cool down"],
     "pick_up_floor_litter": ["Pick up", "Clear", "Bin", "Collect"],
     "reduce_tripping_hazards": ["Clear", "Tidy away", "Pick up", "Move"],
     "clear_cable_from_walkway": ["Clear", "Lift", "Reroute", "Move"],

@@ -199,7 +199,7 @@ def _stand_parent(sel: Selection, lay: Layout, placed: dict[str, Placed], ppl: P
     if holder is not None and _on_a_support(sel):
         ppl.fixed = True
         for _ in range(FACING_TRIES):  # the surface draws a random yaw: keep one whose door faces the robot
-            lay.place_on_surface(ppl, holder, surface_of(holder), inward=INWARD, near_side=HAZARD_NEAR_SIDE)
+            lay.place_on_surface(ppl, holder, surface_of(holder), inward=INWARD)
             if ppl.front is None:
                 return
             c, s_ = np.cos(ppl.yaw), np.sin(ppl.yaw)
