@@ -44,10 +44,26 @@ def _copy_run(src: Path, dst: Path) -> None:
     shutil.copytree(src, dst, copy_function=link, ignore=shutil.ignore_patterns("plans", "skills", "report"))
 
 
-def main() -> int:
+def _detection_scores(folder: Path, ids: set[str] | None = None):
+    """The run's detections scored against truth.json (only the tasks in ``ids`` when given)."""
     from anomalygen.detect.score import score_detections
-    from anomalygen.evaluate.hazard_table import hazard_table, markdown
     from anomalygen.evaluate.run_metrics import load_detections, load_manifests
+    from anomalygen.runfolder import RunFolder
+
+    run = RunFolder(folder)
+    tasks = [t for t in run.load_tasks() if ids is None or t.id in ids]
+    dets = [d for d in load_detections(run) if ids is None or d.task_id in ids]
+    return score_detections(dets, load_manifests(run, tasks), 3)
+
+
+def _summary(sc) -> dict:
+    return {"recall": sc.recall, "precision": sc.precision, "f1": sc.f1, "false_alarm_rate": sc.false_alarm_rate,
+            "hit_at_1_single": sc.hit_at_k.get(1), "hazards": sc.hazards, "scenes": sc.scenes,
+            "hazard_free": sc.hazard_free_scenes}
+
+
+def main() -> int:
+    from anomalygen.evaluate.hazard_table import hazard_table, markdown
     from anomalygen.runfolder import RunFolder
 
     ap = argparse.ArgumentParser()
@@ -70,15 +86,10 @@ def main() -> int:
     t_detect = time.perf_counter()
     _copy_run(base, root / "oracle")
     out: dict = {"name": "loop", "n": a.n, "seed": a.seed, "seeds": a.seeds}
-    run = RunFolder(base)
-    tasks = run.load_tasks()
-    ids = [t.id for t in tasks]
-    manifests = load_manifests(run, tasks)
-    scores = score_detections(load_detections(run), manifests, 3)
+    ids = [t.id for t in RunFolder(base).load_tasks()]
+    scores = _detection_scores(base)
     print(f"detection (rules) against truth.json: {scores.model_dump_json()}")
-    out["detection"] = {"recall": scores.recall, "precision": scores.precision, "f1": scores.f1,
-                        "false_alarm_rate": scores.false_alarm_rate, "hit_at_1_single": scores.hit_at_k.get(1),
-                        "hazards": scores.hazards, "scenes": scores.scenes, "hazard_free": scores.hazard_free_scenes}
+    out["detection"] = _summary(scores)
     if a.compare_detectors:
         out["detectors"] = _compare_detectors(root, base, ids, a.compare_detectors, env)
     for mode, folder in (() if a.skip_learn else (("detected", base), ("ground_truth", root / "oracle"))):
@@ -102,10 +113,6 @@ def main() -> int:
 
 def _compare_detectors(root: Path, base: Path, ids: list[str], n: int, env: dict) -> dict:
     """Rules, LLM and hybrid detection scored against truth.json on the same first ``n`` built scenes."""
-    from anomalygen.detect.score import score_detections
-    from anomalygen.evaluate.run_metrics import load_detections, load_manifests
-    from anomalygen.runfolder import RunFolder
-
     built = [t for t in ids if (base / "scenes" / t / "scene.xml").exists()][:n]
     only = [x for t in built for x in ("--only", t)]
     res = {}
@@ -116,14 +123,7 @@ def _compare_detectors(root: Path, base: Path, ids: list[str], n: int, env: dict
         (folder / "detections.jsonl").unlink(missing_ok=True)
         t = time.perf_counter()
         _cli("detect", "--run", str(folder), "--detector", det, "--force", *only, env=env)
-        run = RunFolder(folder)
-        wanted = set(built)
-        dets = [d for d in load_detections(run) if d.task_id in wanted]
-        manifests = load_manifests(run, [x for x in run.load_tasks() if x.id in wanted])
-        sc = score_detections(dets, manifests, 3)
-        res[det] = {"scenes": sc.scenes, "recall": sc.recall, "precision": sc.precision, "f1": sc.f1,
-                    "false_alarm_rate": sc.false_alarm_rate, "hit_at_1_single": sc.hit_at_k.get(1),
-                    "wall_s": round(time.perf_counter() - t, 1)}
+        res[det] = {**_summary(_detection_scores(folder, set(built))), "wall_s": round(time.perf_counter() - t, 1)}
         print(f"detector {det} on {len(built)} scenes: {json.dumps(res[det])}")
     return res
 

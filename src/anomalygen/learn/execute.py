@@ -211,11 +211,10 @@ def _look_again(drv, before, plan: Plan, max_fixes: int, run_steps) -> list[SubT
     found = new_hazards(before, after, kb)
     if not found:
         return []
-    repair, problems = repair_plan(plan.task_id, found, after, spec_as_it_stands(drv.spec, drv.data), kb,
+    repair, problems = repair_plan(plan.task_id, found, after, spec_as_it_stands(drv.spec, after), kb,
                                    max_fixes=max_fixes)
     out = [SubTaskResult(id=f"recheck_{cls}", method=SkillMethod.PRIMITIVE, success=False,
-                         detail=f"seen after the plan, cannot fix: {why}")
-           for why, cls in ((p, p.split(" on ")[0]) for p in problems)]
+                         detail=f"seen after the plan, cannot fix: {why}") for cls, why in problems]
     return (run_steps(repair.subtasks, repair) if repair is not None else []) + out
 
 

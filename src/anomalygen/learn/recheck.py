@@ -33,19 +33,17 @@ def new_hazards(before: SceneGraph, after: SceneGraph, kb) -> list[tuple[str, st
     return out
 
 
-def spec_as_it_stands(spec: SceneSpec, data) -> SceneSpec:
-    """The perceived spec with every joint value read from the live simulation: the planner picks
+def spec_as_it_stands(spec: SceneSpec, graph: SceneGraph) -> SceneSpec:
+    """The perceived spec with the joint states of the scene graph just read: the planner picks
     which knob to turn or door to shut from joint states, and the scene file holds the start."""
-    objects = []
-    for o in spec.objects:
-        states = [js.model_copy(update={"value": float(data.joint(js.name).qpos[0])}) for js in o.joint_states]
-        objects.append(o.model_copy(update={"joint_states": states}))
+    live = {o.name: o.joints for o in graph.objects}
+    objects = [o.model_copy(update={"joint_states": live[o.name]}) if o.name in live else o for o in spec.objects]
     return spec.model_copy(update={"objects": objects})
 
 
 def repair_plan(task_id: str, found: list[tuple[str, str]], graph: SceneGraph, spec: SceneSpec, kb, *,
-                max_fixes: int, sac_actions=()) -> tuple[Plan | None, list[str]]:
-    """One plan fixing the new hazards (at most ``max_fixes``); the problems of those it cannot plan."""
+                max_fixes: int, sac_actions=()) -> tuple[Plan | None, list[tuple[str, str]]]:
+    """One plan fixing the new hazards (at most ``max_fixes``); (class, problem) for those it cannot plan."""
     from anomalygen.plan.bind import bind_fix
     from anomalygen.plan.planner import merge_plans, plan_from_kb
 
@@ -56,7 +54,7 @@ def repair_plan(task_id: str, found: list[tuple[str, str]], graph: SceneGraph, s
             bindings = bind_fix(hc, obj, graph, kb)
             plans.append(plan_from_kb(task_id, cls, bindings, spec=spec, source="detected", sac_actions=sac_actions))
         except ItemFailed as exc:
-            problems.append(f"{cls} on {obj}: {exc}")
+            problems.append((cls, f"{cls} on {obj}: {exc}"))
     if not plans:
         return None, problems
     merged = merge_plans(plans)  # run with this plan: its bindings resolve a single fix's variables

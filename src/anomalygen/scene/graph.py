@@ -20,7 +20,6 @@ import numpy as np
 
 from anomalygen.schema import (
     CHILD_REACH,
-    ENCLOSING_LABELS,
     GraphObject,
     JointState,
     Relation,
@@ -123,7 +122,7 @@ def _joint_states(model, data, obj, jids) -> list[JointState]:
 
 def _is_closed_enclosure(joints: list[JointState]) -> bool:
     """True when every door/drawer/lid of the object is (nearly) closed; False if it has none."""
-    enclosing = [j for j in joints if any(lbl in j.label for lbl in ENCLOSING_LABELS)]
+    enclosing = [j for j in joints if j.encloses]
     return bool(enclosing) and all(j.is_closed(ENCLOSED_TOL) for j in enclosing)
 
 

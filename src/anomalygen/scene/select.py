@@ -220,17 +220,23 @@ def pick_asset(
     return candidates[0]
 
 
+def far_end(joint) -> float:
+    """The end of the joint's range away from its closed value (fully open, fully on)."""
+    lo, hi = joint.range
+    closed = joint.closed_value
+    return hi if abs(hi - closed) >= abs(lo - closed) else lo
+
+
 def open_value(joint, state: str, rng: np.random.Generator) -> float:
     """A joint value for a part state: closed/off at the safe value, open/on far enough to be real.
 
     Hinged doors open at least ~50 degrees (the issue's "fridge door open >= 45 deg"), drawers and
     sliding sashes 60-90 % of their travel, knobs and switches to 70-100 % of their range.
     """
-    lo, hi = joint.range
     closed = joint.closed_value
     if state in ("closed", "off"):
         return float(closed)
-    far = hi if abs(hi - closed) >= abs(lo - closed) else lo
+    far = far_end(joint)
     span = abs(far - closed)
     sign = 1.0 if far >= closed else -1.0
     if state == "on" or joint.label in ("knob", "switch", "button"):

@@ -194,10 +194,8 @@ def _open_as_the_fix_would(chosen: select.Chosen, label: str, hc) -> None:
         return
     fraction = float(step.args["fraction"])
     for joint in select.joints_with_label(chosen.asset, label):
-        lo, hi = joint.range
         closed = joint.closed_value
-        far = hi if abs(hi - closed) >= abs(lo - closed) else lo
-        chosen.joint_values[joint.name] = float(closed + fraction * (far - closed))
+        chosen.joint_values[joint.name] = float(closed + fraction * (select.far_end(joint) - closed))
 
 
 def _roomier_kind(sel: Selection, hc, container, name: str, size: float):

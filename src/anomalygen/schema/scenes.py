@@ -55,6 +55,11 @@ class JointState(Artefact):
         span = abs(far - self.closed_value)
         return 0.0 if span == 0 else min(1.0, abs(value - self.closed_value) / span)
 
+    @property
+    def encloses(self) -> bool:
+        """A door, drawer or lid: shut, what is behind it is out of reach."""
+        return any(lbl in self.label for lbl in ENCLOSING_LABELS)
+
     def is_closed(self, tol: float = CLOSED_TOL, value: float | None = None) -> bool:
         """At most ``tol`` of its travel away from closed (at ``value`` if given, else its own)."""
         return self.open_fraction_at(self.value if value is None else value) <= tol
