@@ -40,9 +40,8 @@ TASKS = [
 
 
 def task_lines() -> list[str]:
-    from anomalygen.schema import TaskProposal
-
     from anomalygen.knowledge import load_kb
+    from anomalygen.schema import TaskProposal
 
     kb = load_kb()
     out = []

@@ -20,6 +20,7 @@ import tempfile
 import time
 from pathlib import Path
 
+
 def _cli(*args: str, env=None) -> None:
     exe = Path(sys.executable).with_name("anomalygen")
     subprocess.run([str(exe), *args, "--quiet"], check=True, env=env)

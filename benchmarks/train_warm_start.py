@@ -46,6 +46,7 @@ def make_run(run: Path, seed: int, n: int = 300) -> None:
 
 def starts_of(run: Path, log=lambda m: print(m, file=sys.stderr)) -> list:
     """One PartStart per knob/switch that is on, in every switch-off scene of the run folder."""
+    import mujoco
     import numpy as np
 
     from anomalygen.control.driver import Driver
@@ -57,8 +58,6 @@ def starts_of(run: Path, log=lambda m: print(m, file=sys.stderr)) -> list:
     from anomalygen.runfolder import read_model
     from anomalygen.scene.graph import load_scene
     from anomalygen.schema import SceneSpec
-
-    import mujoco
 
     tasks = {json.loads(x)["id"]: json.loads(x) for x in (run / "tasks.jsonl").read_text().splitlines() if x.strip()}
     out = []
@@ -101,7 +100,7 @@ def demonstrations(starts, episodes: int, seed: int) -> dict:
         while not done:
             a = reference_action(obs)
             nxt, r, term, trunc, info = env.step(a)
-            for key, v in zip(cols, (obs, nxt, a, r, term)):
+            for key, v in zip(cols, (obs, nxt, a, r, term), strict=True):
                 cols[key].append(v)
             obs, done = nxt, term or trunc
         wins += bool(info.get("is_success"))

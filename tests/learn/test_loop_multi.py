@@ -45,8 +45,8 @@ def test_two_hazards_are_both_found_planned_and_judged(tmp_path):
     # the referee's verdict is the physical state: each hazard resolved exactly when its class no
     # longer holds in the final scene graph the executor wrote
     from anomalygen.knowledge import load_kb
-    from anomalygen.schema import SceneGraph
     from anomalygen.scene.truth import class_matches
+    from anomalygen.schema import SceneGraph
 
     final = read_model(run.skill_dir("m", 0) / "final_graph.json", SceneGraph)
     still = {(c, o) for c, o, _ in class_matches(final, load_kb())}

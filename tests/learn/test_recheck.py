@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+from tests.knowledge.graphs import furniture, graph, joint, obj
+
 from anomalygen.knowledge import load_kb
 from anomalygen.learn.recheck import new_hazards, repair_plan
-from tests.knowledge.graphs import furniture, graph, joint, obj
 
 
 def _scene(door: float, knife_on_floor: bool):

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+from tests.knowledge.graphs import furniture, graph, joint, obj
+
 from anomalygen.knowledge import load_kb
 from anomalygen.plan.bind import choose_container, ends_hazard
-from tests.knowledge.graphs import furniture, graph, joint, obj
 
 
 def _scene():

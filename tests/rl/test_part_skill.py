@@ -51,7 +51,7 @@ def _held_start(scene_dir, plan, k: int = 0):
 def test_planner_hands_the_knob_to_sac(built):
     from anomalygen.schema import SkillMethod
 
-    for _, spec, plan in built.values():
+    for _, _spec, plan in built.values():
         assert plan.subtasks and all(st.method == SkillMethod.SAC for st in plan.subtasks)
         assert all(st.params["family"] == "switch_off" for st in plan.subtasks)
 

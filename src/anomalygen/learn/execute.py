@@ -298,7 +298,7 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
     final = _evaluate(plan.success.predicates, model, data, spec, plan.bindings)
     if final_graph_path is not None:
         from anomalygen.runfolder import write_model
-        
+
         write_model(Path(final_graph_path), scene_graph(model, data, spec))
     timings["execute_s"] = round(time.perf_counter() - t0 - timings["load_s"], 3)
     timings["control_steps"] = float(drv.steps)

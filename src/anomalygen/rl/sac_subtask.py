@@ -140,10 +140,9 @@ def run_sac_subtask(drv, st: SubTask, plan: Plan, *, steps: int, seed: int, thre
     ``result.steps`` counts the Driver's control steps (pre-positioning plus the rollout); the
     detail says the training budget, best evaluation success and what the rollout did.
     """
+    from anomalygen.rl.part_subtask import is_switch_off, run_part_subtask
     from anomalygen.rl.sac import train_sac
     from anomalygen.rl.subtask_env import FRAMESKIP, HORIZON, SubTaskEnv, SubTaskReadout, control_step
-
-    from anomalygen.rl.part_subtask import is_switch_off, run_part_subtask
 
     if reward_mode == "spec" and is_switch_off(drv, st):
         # the family with a shipped warm start and a scene-independent observation (rl/part_subtask.py)
