@@ -42,6 +42,9 @@ class LLMConfig(Section):
     price_completion_per_mtok: float | None = Field(None, ge=0)
     vision: bool = Field(False, description="the endpoint accepts images (scene verification)")
     n_ctx: int = Field(4096, ge=256, description="llamacpp context size")
+    threads: int | None = Field(
+        None, ge=1, description="llamacpp CPU threads; default: the cores this process may use, less one, 1 to 4"
+    )
 
     @property
     def configured(self) -> bool:

@@ -12,7 +12,6 @@ from anomalygen.schema import TaskProposal
 
 @pytest.mark.slow
 @pytest.mark.gguf
-@pytest.mark.timeout(1800)  # the tiny model's repair round ran past 900 s on the 2-core machine (2026-11-25)
 def test_llamacpp_cli_ask_returns_schema_valid_task_proposal(tmp_path, monkeypatch):
     from anomalygen.llm.backends.llamacpp_backend import bundled_model_path
     from anomalygen.llm.cli import app

@@ -105,3 +105,18 @@ def test_every_artefact_schema_converts_to_a_llama_grammar(name):
     schema = bounded_schema(ARTEFACTS[name], max_string=80, max_items=2, required_only=False)
     grammar = xllamacpp.json_schema_to_grammar(schema)
     assert grammar.strip() and "properties" in grammar
+
+
+def test_llamacpp_threads_leave_a_core_to_the_rest_of_the_pipeline(monkeypatch):
+    """Two llama.cpp threads beside a busy simulator on two cores ran the GGUF tests ~5x slower than one."""
+    import os
+
+    from anomalygen.config import LLMConfig
+    from anomalygen.llm.local_server import LocalServer, default_threads
+
+    for cores, want in ((1, 1), (2, 1), (3, 2), (8, 4)):
+        monkeypatch.setattr(os, "sched_getaffinity", lambda _pid, n=cores: set(range(n)), raising=False)
+        assert default_threads() == want
+        assert LocalServer("m.gguf", n_ctx=256).threads == want
+    assert LocalServer("m.gguf", n_ctx=256, threads=3).threads == 3
+    assert LLMConfig(backend="llamacpp", threads=2).threads == 2

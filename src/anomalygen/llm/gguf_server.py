@@ -27,7 +27,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", required=True, help="GGUF file to serve")
     parser.add_argument("--n-ctx", type=int, default=4096, help="context size in tokens")
-    parser.add_argument("--threads", type=int, default=min(4, os.cpu_count() or 1))
+    parser.add_argument("--threads", type=int, default=None, help="default: the cores usable, less one, 1 to 4")
     parser.add_argument("--port", type=int, default=0, help="0: any free port (the address is printed)")
     return parser.parse_args(argv)
 
@@ -36,12 +36,15 @@ def serve(args: argparse.Namespace):
     """Load the model and start listening on 127.0.0.1; returns the running ``xllamacpp.Server``."""
     import xllamacpp
 
+    from anomalygen.llm.local_server import default_threads
+
     params = xllamacpp.CommonParams()
     params.model.path = args.model
     params.n_ctx = args.n_ctx
     params.n_parallel = 1  # one slot: the whole context serves the request in flight
-    params.cpuparams.n_threads = args.threads
-    params.cpuparams_batch.n_threads = args.threads
+    threads = args.threads or default_threads()
+    params.cpuparams.n_threads = threads
+    params.cpuparams_batch.n_threads = threads
     params.hostnames = ["127.0.0.1"]  # never reachable from outside this machine
     params.port = args.port
     params.ui = False

@@ -39,13 +39,27 @@ def describe_exit(returncode: int | None) -> str:
     return f"exited with code {returncode}"
 
 
+def default_threads() -> int:
+    """The cores this process may use, less one (the pipeline and the simulator keep a core), 1 to 4.
+
+    Why not every core: llama.cpp's worker threads wait for each other in spin barriers, so one
+    thread pre-empted by another busy process stalls them all. On a 2-core machine beside a second
+    busy process, two threads ran the tiny model's test requests many times slower than one.
+    """
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):  # not Linux
+        cores = os.cpu_count() or 1
+    return max(1, min(4, cores - 1))
+
+
 class LocalServer:
     """One ``gguf_server`` child process serving ``model`` on 127.0.0.1."""
 
     def __init__(self, model: Path, *, n_ctx: int, threads: int | None = None):
         self.model = Path(model)
         self.n_ctx = n_ctx
-        self.threads = threads or min(4, os.cpu_count() or 1)
+        self.threads = threads or default_threads()
         self.address: str | None = None
         self.starts = 0
         self._proc: subprocess.Popen | None = None

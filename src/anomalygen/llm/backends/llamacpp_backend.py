@@ -28,7 +28,7 @@ BUNDLED_FILE = "SmolLM2-135M-Instruct.Q4_1.gguf"
 MAX_CRASHES_WITHOUT_REPLY = 2  # crash, restart, crash again: stop restarting
 LOCAL_TIMEOUT_S = 300.0  # floor for one local request (a 1.5B model writes 12-16 tokens/s on 2 cores)
 
-_SERVERS: dict[tuple[str, int], LocalServer] = {}
+_SERVERS: dict[tuple[str, int, int | None], LocalServer] = {}
 _SERVERS_LOCK = threading.Lock()
 
 
@@ -47,12 +47,12 @@ def bundled_model_path() -> Path:
     raise UserError(f"package {BUNDLED_PACKAGE} holds no .gguf file")
 
 
-def local_server(path: Path, n_ctx: int) -> LocalServer:
+def local_server(path: Path, n_ctx: int, threads: int | None = None) -> LocalServer:
     """The process-wide server for ``path`` (one model load per process, shared by all clients)."""
-    key = (str(path.resolve()), n_ctx)
+    key = (str(path.resolve()), n_ctx, threads)
     with _SERVERS_LOCK:
         if key not in _SERVERS:
-            _SERVERS[key] = LocalServer(Path(key[0]), n_ctx=n_ctx)
+            _SERVERS[key] = LocalServer(Path(key[0]), n_ctx=n_ctx, threads=threads)
         return _SERVERS[key]
 
 
@@ -73,7 +73,7 @@ class LlamaCppBackend:
         self.path = path
         self.model = path.name
         self.config = config
-        self.server = local_server(path, config.n_ctx)
+        self.server = local_server(path, config.n_ctx, config.threads)
         self._http = None
         self._http_address: str | None = None
         self._crashes_without_reply = 0
