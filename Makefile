@@ -48,7 +48,7 @@ demo: $(STAMP)
 	$(VENV)/bin/anomalygen run --out $(DEMO_OUT)
 
 test: $(STAMP) system-deps
-	$(PY) -m pytest -n 2 --dist loadgroup --timeout 900
+	$(PY) -m pytest -n 2 --dist loadgroup --timeout 900 --durations 25
 
 # Headless Chromium for the report screenshot test (Debian package 'chromium'). Outside CI a machine
 # without apt/root only skips that test; in CI (CI set) a missing browser is an error.
