@@ -126,6 +126,15 @@ def test_refrigerator_has_freezer_and_a_fridge_cavity_closed_by_a_door():
             )
 
 
+def test_counter_of_a_requested_size_keeps_counter_height():
+    # a 2.3 m counter is longer, not taller: scaled uniformly it stood 1.46 m high, out of the arm's reach
+    for size in (1.0, 1.8, 2.3):
+        c = generate("counter", 418056419, size=size)
+        assert c.size == pytest.approx(size, abs=1e-3)
+        assert 0.85 < c.surfaces[0].center[2] < 0.93 and c.aabb[1][2] < 0.93
+        assert c.aabb[1][1] - c.aabb[0][1] < 0.7  # about 0.6 m deep
+
+
 def test_furniture_surfaces_and_cavities():
     counter = generate("counter", 0)
     top = counter.surfaces[0]

@@ -8,8 +8,11 @@ generators and importers and is the only one that loads them.
 
 from __future__ import annotations
 
+import inspect
+
 from anomalygen.assets.finalize import finalize
 from anomalygen.assets.model import Asset
+from anomalygen.assets.names import size_range
 from anomalygen.assets.registry import GENERATORS
 from anomalygen.schema import AssetRef, AssetSource
 
@@ -26,7 +29,14 @@ def generate(name: str, seed: int, size: float | None = None) -> Asset:
     if name not in GENERATORS:
         raise KeyError(f"no generator for {name!r}; known: {', '.join(sorted(GENERATORS))}")
     rng = item_rng(seed, "asset", name)
-    draft = GENERATORS[name](rng)
+    gen = GENERATORS[name]
+    if size is not None and "size" in inspect.signature(gen).parameters:
+        # a generator that builds to the requested size itself (a counter grows in length, not in
+        # height: scaled uniformly, a 2.3 m counter stood 1.46 m tall, beyond the arm's reach)
+        lo, hi = size_range(name)
+        draft = gen(rng, size=float(min(hi, max(lo, size))))
+    else:
+        draft = gen(rng)
     asset = finalize(draft, name=name, seed=seed, size=size, rng=rng)
     if size is not None:
         asset.params["requested_size"] = size

@@ -49,6 +49,9 @@ class Driver:
         self.steps = 0
         self.opened: dict[str, list[str]] = {}  # container -> joints opened to put something in
         self.compartments: dict[str, tuple] = {}  # container -> (lo, hi, outward normal) behind its opened door
+        # object -> (support, x/y offset of where it came to rest from the spot aimed at): a set-down
+        # that is tried again aims that much the other way
+        self.set_down_error: dict[str, tuple[str, np.ndarray]] = {}
         # container -> its root body's position when the compartment was measured: a light safe on the
         # floor slides while its door is pulled, and the compartment moves with it
         self.compartment_anchor: dict[str, np.ndarray] = {}

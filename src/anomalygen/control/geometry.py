@@ -163,19 +163,23 @@ def free_spot(drv: Driver, support: str, obj: str, *, edge_margin: float = 0.2, 
             continue
         blo, bhi = drv.aabb(o.name)
         if bhi[2] > hi[2] - 0.01 and blo[2] < hi[2] + 0.3:
-            others.append((blo[:2] - 0.03, bhi[:2] + 0.03))
+            others.append((blo[:2], bhi[:2]))
     centre = (lo[:2] + hi[:2]) / 2
     inset = np.minimum(half + 0.02, (hi[:2] - lo[:2]) / 2)
     best, best_score = centre, np.inf
-    # Score a 31 x 31 grid (a 4 cm step can miss the one clear spot on a crowded table): landing on something else costs most, then ending within NEAR_EDGE of an
-    # edge (the hazard itself), then falling short of the wider margin, then distance from the centre.
+    # Score a 31 x 31 grid (a 4 cm step can miss the one clear spot on a crowded table): landing on
+    # something else (nearer it than HIT_GAP) costs most, then ending within NEAR_EDGE of an edge
+    # (the hazard itself), then standing closer than CLEAR_GAP to something (on a crowded counter the
+    # one spot clear of the edges may be 1-2 cm beside a tissue box), then falling short of the wider
+    # margin, then distance from the centre.
     for x in np.linspace(lo[0] + inset[0], hi[0] - inset[0], 31):
         for y in np.linspace(lo[1] + inset[1], hi[1] - inset[1], 31):
             p = np.array([x, y])
-            hits = sum(bool(np.all(p + half > a) and np.all(p - half < b)) for a, b in others)
+            hits = sum(bool(np.all(p + half > a - HIT_GAP) and np.all(p - half < b + HIT_GAP)) for a, b in others)
+            close = sum(bool(np.all(p + half > a - CLEAR_GAP) and np.all(p - half < b + CLEAR_GAP)) for a, b in others)
             edge = float(np.min(np.minimum(p - half - lo[:2], hi[:2] - p - half)))
-            score = (hits * 10.0 + 20.0 * max(0.0, NEAR_EDGE + 0.02 - edge) + 5.0 * max(0.0, edge_margin - edge)
-                     + 0.1 * float(np.linalg.norm(p - centre)))
+            score = (hits * 10.0 + 20.0 * max(0.0, NEAR_EDGE + 0.02 - edge) + 0.3 * close
+                     + 5.0 * max(0.0, edge_margin - edge) + 0.1 * float(np.linalg.norm(p - centre)))
             if score < best_score:
                 best, best_score = p, score
     return np.array([best[0], best[1], hi[2] - 0.01])  # set down until it touches: a dropped globe topples
@@ -231,6 +235,8 @@ def footprint(drv: Driver, obj: str) -> tuple[float, float, float]:
     return (float(np.arctan2(major[1], major[0])), float(np.ptp(along)) / 2, float(np.ptp(across)) / 2)
 
 
+HIT_GAP = 0.01  # m: a set-down spot nearer another object's box than this counts as landing on it
+CLEAR_GAP = 0.03  # m kept from other objects where the top leaves room
 NEAR_EDGE = 0.15  # m: the knowledge base's near_edge distance for fragile things (move_fragile_from_edge)
 
 

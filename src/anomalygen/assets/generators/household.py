@@ -912,9 +912,13 @@ def shelf(rng):
 
 
 @register("counter")
-def counter(rng):
+def counter(rng, size=None):
+    """A worktop on a cabinet. Asked for a ``size`` (its largest dimension), it is built that long and
+    keeps a counter's height and depth: a kitchen counter is 0.86-0.92 m high however long it is."""
     r = Part("root")
     hx, hy, h = u(rng, 0.5, 1.0), u(rng, 0.28, 0.32), u(rng, 0.86, 0.92)
+    if size is not None:
+        hx = max(hy, h / 2, size / 2 - 0.01)  # the top overhangs the cabinet by 0.01 m
     body = colour(rng, WOOD + [WHITE, (0.3, 0.35, 0.45, 1)])
     top = colour(rng, [(0.85, 0.84, 0.8, 1), (0.2, 0.2, 0.22, 1), WOOD[3]])
     r.box((hx, hy - 0.02, h / 2 - 0.02), (0, 0.02, h / 2 - 0.02), body, 300)
