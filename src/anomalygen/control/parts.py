@@ -84,6 +84,9 @@ def _object_root(m, body: int) -> int:
     return body
 
 
+EDGE_FACE = 0.05  # m: a face narrower than this is an edge the cup cannot seal on
+
+
 def grasp_candidates(drv, joint: str, closed: float) -> list[PartGrasp]:
     """The outer and the inner face of the part, with a grasp point each (outer first)."""
     m, d = drv.model, drv.data
@@ -98,8 +101,18 @@ def grasp_candidates(drv, joint: str, closed: float) -> list[PartGrasp]:
     axis_w = d.xaxis[j] / np.linalg.norm(d.xaxis[j])
     axis_l = rb.T @ axis_w
     size = hi - lo
+    panel = False
     if m.jnt_type[j] == SLIDE:
         k = int(np.argmax(np.abs(axis_l)))  # the face across the slide direction: the drawer front
+        # A sliding sash (or a sliding door) moves in its own plane: the face across the slide is a
+        # 3 cm edge, and a cup on that edge leaves the arm beside the pane, where backing off drags
+        # the sash along and going home shoves it shut again. Such a panel is held by its broad face
+        # from the room side and slid sideways.
+        edge = sorted(size[i] for i in range(3) if i != k)
+        thin = int(np.argmin(size))
+        upright = abs(rb[2, thin]) < 0.3 and abs(axis_w[2]) < 0.3  # a standing pane sliding sideways
+        if edge[0] < EDGE_FACE and thin != k and upright:
+            k, panel = thin, True
     else:
         # thinnest box axis that is not the hinge axis: across the panel
         cands = [i for i in range(3) if abs(axis_l[i]) < 0.7]
@@ -132,7 +145,7 @@ def grasp_candidates(drv, joint: str, closed: float) -> list[PartGrasp]:
         p_w = d.xpos[body] + rb @ p_l
         n_w = rb @ n_l
         p_c, n_c = rc @ p_w + tc, rc @ n_w
-        if m.jnt_type[j] == SLIDE:  # a drawer's front faces the way it slides out
+        if m.jnt_type[j] == SLIDE and not panel:  # a drawer's front faces the way it slides out
             lo_r, hi_r = m.jnt_range[j]
             far = hi_r if abs(hi_r - closed) >= abs(lo_r - closed) else lo_r
             outer = bool(np.dot(n_w, axis_w) * np.sign(far - closed) > 0)
