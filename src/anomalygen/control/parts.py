@@ -263,7 +263,10 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
         dp, drv.dp = drv.dp, 0.004  # back off gently: a fast pull drags a light part along
         if g.outer:
             if not hinge:  # a cup resting on a drawer front's top edge would hook it and pull it out
-                drv.goto(drv.site + np.array([0.0, 0.0, 0.02]), max_steps=10)
+                held_at = drv.site.copy()
+                drv.goto(held_at + np.array([0.0, 0.0, 0.02]), max_steps=10, tol=0.004)
+                if _cup_touches(drv, g.body):  # it rose under the handle: leave straight out from where it held
+                    drv.goto(held_at, max_steps=10)
             drv.goto(drv.site + n * 0.10, max_steps=40)
         else:  # the inner face looks into the cabinet: leave upwards, over the part's edge
             drv.goto(drv.site + n * 0.03, max_steps=15)
@@ -276,6 +279,21 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
     ok = abs(q() - goal) <= tol
     detail = f"{joint} = {q():.3f} (goal {goal:.3f})" + (f"; {'; '.join(notes)}" if notes else "")
     return PrimitiveResult(ok, drv.steps - s0, detail)
+
+
+def _cup_touches(drv, body: int) -> bool:
+    """Is the suction cup in contact with ``body``?"""
+    import mujoco
+
+    from anomalygen.scene import robot
+
+    m, d = drv.model, drv.data
+    cup = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, robot.CUP_BODY)
+    for i in range(d.ncon):
+        b1, b2 = int(m.geom_bodyid[d.contact.geom1[i]]), int(m.geom_bodyid[d.contact.geom2[i]])
+        if {b1, b2} == {cup, body}:
+            return True
+    return False
 
 
 def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400) -> str:
