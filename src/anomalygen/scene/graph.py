@@ -100,18 +100,14 @@ def geom_world_aabbs(model, data) -> tuple[np.ndarray, np.ndarray]:
     mats = data.geom_xmat.reshape(-1, 3, 3)
     center = data.geom_xpos + np.einsum("gij,gj->gi", mats, center_local)
     half = np.einsum("gij,gj->gi", np.abs(mats), half_local)
-    # Round shapes get their exact box: the turned local box of a ball rolling in a basket grew its
-    # box by up to 40 % (its bottom 3 cm under the floor) and the ball was no longer 'inside'.
+    # Balls and ellipsoids get their exact box: the turned local box of a ball rolling in a basket
+    # grew by up to 40 % (its bottom 3 cm under the floor) and the ball was no longer 'inside'.
+    # (Capsules and cylinders keep the turned box: cable links and knobs are measured as before.)
     size, kind = model.geom_size, model.geom_type
     sph = kind == mujoco.mjtGeom.mjGEOM_SPHERE
     half[sph] = size[sph, :1]
     ell = kind == mujoco.mjtGeom.mjGEOM_ELLIPSOID
     half[ell] = np.sqrt(np.einsum("gij,gj->gi", mats[ell] ** 2, size[ell] ** 2))
-    axis = np.abs(mats[:, :, 2])  # world components of the geom's local z (capsule, cylinder axis)
-    cap = kind == mujoco.mjtGeom.mjGEOM_CAPSULE
-    half[cap] = axis[cap] * size[cap, 1:2] + size[cap, :1]
-    cyl = kind == mujoco.mjtGeom.mjGEOM_CYLINDER
-    half[cyl] = axis[cyl] * size[cyl, 1:2] + size[cyl, :1] * np.sqrt(np.clip(1.0 - axis[cyl] ** 2, 0.0, 1.0))
     return center - half, center + half
 
 
