@@ -123,6 +123,11 @@ def plan_path(model, data, joint_names, q_goal, *, time_limit: float = 2.0, seed
         return None
     n = len(joint_names)
     lim = joint_bounds(model, joint_names)
+    # A joint pushed a little past its soft limit (the arm leaning on a part it just slid) would put
+    # the start outside the space and BIT* would fail at once, leaving a straight fallback that sweeps
+    # through the furniture: the bounds take in where the arm and the goal really are.
+    lim = np.stack([np.minimum(lim[:, 0], np.minimum(q_start, q_goal)),
+                    np.maximum(lim[:, 1], np.maximum(q_start, q_goal))], axis=1)
     space = ob.RealVectorStateSpace(n)
     bounds = ob.RealVectorBounds(n)
     for i, (lo, hi) in enumerate(lim):

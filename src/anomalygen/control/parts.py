@@ -84,6 +84,9 @@ def _object_root(m, body: int) -> int:
     return body
 
 
+EDGE_FACE = 0.05  # m: a face narrower than this is an edge the cup cannot seal on
+
+
 def grasp_candidates(drv, joint: str, closed: float) -> list[PartGrasp]:
     """The outer and the inner face of the part, with a grasp point each (outer first)."""
     m, d = drv.model, drv.data
@@ -98,8 +101,18 @@ def grasp_candidates(drv, joint: str, closed: float) -> list[PartGrasp]:
     axis_w = d.xaxis[j] / np.linalg.norm(d.xaxis[j])
     axis_l = rb.T @ axis_w
     size = hi - lo
+    panel = False
     if m.jnt_type[j] == SLIDE:
         k = int(np.argmax(np.abs(axis_l)))  # the face across the slide direction: the drawer front
+        # A sliding sash (or a sliding door) moves in its own plane: the face across the slide is a
+        # 3 cm edge, and a cup on that edge leaves the arm beside the pane, where backing off drags
+        # the sash along and going home shoves it shut again. Such a panel is held by its broad face
+        # from the room side and slid sideways.
+        edge = sorted(size[i] for i in range(3) if i != k)
+        thin = int(np.argmin(size))
+        upright = abs(rb[2, thin]) < 0.3 and abs(axis_w[2]) < 0.3  # a standing pane sliding sideways
+        if edge[0] < EDGE_FACE and thin != k and upright:
+            k, panel = thin, True
     else:
         # thinnest box axis that is not the hinge axis: across the panel
         cands = [i for i in range(3) if abs(axis_l[i]) < 0.7]
@@ -132,7 +145,7 @@ def grasp_candidates(drv, joint: str, closed: float) -> list[PartGrasp]:
         p_w = d.xpos[body] + rb @ p_l
         n_w = rb @ n_l
         p_c, n_c = rc @ p_w + tc, rc @ n_w
-        if m.jnt_type[j] == SLIDE:  # a drawer's front faces the way it slides out
+        if m.jnt_type[j] == SLIDE and not panel:  # a drawer's front faces the way it slides out
             lo_r, hi_r = m.jnt_range[j]
             far = hi_r if abs(hi_r - closed) >= abs(lo_r - closed) else lo_r
             outer = bool(np.dot(n_w, axis_w) * np.sign(far - closed) > 0)
@@ -250,7 +263,10 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
         dp, drv.dp = drv.dp, 0.004  # back off gently: a fast pull drags a light part along
         if g.outer:
             if not hinge:  # a cup resting on a drawer front's top edge would hook it and pull it out
-                drv.goto(drv.site + np.array([0.0, 0.0, 0.02]), max_steps=10)
+                held_at = drv.site.copy()
+                drv.goto(held_at + np.array([0.0, 0.0, 0.02]), max_steps=10, tol=0.004)
+                if _cup_touches(drv, g.body):  # it rose under the handle: leave straight out from where it held
+                    drv.goto(held_at, max_steps=10)
             drv.goto(drv.site + n * 0.10, max_steps=40)
         else:  # the inner face looks into the cabinet: leave upwards, over the part's edge
             drv.goto(drv.site + n * 0.03, max_steps=15)
@@ -263,6 +279,21 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
     ok = abs(q() - goal) <= tol
     detail = f"{joint} = {q():.3f} (goal {goal:.3f})" + (f"; {'; '.join(notes)}" if notes else "")
     return PrimitiveResult(ok, drv.steps - s0, detail)
+
+
+def _cup_touches(drv, body: int) -> bool:
+    """Is the suction cup in contact with ``body``?"""
+    import mujoco
+
+    from anomalygen.scene import robot
+
+    m, d = drv.model, drv.data
+    cup = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, robot.CUP_BODY)
+    for i in range(d.ncon):
+        b1, b2 = int(m.geom_bodyid[d.contact.geom1[i]]), int(m.geom_bodyid[d.contact.geom2[i]])
+        if {b1, b2} == {cup, body}:
+            return True
+    return False
 
 
 def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400) -> str:
