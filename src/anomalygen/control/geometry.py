@@ -188,26 +188,89 @@ def free_spot(drv: Driver, support: str, obj: str, *, edge_margin: float = 0.2, 
 def opening(drv: Driver, region: str) -> tuple[np.ndarray, np.ndarray]:
     """The box above which a dropped object falls into ``region``: the carcass's top rectangle, minus
     the strip that a half-open lid still hangs over (the lid swings about a horizontal axis, so it
-    covers the side of the opening next to its hinge)."""
+    covers the side of the opening next to its hinge). The strip is cut across the direction the lid
+    swings in, which need not be a world axis (a trash can stands turned), so the box returned is the
+    world box of what is left of the top rectangle."""
     if not drv.opened.get(region):
         return drv.aabb(region)
     lo, hi = (v.copy() for v in static_box(drv, region))
     m = drv.model
+    poly = np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])
     for jn in drv.opened[region]:
         j = m.joint(jn).id
         if m.jnt_type[j] != HINGE:
             continue
         axis = drv.data.xaxis[j]
-        k = 1 if abs(axis[0]) > abs(axis[1]) else 0  # horizontal direction the part swings along
-        plo, phi = drv.aabb(m.body(int(m.jnt_bodyid[j])).name)
-        if phi[k] <= lo[k] or plo[k] >= hi[k]:
+        u = np.array([-axis[1], axis[0]])  # horizontal direction the part swings along
+        if np.linalg.norm(u) < 0.5:
+            continue  # a vertical hinge: a door, beside the opening rather than over it
+        u = u / np.linalg.norm(u)
+        pts = _body_corners(drv, int(m.jnt_bodyid[j]))[:, :2] @ u
+        plo, phi = float(pts.min()), float(pts.max())
+        along = poly @ u
+        if phi <= along.min() or plo >= along.max():
             continue  # swung clear of the opening
-        below, above = plo[k] - lo[k], hi[k] - phi[k]
-        if below >= above:
-            hi[k] = max(lo[k] + 1e-3, plo[k])
-        else:
-            lo[k] = min(hi[k] - 1e-3, phi[k])
+        # keep the wrist above the held object clear of the lid's edge as well, where the strip allows
+        low_side = plo - along.min() >= along.max() - phi
+        for margin in (LID_CLEARANCE, 0.0):
+            cut = _clip(poly, -u, -(plo - margin)) if low_side else _clip(poly, u, phi + margin)
+            if len(cut) >= 3 and np.ptp(cut @ u) > MIN_STRIP:
+                break
+        poly = cut
+        if len(poly) < 3:
+            c = (lo[:2] + hi[:2]) / 2
+            poly = np.array([c, c + 1e-3])
+    lo[:2], hi[:2] = poly.min(axis=0), poly.max(axis=0)
+    hi[:2] = np.maximum(hi[:2], lo[:2] + 1e-3)
     return lo, hi
+
+
+LID_CLEARANCE = 0.05  # m kept between an open lid's edge and the drop strip, for the wrist
+MIN_STRIP = 0.12  # m: a strip narrower than this (a small bin) keeps no clearance: the object must fit
+
+
+def lid_free_side(drv: Driver, region: str) -> np.ndarray | None:
+    """Horizontal unit direction from the hinge of ``region``'s opened lid across its opening: the
+    side to work from, where the lid leans away from the arm (from the hinge side the wrist meets the
+    lid's underside and knocks it shut). None without one such lid (flaps on opposite sides cancel)."""
+    m, d = drv.model, drv.data
+    lo, hi = static_box(drv, region)
+    centre = (lo[:2] + hi[:2]) / 2
+    total = np.zeros(2)
+    for jn in drv.opened.get(region, []):
+        j = m.joint(jn).id
+        axis = d.xaxis[j]
+        if m.jnt_type[j] != HINGE or abs(axis[2]) > 0.7:
+            continue
+        u = np.array([-axis[1], axis[0]])
+        u = u / (np.linalg.norm(u) + 1e-12)
+        total += u * np.sign(float(np.dot(centre - d.xanchor[j][:2], u)))
+    n = float(np.linalg.norm(total))
+    return total / n if n > 0.5 else None
+
+
+def _clip(poly: np.ndarray, n: np.ndarray, c: float) -> np.ndarray:
+    """The part of a convex polygon where p.n >= c (one Sutherland-Hodgman pass)."""
+    out = []
+    for i in range(len(poly)):
+        a, b = poly[i], poly[(i + 1) % len(poly)]
+        da, db = float(a @ n) - c, float(b @ n) - c
+        if da >= 0:
+            out.append(a)
+        if da * db < 0:
+            out.append(a + (b - a) * da / (da - db))
+    return np.array(out) if out else np.zeros((0, 2))
+
+
+def _body_corners(drv: Driver, body: int) -> np.ndarray:
+    """World corners of the boxes of a body's collision geoms (all its geoms if none collide)."""
+    m, d = drv.model, drv.data
+    geoms = [g for g in range(m.ngeom) if m.geom_bodyid[g] == body]
+    geoms = [g for g in geoms if m.geom_contype[g] or m.geom_conaffinity[g]] or geoms
+    box = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    pts = [(box * m.geom_aabb[g, 3:] + m.geom_aabb[g, :3]) @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g]
+           for g in geoms]
+    return np.concatenate(pts)
 
 
 def long_axis_yaw(drv: Driver, obj: str) -> float:

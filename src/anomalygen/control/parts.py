@@ -194,7 +194,7 @@ def _accessible(n_w: np.ndarray) -> bool:
 
 
 def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.02, attempts: int = 4,
-                 max_steps: int = 900):
+                 max_steps: int = 900, max_drag: float = MAX_DRAG):
     """Hold the part by suction and lead it to ``goal``; re-grasp when it stops following."""
     from anomalygen.control.ik import quat_z_to
     from anomalygen.scene import robot
@@ -255,7 +255,7 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
             notes.append(f"attempt {attempt + 1}: cup did not reach the {'outer' if g.outer else 'inner'} face")
             drv.goto(drv.site + n * 0.08, max_steps=40)
             continue
-        why = _drive(drv, joint, stop, tol=tol)
+        why = _drive(drv, joint, stop, tol=tol, max_drag=max_drag)
         if why:
             notes.append(f"attempt {attempt + 1}: {why}")
         robot.suction_off(m, d, name)
@@ -296,7 +296,7 @@ def _cup_touches(drv, body: int) -> bool:
     return False
 
 
-def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400) -> str:
+def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400, max_drag: float = MAX_DRAG) -> str:
     """Lead the held part towards ``goal``: the cup target rides the part's path just ahead of it."""
     import mujoco
 
@@ -334,7 +334,7 @@ def _drive(drv, joint: str, goal: float, *, tol: float, max_steps: int = 400) ->
         quat = np.zeros(4)
         mujoco.mju_mulQuat(quat, rot, cupq0)
         drv.goto(target, quat, max_steps=1, tol=0.0)
-        if np.linalg.norm(d.xpos[root] - root0) > MAX_DRAG or d.xmat[root][8] < np.cos(MAX_TILT):
+        if np.linalg.norm(d.xpos[root] - root0) > max_drag or d.xmat[root][8] < np.cos(MAX_TILT):
             why = f"stopped: {m.body(root).name} was being dragged or tipped"
             break
         gap = abs(float(d.qpos[adr]) - goal)
@@ -441,12 +441,66 @@ def open_for_access(drv, obj: str, labels):
         goal = js.closed_value + OPEN_FRACTION * (_far(js) - js.closed_value)
         tol = 0.3 * abs(js.range[1] - js.range[0])  # over half open is open enough to put things in
         q = float(drv.data.joint(js.name).qpos[0])
-        if abs(q - js.closed_value) >= abs(goal - js.closed_value) - tol:
-            continue
-        r = actuate_part(drv, js.name, goal, closed=js.closed_value, tol=tol)
-        ok &= r.success
-        details.append(r.detail)
+        if abs(q - js.closed_value) < abs(goal - js.closed_value) - tol:
+            r = actuate_part(drv, js.name, goal, closed=js.closed_value, tol=tol)
+            ok &= r.success
+            details.append(r.detail)
+        steep = _near_upright(drv, js)
+        sgn = np.sign(_far(js) - js.closed_value)
+        if ok and steep is not None and (steep - float(drv.data.joint(js.name).qpos[0])) * sgn > 0.1:
+            # A lid is held where it is left (hinge friction), and one left half open leans over the
+            # opening: a carton lowered in hits it. Lift it on to just short of upright, but give up
+            # as soon as the container itself moves (near upright the cup pulls sideways, and a light
+            # box slides rather than its stiff lid turning); what it reached is kept.
+            before = float(drv.data.joint(js.name).qpos[0])
+            r = actuate_part(drv, js.name, steep, closed=js.closed_value, tol=0.05, attempts=2,
+                             max_drag=STEEP_MAX_DRAG)
+            details.append("lifted on: " + r.detail)
+            if (before - float(drv.data.joint(js.name).qpos[0])) * sgn > 0.1:  # knocked back down on the way
+                r = actuate_part(drv, js.name, goal, closed=js.closed_value, tol=tol)
+                ok &= r.success
+                details.append("again: " + r.detail)
     return PrimitiveResult(ok, drv.steps - s0, "opened: " + "; ".join(details) if details else f"{obj} already open")
+
+
+SHORT_OF_UPRIGHT = 0.15  # rad: how far short of upright a lid is lifted on to
+STEEP_MAX_DRAG = 0.03  # m the container may move while its lid is lifted on
+
+
+def _upright_value(drv, joint: str) -> float | None:
+    """Joint value at which a hinged part's centre of mass stands straight above its (horizontal)
+    hinge axis; None for a slide or a hinge that is not horizontal."""
+    m, d = drv.model, drv.data
+    j = m.joint(joint).id
+    if m.jnt_type[j] != HINGE:
+        return None
+    axis = d.xaxis[j] / np.linalg.norm(d.xaxis[j])
+    if abs(axis[2]) > 0.3:
+        return None
+    up = np.array([0.0, 0.0, 1.0]) - axis * axis[2]
+    r = d.xipos[int(m.jnt_bodyid[j])] - d.xanchor[j]
+    r = r - axis * np.dot(r, axis)
+    if np.linalg.norm(r) < 1e-4:
+        return None
+    up, r = up / np.linalg.norm(up), r / np.linalg.norm(r)
+    phi = float(np.arctan2(np.dot(axis, np.cross(r, up)), np.dot(r, up)))  # the turn taking r to up
+    return float(d.qpos[m.jnt_qposadr[j]]) + phi
+
+
+def _near_upright(drv, js) -> float | None:
+    """The value just short of upright for a hinged lid or flap (its own stop if that comes first),
+    None for other parts."""
+    if js.label not in LIDS:
+        return None
+    upright = _upright_value(drv, js.name)
+    if upright is None:
+        return None
+    far = _far(js)
+    sgn = np.sign(far - js.closed_value)
+    if (upright - js.closed_value) * sgn <= 0:
+        return None
+    steep = upright - sgn * SHORT_OF_UPRIGHT
+    return float(far - sgn * 0.05 if (steep - far) * sgn > -0.05 else steep)
 
 
 def _falls_shut(drv, joint: str, closed: float) -> bool:

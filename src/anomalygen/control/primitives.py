@@ -20,6 +20,7 @@ from anomalygen.control.geometry import (
     free_spot,
     grasp_points,
     joint_motion_direction,
+    lid_free_side,
     long_axis_yaw,
     opening,
     part_point_local,
@@ -253,7 +254,9 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     off = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]]) @ off
     cup_goal = np.array([*(aim[:2] - off), goal[2]])
     above, low = np.array([*cup_goal[:2], carry_z]), cup_goal + np.array([0, 0, below])
-    if not drv.place_base_near(cup_goal, reach_poses=[(above, final), (low, final)]):
+    side = lid_free_side(drv, region) if into else None
+    if not ((side is not None and drv.place_base_near(cup_goal, side=side, reach_poses=[(above, final), (low, final)]))
+            or drv.place_base_near(cup_goal, reach_poses=[(above, final), (low, final)])):
         return PrimitiveResult(False, drv.steps - s0, f"no collision-free base pose near {region}")
     if not drv.reach_planned((above,), final):
         drv.goto(above, quat, max_steps=250)

@@ -618,7 +618,8 @@ def trash_can(rng):
     pedal = rng.random() < 0.6
     lid = r.child("lid", (0, rad + 0.005, h + 0.002))
     lid.hinge("lid_hinge", (1, 0, 0), (-1.6, 0), "lid", 0.0)
-    lid.cyl(rad + 0.006, 0.006, (0, -rad - 0.005, 0.006), c, 1200)
+    # a moulded shell, not 12 mm of solid plastic (which made a 2 kg lid on a 7 kg bin)
+    lid.cyl(rad + 0.006, 0.006, (0, -rad - 0.005, 0.006), c, D_HOLLOW)
     feats = [colour_name(c), "hinged lid"]
     if pedal:
         p = r.child("pedal", (0, -rad + 0.02, 0.04))
