@@ -70,10 +70,12 @@ def test_demo_defaults_are_the_embedded_offline_ones():
 
 
 def _config(tmp_path, n):
+    # videos off: rendering them was 110 of learn's 130 s on five tasks, and these tests check resume and
+    # executors, not videos (test_learn_stage and the demo cover those)
     path = tmp_path / "small.toml"
     path.write_text(
         f"workers = 1\nquiet = true\n[brainstorm]\nengine = \"knowledge\"\nn = {n}\n"
-        "[learn]\nsac_steps = 50\n[evaluate]\nbaselines = false\nwmd_pairs = 10\nimage_metrics = false\n"
+        "[learn]\nsac_steps = 50\nvideo = false\n[evaluate]\nbaselines = false\nwmd_pairs = 10\nimage_metrics = false\n"
     )
     return path
 
