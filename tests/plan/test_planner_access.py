@@ -189,3 +189,41 @@ def test_plan_stage_honours_settings_sac_actions(tmp_path):
     assert again.done == 2
     assert all(s.method == SkillMethod.PRIMITIVE for s in read_model(run.plan_path("oven"), Plan).subtasks)
     assert all(s.method == SkillMethod.PRIMITIVE for s in read_model(run.plan_path("box"), Plan).subtasks)
+
+
+def _fridge_spec(*, door: float, inside: str | None = "refrigerator_0", fridge_joints=True) -> SceneSpec:
+    joints = [JointState(name="refrigerator_0/door_hinge", label="door", type="hinge", value=door, range=(0.0, 1.9),
+                         closed_value=0.0),
+              JointState(name="refrigerator_0/freezer_slide", label="drawer", type="slide", value=0.0,
+                         range=(0.0, 0.5), closed_value=0.0)] if fridge_joints else []
+    milk = _obj("spoiled_milk_carton_0", "spoiled_milk_carton", ObjectRole.HAZARD, pos=(1.8, 0.3, 0.5))
+    milk = milk.model_copy(update={"inside": inside, "support": inside or "floor"})
+    objects = [milk, _obj("refrigerator_0", "Refrigerator", ObjectRole.AUXILIARY, joints),
+               _obj("trashcan_0", "TrashCan", ObjectRole.CONTAINER, [_lid(0.0)])]
+    return SceneSpec(scene_id="s", task_id="t", room="kitchen", seed=0, objects=objects,
+                     bindings={"$hazard": "spoiled_milk_carton_0", "$container": "trashcan_0"})
+
+
+@pytest.mark.parametrize("door", [0.0, 1.3])
+def test_food_in_a_fridge_is_taken_out_through_the_door_in_front_of_it(door):
+    """Sour milk on a fridge shelf: picked from above the cup meets the fridge's top, so it comes out
+    through the opening; the part in front of it is opened first (whether the scene shows it open
+    or shut, the executor finds which one holds the carton) and every fridge door is shut at the end."""
+    spec = _fridge_spec(door=door)
+    plan = plan_from_kb("t", "dispose_spoiled_food", dict(spec.bindings), spec=spec)
+    assert [s.id for s in plan.subtasks] == ["s0_open_container", "s0_open_source", "s1_take_out_of",
+                                             "s2_place_inside", "s9_close_container", "s9_close_source"]
+    opened, take, shut = plan.subtasks[1], plan.subtasks[2], plan.subtasks[5]
+    assert opened.params == shut.params == {"object": "refrigerator_0", "part": "drawer|door", "access": True,
+                                            "contents": "spoiled_milk_carton_0"}
+    assert (opened.primitive, take.primitive, shut.primitive) == ("pull", "take_out_of", "push")
+    assert take.params == {"object": "spoiled_milk_carton_0", "region": "refrigerator_0"}
+    [out] = take.success.predicates
+    assert out.name == "inside" and out.negate and out.args["container"] == "refrigerator_0"
+
+
+@pytest.mark.parametrize("inside,fridge_joints", [(None, True), ("refrigerator_0", False)])
+def test_food_on_a_table_or_in_an_open_box_is_still_picked(inside, fridge_joints):
+    spec = _fridge_spec(door=0.0, inside=inside, fridge_joints=fridge_joints)
+    plan = plan_from_kb("t", "dispose_spoiled_food", dict(spec.bindings), spec=spec)
+    assert [s.id for s in plan.subtasks] == ["s0_open_container", "s1_pick", "s2_place_inside", "s9_close_container"]

@@ -410,16 +410,65 @@ def best_door(drv, obj: str, doors: list):
     return max(ok, key=lambda t: t[0])[1] if ok else None
 
 
-def open_for_access(drv, obj: str, labels):
-    """Open the container so an object can go in: every lid and flap, or the best drawer.
+def _compartment_when_shut(drv, obj: str, js):
+    """``compartment_behind`` of a door in whatever state it is: measured with the door put shut for
+    the kinematics only (the state is restored, no time passes)."""
+    import mujoco
+
+    adr = drv.model.jnt_qposadr[drv.model.joint(js.name).id]
+    q = float(drv.data.qpos[adr])
+    drv.data.qpos[adr] = js.closed_value
+    mujoco.mj_kinematics(drv.model, drv.data)
+    try:
+        return compartment_behind(drv, obj, js)
+    finally:
+        drv.data.qpos[adr] = q
+        mujoco.mj_forward(drv.model, drv.data)
+
+
+def holding_closure(drv, obj: str, contents: str):
+    """The door or drawer of ``obj`` in front of ``contents``, open or shut: (JointState, compartment
+    or None). A fridge has a freezer drawer or door and a main door; the one to open, and the way the
+    cup comes in, is the one whose compartment holds the object's centre."""
+    lo_c, hi_c = drv.aabb(contents)
+    c = (lo_c + hi_c) / 2
+    for js in closure_joints(drv, obj, ["door"]):
+        lo, hi, out = _compartment_when_shut(drv, obj, js)
+        if np.all(c >= lo - 0.03) and np.all(c <= hi + 0.03):
+            return js, (lo, hi, out)
+    for js in closure_joints(drv, obj, ["drawer"]):
+        lo, hi = drv.aabb(drv.joint_body(js.name))
+        if np.all(c[:2] >= lo[:2]) and np.all(c[:2] <= hi[:2]) and lo[2] <= c[2] <= hi[2] + 0.05:
+            return js, None
+    return None
+
+
+def open_for_access(drv, obj: str, labels, contents: str | None = None):
+    """Open the container so an object can go in: every lid and flap, or the best drawer; with
+    ``contents`` (an object to take out), the door or drawer in front of that object.
 
     Records what was opened in ``drv.opened[obj]`` (so the place step drops into an opened drawer
     and the close step shuts exactly these) and returns a PrimitiveResult.
     """
 
     s0 = drv.steps
-    lids = closure_joints(drv, obj, [lab for lab in labels if lab in LIDS])
-    chosen = lids
+    if contents is not None and obj in drv.opened:  # a second attempt: the same part again
+        lids = []
+        chosen = [js for js in closure_joints(drv, obj, CLOSURES_ALL) if js.name in drv.opened[obj]]
+    elif contents is not None:
+        found = holding_closure(drv, obj, contents)
+        if found is None:
+            return PrimitiveResult(True, 0, f"{contents} lies behind no door or drawer of {obj}: nothing to open")
+        js, room = found
+        if room is not None:
+            drv.compartments[obj] = room
+            drv.compartment_anchor[obj] = drv.data.xpos[drv.body_id(obj)].copy()
+        labels = [js.label]
+        lids = []
+        chosen = [js]
+    else:
+        lids = closure_joints(drv, obj, [lab for lab in labels if lab in LIDS])
+        chosen = lids
     if not chosen:
         drawer = best_drawer(drv, obj, closure_joints(drv, obj, ["drawer"]))
         chosen = [drawer] if drawer is not None else []
@@ -516,11 +565,14 @@ def _falls_shut(drv, joint: str, closed: float) -> bool:
     return bool(torque * np.sign(q - closed) < 0)
 
 
-def close_opened(drv, obj: str):
-    """Shut the parts ``open_for_access`` opened on ``obj`` (hinged lids last-opened first)."""
+def close_opened(drv, obj: str, *, every: bool = False):
+    """Shut the parts ``open_for_access`` opened on ``obj`` (hinged lids last-opened first); with
+    ``every``, also the ones found open (a fridge the object came out of: every door it has)."""
 
     s0 = drv.steps
     names = list(reversed(drv.opened.get(obj, [])))
+    if every:
+        names += [js.name for js in closure_joints(drv, obj, CLOSURES_ALL) if js.name not in names]
     ok, details = True, []
     for js in closure_joints(drv, obj, CLOSURES_ALL):
         if js.name not in names:

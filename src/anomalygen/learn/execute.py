@@ -148,8 +148,8 @@ def run_subtask(drv, st: SubTask, plan: Plan):
         from anomalygen.control import parts
 
         if prim == "pull":
-            return parts.open_for_access(drv, obj, str(prm.get("part", "lid")).split("|"))
-        return parts.close_opened(drv, obj)
+            return parts.open_for_access(drv, obj, str(prm.get("part", "lid")).split("|"), prm.get("contents"))
+        return parts.close_opened(drv, obj, every=bool(prm.get("contents")))
     if prim in ("push", "pull", "close_joint", "open_joint", "switch_off"):
         return _drive_joints(drv, st, obj, prim, prm)
     return PrimitiveResult(False, 0, f"primitive {prim!r} is not implemented")

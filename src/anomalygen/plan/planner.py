@@ -185,17 +185,21 @@ def closed_closures(spec: SceneSpec | None, instance: str) -> list[str]:
     return [lab for lab in CLOSURES if lab in labels]
 
 
-def access_steps(container: str, labels: list[str]) -> tuple[SubTask, SubTask]:
+def access_steps(container: str, labels: list[str], *, contents: str | None = None) -> tuple[SubTask, SubTask]:
     """Open a shut container before the pick (suction cannot hold an object and a lid at once) and
-    shut it again after the place: a drawer left open is a hazard of its own."""
+    shut it again after the place: a drawer left open is a hazard of its own. With ``contents`` the
+    container is the one the object comes out of: the door or drawer in front of it is opened (the
+    executor finds which from the scene) and shut again at the end."""
     part = "|".join(labels)
-    opened = SubTask(id="s0_open_container", description=f"open {container} ({part}) to put something inside",
-                     method=SkillMethod.PRIMITIVE, primitive="pull",
-                     params={"object": container, "part": part, "access": True},
+    which = "source" if contents else "container"
+    why = f"to take {contents} out" if contents else "to put something inside"
+    params = {"object": container, "part": part, "access": True, **({"contents": contents} if contents else {})}
+    opened = SubTask(id=f"s0_open_{which}", description=f"open {container} ({part}) {why}",
+                     method=SkillMethod.PRIMITIVE, primitive="pull", params=params,
                      reward=RewardSpec(terms=[RewardTerm(kind="distance", a="ee", b=container, weight=0.5),
                                               RewardTerm(kind="action_penalty", weight=0.01)]))
-    shut = SubTask(id="s9_close_container", description=f"close {container} again", method=SkillMethod.PRIMITIVE,
-                   primitive="push", params={"object": container, "part": part, "access": True},
+    shut = SubTask(id=f"s9_close_{which}", description=f"close {container} again", method=SkillMethod.PRIMITIVE,
+                   primitive="push", params=params,
                    reward=RewardSpec(terms=[RewardTerm(kind="action_penalty", weight=0.01)]),
                    success=SuccessSpec(predicates=[PredicateCall(name="joint_closed", args={
                        "object": container, "label": part, "max_fraction": 0.1})]))
@@ -231,8 +235,34 @@ def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, s
                 opened, shut = access_steps(container, labels)
                 subtasks = [opened, *subtasks, shut]
             break
+    subtasks = _take_out_first(subtasks, cls, bindings, spec)
     return Plan(task_id=task_id, source=source, engine=Engine.KNOWLEDGE, subtasks=subtasks,
                 success=SuccessSpec(predicates=list(cls.success)), bindings=dict(bindings))
+
+
+def _take_out_first(subtasks: list[SubTask], cls, bindings: dict[str, str], spec: SceneSpec | None) -> list[SubTask]:
+    """A recipe that starts with a pick, for an object lying in a container with doors or drawers
+    (sour milk on a fridge shelf): the pick becomes take_out_of through the opening, with the part
+    in front of the object opened before and shut after (a fridge door left open is a hazard too).
+
+    The opening comes after the destination's (the cup cannot hold the object and a lid at once) and
+    the shutting last, once the object is where it belongs. The scene spec says what lies inside what;
+    that is geometry the robot perceives (the perceived spec keeps it), not the answer key.
+    """
+    if spec is None or not cls.recipe or cls.recipe[0].action != "pick":
+        return subtasks
+    obj = _resolve(cls.recipe[0].args.get("object", "$hazard"), bindings)
+    source = next((o.inside for o in spec.objects if o.name == obj), None)
+    labels = sorted({js.label for o in spec.objects if o.name == source for js in o.joint_states
+                     if js.label in ("drawer", "door")}, key=CLOSURES.index)
+    picks = [i for i, st in enumerate(subtasks) if st.primitive == "grasp"]
+    if not labels or not picks:
+        return subtasks
+    out_of = PredicateCall(name="inside", args={"object": obj, "container": source}, negate=True)
+    take = _handling_subtask(subtasks[picks[0]].id.replace("pick", "take_out_of"), "take_out_of", obj,
+                             {"container": source}, {}, [out_of])
+    opened, shut = access_steps(source, labels, contents=obj)
+    return [*subtasks[:picks[0]], opened, take, *subtasks[picks[0] + 1:], shut]
 
 
 def _bound(call: PredicateCall, bindings: dict[str, str]) -> PredicateCall:
