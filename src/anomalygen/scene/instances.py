@@ -52,6 +52,30 @@ def _sweep(asset, values: dict[str, float]) -> float:
     return out
 
 
+SWING_MAX = 0.9  # m: the most room kept clear in front of shut doors/drawers
+#: the roles of objects the robot may have to open (to put the hazard in, or take it out)
+OPENED_ROLES = (ObjectRole.CONTAINER, ObjectRole.TARGET, ObjectRole.HAZARD)
+
+
+def _swing(asset) -> float:
+    """Room a shut door/drawer needs in front to open: a drawer its travel, a side-hinged door its
+    width (the asset's width shared among its side-hinged doors), a door hinged at its foot its
+    height; capped at ``SWING_MAX``."""
+    ext = asset.aabb[1] - asset.aabb[0]
+    side = [j for j in asset.joints if j.type == "hinge" and j.label == "door" and abs(j.axis[2]) >= 0.5]
+    out = 0.0
+    for j in asset.joints:
+        if j.label not in ("door", "drawer"):
+            continue
+        if j.type == "slide":
+            out = max(out, abs(j.range[1] - j.range[0]) + 0.02)
+        elif abs(j.axis[2]) >= 0.5:
+            out = max(out, float(ext[0]) / len(side))
+        else:
+            out = max(out, float(ext[2]))
+    return min(out, SWING_MAX)
+
+
 def placed_instance(chosen: select.Chosen) -> Placed:
     lo, hi = (np.asarray(v, float) for v in chosen.asset.aabb)
     p = Placed(
@@ -66,6 +90,8 @@ def placed_instance(chosen: select.Chosen) -> Placed:
         front=_front(chosen.asset),
     )
     p.sweep = _sweep(chosen.asset, chosen.joint_values)
+    if chosen.role in OPENED_ROLES and p.front is not None:
+        p.swing = _swing(chosen.asset)
     return p
 
 

@@ -52,6 +52,10 @@ class Placed:
     support: str = "floor"
     inside: str | None = None
     sweep: float = 0.0  # extra clearance in front for open doors/drawers
+    # room in front that other things keep clear of, so the robot can open the shut doors/drawers
+    # (a counter 2 cm in front of a cabinet's doors keeps them shut); unlike ``sweep`` the base may
+    # stand in it, and it does not push the base back from the front
+    swing: float = 0.0
 
     def world_half(self) -> np.ndarray:
         c, s = abs(math.cos(self.yaw)), abs(math.sin(self.yaw))
@@ -63,15 +67,17 @@ class Placed:
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         return self.pos + np.array([c * cl[0] - s * cl[1], s * cl[0] + c * cl[1], cl[2]])
 
-    def footprint(self) -> tuple[np.ndarray, np.ndarray]:
-        """World AABB (lo, hi) including the sweep of open doors/drawers."""
+    def footprint(self, *, swing: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """World AABB (lo, hi) including the sweep of open doors/drawers (``swing``: and the room
+        kept clear in front for opening the shut ones)."""
         center, half = self.world_center(), self.world_half()
         lo, hi = center - half, center + half
-        if self.sweep > 0 and self.front is not None:
+        reach = max(self.sweep, self.swing) if swing else self.sweep
+        if reach > 0 and self.front is not None:
             c, s = math.cos(self.yaw), math.sin(self.yaw)
             f = np.array([c * self.front[0] - s * self.front[1], s * self.front[0] + c * self.front[1], 0.0])
-            lo = np.minimum(lo, lo + f * self.sweep)
-            hi = np.maximum(hi, hi + f * self.sweep)
+            lo = np.minimum(lo, lo + f * reach)
+            hi = np.maximum(hi, hi + f * reach)
         return lo, hi
 
     @property
@@ -125,10 +131,11 @@ class Layout:
             box[1][:2] > ROOM_CENTER + ROOM_HALF + 0.3
         ):
             return True
+        zone = obj.footprint(swing=True)
         for other in self.items:
             if other.name in ignore or other.name == obj.name:
                 continue
-            if overlaps(box, other.footprint()):
+            if overlaps(zone, other.footprint()) or overlaps(box, other.footprint(swing=True)):
                 return True
         return self._hits_base(box)
 
