@@ -60,7 +60,7 @@ def _js(drv, obj: str, label: str):
 
 
 def _fraction(drv, js) -> float:
-    from anomalygen.control.parts import _far
+    from anomalygen.control.access import _far
 
     return abs(_q(drv, js.name) - js.closed_value) / abs(_far(js) - js.closed_value)
 
@@ -158,7 +158,7 @@ def test_loose_objects_are_welded_by_their_massive_body(scenes):
 
 
 def test_shut_lid_is_opened_for_access_and_closed_again(scenes):
-    from anomalygen.control.parts import close_opened, open_for_access
+    from anomalygen.control.access import close_opened, open_for_access
 
     drv = _driver(scenes, "box")
     (lid,) = _js(drv, "storage_box_0", "lid")
@@ -179,7 +179,7 @@ def test_shut_lid_is_opened_for_access_and_closed_again(scenes):
 @pytest.fixture(scope="module")
 def drawer_run(scenes):
     """open_for_access on the shut cabinet, then close_opened: joint values after each."""
-    from anomalygen.control.parts import close_opened, open_for_access
+    from anomalygen.control.access import close_opened, open_for_access
 
     drv = _driver(scenes, "drawers")
     obj = scenes["drawers"][1].bindings["$container"]

@@ -100,7 +100,8 @@ def _swing_door_wide(drv: Driver, container: str) -> None:
     """Open the hinged door(s) the access step opened to their stop. Opened part way (about 90
     degrees) a side door stands square to the opening, where the arm reaching in meets it and
     pushes it shut again; at its stop it is folded back, out of the way."""
-    from anomalygen.control.parts import actuate_part, closure_joints
+    from anomalygen.control.access import closure_joints
+    from anomalygen.control.parts import actuate_part
 
     for js in closure_joints(drv, container, ("door",)):
         if js.name not in drv.opened.get(container, []) or drv.model.joint(js.name).type[0] != HINGE:

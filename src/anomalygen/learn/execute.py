@@ -145,11 +145,11 @@ def run_subtask(drv, st: SubTask, plan: Plan):
         prm.setdefault("part", "lid|flap")
         return _drive_joints(drv, st, obj, "push" if prim == "close_lid" else "pull", prm)
     if prim in ("push", "pull") and prm.get("access"):  # open a container to put something in / shut it again
-        from anomalygen.control import parts
+        from anomalygen.control import access
 
         if prim == "pull":
-            return parts.open_for_access(drv, obj, str(prm.get("part", "lid")).split("|"), prm.get("contents"))
-        return parts.close_opened(drv, obj, every=bool(prm.get("contents")))
+            return access.open_for_access(drv, obj, str(prm.get("part", "lid")).split("|"), prm.get("contents"))
+        return access.close_opened(drv, obj, every=bool(prm.get("contents")))
     if prim in ("push", "pull", "close_joint", "open_joint", "switch_off"):
         return _drive_joints(drv, st, obj, prim, prm)
     return PrimitiveResult(False, 0, f"primitive {prim!r} is not implemented")
