@@ -100,6 +100,13 @@ def holding_closure(drv, obj: str, contents: str):
     return None
 
 
+def _record_compartment(drv, obj: str, room) -> None:
+    """Remember the compartment the place and take-out steps go through, and where its container
+    stood then (a light container that slides carries its compartment along)."""
+    drv.compartments[obj] = room
+    drv.compartment_anchor[obj] = drv.data.xpos[drv.body_id(obj)].copy()
+
+
 def open_for_access(drv, obj: str, labels, contents: str | None = None):
     """Open the container so an object can go in: every lid and flap, or the best drawer; with
     ``contents`` (an object to take out), the door or drawer in front of that object.
@@ -110,7 +117,6 @@ def open_for_access(drv, obj: str, labels, contents: str | None = None):
 
     s0 = drv.steps
     if contents is not None and obj in drv.opened:  # a second attempt: the same part again
-        lids = []
         chosen = [js for js in closure_joints(drv, obj, CLOSURES_ALL) if js.name in drv.opened[obj]]
     elif contents is not None:
         found = holding_closure(drv, obj, contents)
@@ -118,14 +124,10 @@ def open_for_access(drv, obj: str, labels, contents: str | None = None):
             return PrimitiveResult(True, 0, f"{contents} lies behind no door or drawer of {obj}: nothing to open")
         js, room = found
         if room is not None:
-            drv.compartments[obj] = room
-            drv.compartment_anchor[obj] = drv.data.xpos[drv.body_id(obj)].copy()
-        labels = [js.label]
-        lids = []
+            _record_compartment(drv, obj, room)
         chosen = [js]
     else:
-        lids = closure_joints(drv, obj, [lab for lab in labels if lab in LIDS])
-        chosen = lids
+        chosen = closure_joints(drv, obj, [lab for lab in labels if lab in LIDS])
     if not chosen:
         drawer = best_drawer(drv, obj, closure_joints(drv, obj, ["drawer"]))
         chosen = [drawer] if drawer is not None else []
@@ -138,8 +140,7 @@ def open_for_access(drv, obj: str, labels, contents: str | None = None):
         if door is None:
             return PrimitiveResult(False, 0, f"{obj} has no lid, flap, drawer or door with a reachable "
                                              "compartment behind it")
-        drv.compartments[obj] = compartment_behind(drv, obj, door)
-        drv.compartment_anchor[obj] = drv.data.xpos[drv.body_id(obj)].copy()
+        _record_compartment(drv, obj, compartment_behind(drv, obj, door))
         chosen = [door]
     drv.opened[obj] = [js.name for js in chosen]
     ok, details = True, []
