@@ -241,24 +241,28 @@ class Layout:
         inward: float = 0.0,
         label: str | None = None,
         near_side: float | None = None,
+        yaw: float | None = None,
     ) -> None:
         """Rest ``obj`` on a rectangle (world lo_xy, hi_xy, top z) of ``holder``.
 
         ``edge``: the footprint ends 1.5-7 cm from the surface edge that faces the robot (the
         knowledge base counts <= 12 cm as "near the edge"). ``inward``: keep this far from all edges
         (less when the object is too big for that). ``near_side``: the object's centre at most this
-        far from the robot-facing edge, so the arm reaches it from beside the support.
+        far from the robot-facing edge, so the arm reaches it from beside the support. ``yaw``: stand
+        it at this yaw (an appliance whose door faces out over the edge) instead of a random one.
         """
         lo_xy, hi_xy, top = surface
         to_base = self.base[:2] - (lo_xy + hi_xy) / 2
         axis = int(np.argmax(np.abs(to_base)))
         sign = np.sign(to_base[axis]) or -1.0
         for _ in range(TRIES):
-            obj.yaw = float(
+            obj.yaw = yaw if yaw is not None else float(
                 self.rng.choice([0.0, math.pi / 2, math.pi, -math.pi / 2]) + self.rng.uniform(-0.15, 0.15)
             )
             half = obj.world_half()
             slack = (hi_xy - lo_xy) / 2 - half[:2]
+            if np.any(slack < 0) and yaw is not None:
+                raise ItemFailed(f"{obj.name} does not fit on {holder.name} at the yaw asked for")
             if np.any(slack < 0):
                 obj.yaw = 0.0 if (obj.hi - obj.lo)[0] <= (obj.hi - obj.lo)[1] else math.pi / 2
                 half = obj.world_half()

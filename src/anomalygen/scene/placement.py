@@ -22,7 +22,7 @@ from anomalygen.scene.instances import (
     surface_of,
 )
 from anomalygen.scene.judgement import place_hazard_safely, place_judgement_items, room_fixtures
-from anomalygen.scene.layout import Layout, Placed
+from anomalygen.scene.layout import Layout, Placed, face_robot_yaw
 from anomalygen.scene.selection import Selection, clutter_names
 from anomalygen.schema import ObjectRole
 
@@ -83,6 +83,10 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
         if ch is parent and _on_a_support(sel):  # a big microwave the hazard is in: onto the counter, below
             continue
         p = placed[ch.name] = placed_instance(ch)
+        if ch is sel.support_var and p.front is None and _on_a_support(sel):
+            # the counter an appliance stands on: square to the room, its front (the catalogue's -y,
+            # where a counter's panels are) towards the robot, so the appliance can face out over it
+            p.front = np.array([0.0, -1.0])
         lay.place_on_floor(p, relevant=True, face=True)
     if hazard.fixed and hazard.name not in placed:
         p = placed[hazard.name] = placed_instance(hazard)
@@ -198,6 +202,8 @@ def _stand_parent(sel: Selection, lay: Layout, placed: dict[str, Placed], ppl: P
     holder = placed.get(sel.support_var.name) if sel.support_var is not None else None
     if holder is not None and _on_a_support(sel):
         ppl.fixed = True
+        if ppl.front is not None and _at_front_edge(lay, ppl, holder):
+            return
         for _ in range(FACING_TRIES):  # the surface draws a random yaw: keep one whose door faces the robot
             lay.place_on_surface(ppl, holder, surface_of(holder), inward=INWARD)
             if ppl.front is None:
@@ -210,6 +216,24 @@ def _stand_parent(sel: Selection, lay: Layout, placed: dict[str, Placed], ppl: P
             lay.items.remove(ppl)
         raise ItemFailed(f"{ppl.name} found no spot on {holder.name} with its door towards the room")
     lay.place_on_floor(ppl, relevant=True, face=True)
+
+
+def _at_front_edge(lay: Layout, ppl: Placed, holder: Placed) -> bool:
+    """Stand an appliance near the edge of its support that faces the robot (the open floor), its
+    door facing out over that edge, as a microwave stands on a kitchen counter. Drawn anywhere on the
+    top with its door towards the robot, it stood up to 0.64 m in from the edge, its door along the
+    worktop, where the arm reaching over the counter could not get into it. False when it does not fit."""
+    lo_xy, hi_xy, _ = surface = surface_of(holder)
+    to_base = lay.base[:2] - (lo_xy + hi_xy) / 2
+    axis = int(np.argmax(np.abs(to_base)))
+    out = np.zeros(2)
+    out[axis] = np.sign(to_base[axis]) or -1.0
+    yaw = face_robot_yaw(ppl.front, out)
+    try:
+        lay.place_on_surface(ppl, holder, surface, edge=True, inward=INWARD, yaw=yaw)
+    except ItemFailed:
+        return False
+    return True
 
 
 def _table_height_ok(asset) -> bool:

@@ -308,7 +308,7 @@ def microwave(rng):
     r = Part("root")
     hx, hy, hz, t = u(rng, 0.22, 0.28), u(rng, 0.17, 0.21), u(rng, 0.14, 0.17), 0.015
     c = colour(rng, APPLIANCE)
-    _appliance_shell(r, hx, hy, hz, t, c)
+    _appliance_shell(r, hx, hy, 2 * hz, t, c)  # full height: hz is half of it
     pw = hx * 0.5
     r.box((pw / 2, 0.01, hz - 0.004), (hx - pw / 2, -hy - 0.01, hz), c, D_HOLLOW)  # control panel
     side_door(
