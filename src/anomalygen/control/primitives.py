@@ -262,7 +262,9 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     cup_goal = np.array([*(aim[:2] - off), goal[2]])
     above, low = np.array([*cup_goal[:2], carry_z]), cup_goal + np.array([0, 0, below])
     side = lid_free_side(drv, region) if into else None
-    low_carry = max(goal[2] + below + 0.1, rim + below + 0.05, drv.aabb(region)[1][2] + below + 0.05)
+    # how low the object may hang: held askew by its side it turns on the way (its longest side, then)
+    hang = below if face_down else max(below, float(np.max(ohi - olo)))
+    low_carry = max(goal[2] + below + 0.1, rim + below + 0.05, drv.aabb(region)[1][2] + hang + 0.05)
     for lower in (False, True):
         if lower:  # carried high (off a 1.2 m shelf) the pose over the spot is out of reach, and the arm,
             # stretching for it, dragged the base into the bin: carry it only as high as the container
