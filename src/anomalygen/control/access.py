@@ -160,7 +160,7 @@ def open_for_access(drv, obj: str, labels, contents: str | None = None):
             # as soon as the container itself moves (near upright the cup pulls sideways, and a light
             # box slides rather than its stiff lid turning); what it reached is kept.
             before = float(drv.data.joint(js.name).qpos[0])
-            r = actuate_part(drv, js.name, steep, closed=js.closed_value, tol=0.05, attempts=2,
+            r = actuate_part(drv, js.name, steep, closed=js.closed_value, tol=0.03, attempts=2,
                              max_drag=STEEP_MAX_DRAG)
             details.append("lifted on: " + r.detail)
             if (before - float(drv.data.joint(js.name).qpos[0])) * sgn > 0.1:  # knocked back down on the way
@@ -170,7 +170,7 @@ def open_for_access(drv, obj: str, labels, contents: str | None = None):
     return PrimitiveResult(ok, drv.steps - s0, "opened: " + "; ".join(details) if details else f"{obj} already open")
 
 
-SHORT_OF_UPRIGHT = 0.15  # rad: how far short of upright a lid is lifted on to
+PAST_UPRIGHT = 0.1  # rad: how far past upright a lid is lifted on to (or to its stop)
 STEEP_MAX_DRAG = 0.03  # m the container may move while its lid is lifted on
 
 
@@ -206,8 +206,8 @@ def _near_upright(drv, js) -> float | None:
     sgn = np.sign(far - js.closed_value)
     if (upright - js.closed_value) * sgn <= 0:
         return None
-    steep = upright - sgn * SHORT_OF_UPRIGHT
-    return float(far - sgn * 0.05 if (steep - far) * sgn > -0.05 else steep)
+    steep = upright + sgn * PAST_UPRIGHT
+    return float(far - sgn * 0.02 if (steep - far) * sgn > -0.02 else steep)
 
 
 def _falls_shut(drv, joint: str, closed: float) -> bool:

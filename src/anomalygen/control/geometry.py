@@ -208,8 +208,8 @@ def opening(drv: Driver, region: str) -> tuple[np.ndarray, np.ndarray]:
         pts = _body_corners(drv, int(m.jnt_bodyid[j]))[:, :2] @ u
         plo, phi = float(pts.min()), float(pts.max())
         along = poly @ u
-        if phi <= along.min() or plo >= along.max():
-            continue  # swung clear of the opening
+        if phi + LID_CLEARANCE <= along.min() or plo - LID_CLEARANCE >= along.max():
+            continue  # swung clear of the opening (a lid standing at the rim is still in the way)
         # keep the wrist above the held object clear of the lid's edge as well, where the strip allows
         low_side = plo - along.min() >= along.max() - phi
         for margin in (LID_CLEARANCE, 0.0):

@@ -29,6 +29,7 @@ LEAD_HINGE = 0.06
 MAX_DRAG = 0.10  # m the container may be dragged by its part before the drive gives up
 MAX_TILT = 0.35  # rad it may tip
 COMFORT_Z = 0.95  # m: height at which the arm holds a tall door
+LID_EDGE_INSET = 0.035  # m from a lid's free edge to the cup's centre (the cup is 0.02 m in radius)
 
 
 @dataclass
@@ -38,6 +39,7 @@ class PartGrasp:
     normal_local: np.ndarray  # outward normal of the grasped face, part body frame
     outer: bool  # the face that points out of the cabinet when closed
     beyond_local: np.ndarray | None = None  # just past the free edge (hinged parts), part body frame
+    lid: bool = False  # a panel lying flat when shut, on a horizontal hinge
 
 
 def _rot(axis: np.ndarray, angle: float) -> np.ndarray:
@@ -118,6 +120,7 @@ def grasp_candidates(drv, joint: str, closed: float) -> list[PartGrasp]:
         cands = [i for i in range(3) if abs(axis_l[i]) < 0.7]
         k = min(cands, key=lambda i: size[i])
     out: list[PartGrasp] = []
+    lid = False
     for sgn in (1.0, -1.0):
         n_l = np.zeros(3)
         n_l[k] = sgn
@@ -130,6 +133,15 @@ def grasp_candidates(drv, joint: str, closed: float) -> list[PartGrasp]:
             i_far = max(others, key=lambda i: abs(abs(axis_l[i]) - 1.0) * size[i])
             far = hi[i_far] if abs(hi[i_far] - anchor_l[i_far]) > abs(lo[i_far] - anchor_l[i_far]) else lo[i_far]
             p_l[i_far] = anchor_l[i_far] + 0.75 * (far - anchor_l[i_far])
+            lid = bool(abs(axis_w[2]) < 0.3 and abs((rc @ rb[:, k])[2]) > 0.7)
+            if lid:
+                # a lid (a panel lying flat when shut, on a horizontal hinge) is held near its free
+                # edge: a lid that reaches past the cup rises into the wrist as it turns, and the wrist,
+                # pressed down on it, shoves the container along (a trash can slid 4 cm and the lid
+                # stopped at 1 rad)
+                edge = far - np.sign(far - anchor_l[i_far]) * LID_EDGE_INSET
+                if abs(edge - anchor_l[i_far]) > abs(p_l[i_far] - anchor_l[i_far]):
+                    p_l[i_far] = edge
             # along a vertical hinge, hold the door at a comfortable height (a freezer door's middle
             # is out of the arm's reach)
             i_ax = int(np.argmax(np.abs(axis_l)))
@@ -151,7 +163,7 @@ def grasp_candidates(drv, joint: str, closed: float) -> list[PartGrasp]:
             outer = bool(np.dot(n_w, axis_w) * np.sign(far - closed) > 0)
         else:  # a door's or lid's outer face looks away from the carcass when shut
             outer = bool(np.dot(n_c, p_c - centre) > 0)
-        out.append(PartGrasp(body, p_l, n_l, outer=outer, beyond_local=beyond))
+        out.append(PartGrasp(body, p_l, n_l, outer=outer, beyond_local=beyond, lid=lid))
     out.sort(key=lambda g: not g.outer)
     return out
 
@@ -182,7 +194,7 @@ def _on_surface(drv, g: PartGrasp) -> PartGrasp:
         hit = start - n * dist
         if part[int(geomid[0])]:
             rb = d.xmat[g.body].reshape(3, 3)
-            return PartGrasp(g.body, rb.T @ (hit - d.xpos[g.body]), g.normal_local, g.outer, g.beyond_local)
+            return PartGrasp(g.body, rb.T @ (hit - d.xpos[g.body]), g.normal_local, g.outer, g.beyond_local, g.lid)
         travelled += dist + 1e-4
         start = hit - n * 1e-4
     return g
@@ -227,8 +239,17 @@ def actuate_part(drv, joint: str, goal: float, *, closed: float, tol: float = 0.
         mid = r @ p + t
         side = n if np.linalg.norm(n[:2]) > 0.3 else None
         reach = [(p + n * PRE_CONTACT, quat_z_to(-n))]
-        if not (drv.place_base_near(mid, side=side, reach_poses=reach) or drv.place_base_near(p, side=side)
-                or drv.place_base_near(p)):
+        arc = []
+        if g.lid:  # the cup turns with a lid: a base from which the arm follows the arc to its end, cup
+            # on the face all the way (from the free edge's side the wrist cannot tip back far enough and
+            # presses on the lid; from the hinge axis's end it is a roll of the wrist)
+            for f in (0.5, 1.0):
+                r_f, t_f = part_transform(drv, joint, (stop - q()) * f)
+                arc.append((r_f @ p + t_f + r_f @ n * PRE_CONTACT, quat_z_to(-(r_f @ n))))
+        placed = drv.place_base_near(mid, side=side, reach_poses=reach + arc)
+        if placed and arc and not drv.reaches:  # no base follows the whole arc: one that reaches the lid
+            placed = drv.place_base_near(mid, side=side, reach_poses=reach)
+        if not (placed or drv.place_base_near(p, side=side) or drv.place_base_near(p)):
             notes.append("no base pose")
             break
         quat = quat_z_to(-n)

@@ -27,6 +27,13 @@ from anomalygen.control.geometry import (
     rim_z,
     top_rect,
 )
+from anomalygen.control.setdown import (  # noqa: F401
+    SLOW_DP,
+    _let_swing_die,
+    centre_over,
+    held_touches,
+    lower_until_contact,
+)
 
 
 def _step(env_like, target_pos) -> None:
@@ -255,9 +262,19 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     cup_goal = np.array([*(aim[:2] - off), goal[2]])
     above, low = np.array([*cup_goal[:2], carry_z]), cup_goal + np.array([0, 0, below])
     side = lid_free_side(drv, region) if into else None
-    if not ((side is not None and drv.place_base_near(cup_goal, side=side, reach_poses=[(above, final), (low, final)]))
-            or drv.place_base_near(cup_goal, reach_poses=[(above, final), (low, final)])):
-        return PrimitiveResult(False, drv.steps - s0, f"no collision-free base pose near {region}")
+    # how low the object may hang: held askew by its side it turns on the way (its longest side, then)
+    hang = below if face_down else max(below, float(np.max(ohi - olo)))
+    low_carry = max(goal[2] + below + 0.1, rim + below + 0.05, drv.aabb(region)[1][2] + hang + 0.05)
+    for lower in (False, True):
+        if lower:  # carried high (off a 1.2 m shelf) the pose over the spot is out of reach, and the arm,
+            # stretching for it, dragged the base into the bin: carry it only as high as the container
+            # asks (its open lid included: the wrist swept through a lid standing 0.3 m over the rim)
+            above[2] = low_carry
+        if not ((side is not None and drv.place_base_near(cup_goal, side=side, reach_poses=[(above, final), (low, final)]))
+                or drv.place_base_near(cup_goal, reach_poses=[(above, final), (low, final)])):
+            return PrimitiveResult(False, drv.steps - s0, f"no collision-free base pose near {region}")
+        if drv.reaches or above[2] <= low_carry + 0.05:
+            break
     if not drv.reach_planned((above,), final):
         drv.goto(above, quat, max_steps=250)
         for f in np.linspace(0.2, 1.0, 5):
@@ -267,15 +284,14 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
     below = drv.site[2] - drv.aabb(obj)[0][2]  # again: the swing and the turn change how the object hangs
     low = np.array([low[0], low[1], goal[2] + below])
     # correct what is left of the object's offset from the spot (the base pose only approximates it)
-    for _ in range(2):
-        olo, ohi = drv.aabb(obj)
-        err = aim[:2] - (olo[:2] + ohi[:2]) / 2
-        if np.linalg.norm(err) < 0.01:
-            break
-        above = np.array([above[0] + err[0], above[1] + err[1], above[2]])
-        low = np.array([low[0] + err[0], low[1] + err[1], low[2]])
-        drv.goto(above, quat, max_steps=120, tol=0.01)
+    above, low = centre_over(drv, obj, aim, above, low, quat)
+    hover = rim + drv.site[2] - drv.aabb(obj)[0][2] + 0.04  # the object's bottom 4 cm over the rim
+    if into and hover < above[2] - 0.1:
+        # and again just over the rim: carried down from high up (a carton off a 1.2 m shelf, held
+        # askew) the wrist turns on the way and the object came down 8 cm off, onto the lid
+        drv.goto(np.array([*above[:2], hover]), quat, max_steps=200, tol=0.01)
         _let_swing_die(drv, obj)
+        above, low = centre_over(drv, obj, aim, np.array([*above[:2], hover]), low, quat)
     ok = lower_until_contact(drv, obj, low, quat)
     if release_after:
         release(drv)
@@ -401,61 +417,8 @@ def _place_sideways(drv: Driver, obj: str, region: str, floor: float, *, release
                                                "through its door, cup pointing in")
 
 
-def _let_swing_die(drv: Driver, obj: str, max_steps: int = 40) -> None:
-    """Hold still until the carried object stops swinging: set down while swinging, it lands tilted."""
-    b = drv.body_id(obj)
-    for _ in range(max_steps):
-        w, v = drv.data.cvel[b][:3], drv.data.cvel[b][3:]
-        if np.linalg.norm(w) < 0.15 and np.linalg.norm(v) < 0.02:
-            return
-        drv.step()
-
-
-def lower_until_contact(drv: Driver, obj: str, target, quat, *, max_steps: int = 300, tol: float = 0.02) -> bool:
-    """Lower the held object towards ``target`` (cup face) and stop the moment it touches anything.
-
-    A guarded move: the weld is stiff, so pressing on would push a needle through a thin bottom. It
-    also stops where the arm can reach no lower with the cup upright (deep in a box on the floor the
-    wrist tilts and the swinging object knocks the lid shut). True when the target was reached or
-    the object came to rest on something."""
-    target = np.asarray(target, dtype=float)
-    upright = drv.cup_down(0.9)
-    dp = drv.dp
-    try:
-        for _ in range(max_steps):
-            if held_touches(drv, obj):
-                return True
-            if upright and not drv.cup_down(0.9):  # as low as the arm goes with the cup upright: let go
-                return True
-            # the last 8 cm slowly (3 mm a step): at full speed a 4 mm bottom is crossed between checks
-            drv.dp = SLOW_DP if drv.site[2] - target[2] < 0.08 else dp
-            drv.goto(target, quat, max_steps=1, tol=0.0)
-            if np.linalg.norm(drv.site - target) < tol:
-                return True
-        return False
-    finally:
-        drv.dp = dp
-
-
 MAX_SET_DOWN_CORRECTION = 0.15  # m: a set-down that missed its spot by more is not aimed short again
 SQUARE_RATIO = 1.3  # an object whose footprint is less elongated than this is not turned before a set-down
-SLOW_DP = 0.003  # m per control step for the final part of a set-down
-
-
-def held_touches(drv: Driver, obj: str) -> bool:
-    """Does the held object touch something other than the robot?"""
-    from anomalygen.scene import robot
-
-    d = drv.data
-    mask = robot.subtree_geoms(drv.model, drv.body_id(obj))
-    for i in range(d.ncon):
-        g1, g2 = int(d.contact.geom1[i]), int(d.contact.geom2[i])
-        if mask[g1] == mask[g2]:
-            continue
-        other = g2 if mask[g1] else g1
-        if other not in drv._robot_geoms and d.contact.dist[i] < 0.0005:
-            return True
-    return False
 
 
 def push_part(drv: Driver, joint: str, goal: float, *, tol: float = 0.08, max_steps: int = 500,
