@@ -27,13 +27,7 @@ from anomalygen.control.geometry import (
     rim_z,
     top_rect,
 )
-from anomalygen.control.setdown import (  # noqa: F401
-    SLOW_DP,
-    _let_swing_die,
-    centre_over,
-    held_touches,
-    lower_until_contact,
-)
+from anomalygen.control.setdown import centre_over, let_swing_die, lower_until_contact
 
 
 def _step(env_like, target_pos) -> None:
@@ -280,7 +274,7 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
         for f in np.linspace(0.2, 1.0, 5):
             drv.goto(above, _yawed(quat, f * turn), max_steps=8)
     quat = final
-    _let_swing_die(drv, obj)
+    let_swing_die(drv, obj)
     below = drv.site[2] - drv.aabb(obj)[0][2]  # again: the swing and the turn change how the object hangs
     low = np.array([low[0], low[1], goal[2] + below])
     # correct what is left of the object's offset from the spot (the base pose only approximates it)
@@ -290,7 +284,7 @@ def move_to(drv: Driver, obj: str, region: str, *, release_after: bool = True, i
         # and again just over the rim: carried down from high up (a carton off a 1.2 m shelf, held
         # askew) the wrist turns on the way and the object came down 8 cm off, onto the lid
         drv.goto(np.array([*above[:2], hover]), quat, max_steps=200, tol=0.01)
-        _let_swing_die(drv, obj)
+        let_swing_die(drv, obj)
         above, low = centre_over(drv, obj, aim, np.array([*above[:2], hover]), low, quat)
     ok = lower_until_contact(drv, obj, low, quat)
     if release_after:
@@ -403,7 +397,7 @@ def _place_sideways(drv: Driver, obj: str, region: str, floor: float, *, release
         q = np.zeros(4)
         mujoco.mju_mulQuat(q, np.array([np.cos(f * np.pi / 4), *(np.sin(f * np.pi / 4) * axis)]), level)
         drv.goto(front_hi, q, max_steps=40)
-    _let_swing_die(drv, obj)
+    let_swing_die(drv, obj)
     olo, ohi = drv.aabb(obj)
     below = drv.site[2] - olo[2]
     off = (olo[:2] + ohi[:2]) / 2 - drv.site[:2]  # the object lies ahead of the cup

@@ -19,7 +19,8 @@ import numpy as np
 
 from anomalygen.control.driver import Driver, PrimitiveResult
 from anomalygen.control.geometry import floor_below, static_box
-from anomalygen.control.primitives import grasp, lower_until_contact, release
+from anomalygen.control.primitives import grasp, release
+from anomalygen.control.setdown import lower_until_contact
 
 SIDE_GAP = 0.08  # m between the furniture's footprint and the object (well under the walkway's 0.3 m)
 CLEARANCE = 0.025  # m the object's bottom is kept above the floor while it is moved

@@ -8,7 +8,7 @@ import numpy as np
 from anomalygen.control.driver import Driver
 
 
-def _let_swing_die(drv: Driver, obj: str, max_steps: int = 40) -> None:
+def let_swing_die(drv: Driver, obj: str, max_steps: int = 40) -> None:
     """Hold still until the carried object stops swinging: set down while swinging, it lands tilted."""
     b = drv.body_id(obj)
     for _ in range(max_steps):
@@ -76,7 +76,7 @@ def centre_over(drv: Driver, obj: str, aim, above, low, quat):
         above = np.array([above[0] + err[0], above[1] + err[1], above[2]])
         low = np.array([low[0] + err[0], low[1] + err[1], low[2]])
         drv.goto(above, quat, max_steps=120, tol=0.01)
-        _let_swing_die(drv, obj)
+        let_swing_die(drv, obj)
     return above, low
 
 

@@ -231,6 +231,14 @@ class Layout:
                   f"moved to ({got[0]:.2f}, {got[1]:.2f})") if moved else f"placed at the proposed ({want[0]:.2f}, {want[1]:.2f})"
         self.corrections.append(ValidationCheck(name=f"position:{obj.name}", passed=True, value=round(shift, 4), detail=detail))
 
+    def robot_edge(self, surface) -> tuple[int, float]:
+        """(axis, sign) of the edge of a surface rectangle (world lo_xy, hi_xy, top z) that faces the
+        robot's base: the side an object near the edge is reached from."""
+        lo_xy, hi_xy, _ = surface
+        to_base = self.base[:2] - (lo_xy + hi_xy) / 2
+        axis = int(np.argmax(np.abs(to_base)))
+        return axis, float(np.sign(to_base[axis]) or -1.0)
+
     def place_on_surface(
         self,
         obj: Placed,
@@ -252,9 +260,7 @@ class Layout:
         it at this yaw (an appliance whose door faces out over the edge) instead of a random one.
         """
         lo_xy, hi_xy, top = surface
-        to_base = self.base[:2] - (lo_xy + hi_xy) / 2
-        axis = int(np.argmax(np.abs(to_base)))
-        sign = np.sign(to_base[axis]) or -1.0
+        axis, sign = self.robot_edge(surface)
         for _ in range(TRIES):
             obj.yaw = yaw if yaw is not None else float(
                 self.rng.choice([0.0, math.pi / 2, math.pi, -math.pi / 2]) + self.rng.uniform(-0.15, 0.15)

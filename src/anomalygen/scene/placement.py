@@ -223,11 +223,10 @@ def _at_front_edge(lay: Layout, ppl: Placed, holder: Placed) -> bool:
     door facing out over that edge, as a microwave stands on a kitchen counter. Drawn anywhere on the
     top with its door towards the robot, it stood up to 0.64 m in from the edge, its door along the
     worktop, where the arm reaching over the counter could not get into it. False when it does not fit."""
-    lo_xy, hi_xy, _ = surface = surface_of(holder)
-    to_base = lay.base[:2] - (lo_xy + hi_xy) / 2
-    axis = int(np.argmax(np.abs(to_base)))
+    surface = surface_of(holder)
+    axis, sign = lay.robot_edge(surface)
     out = np.zeros(2)
-    out[axis] = np.sign(to_base[axis]) or -1.0
+    out[axis] = sign
     yaw = face_robot_yaw(ppl.front, out)
     try:
         lay.place_on_surface(ppl, holder, surface, edge=True, inward=INWARD, yaw=yaw)
