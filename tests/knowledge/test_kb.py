@@ -54,7 +54,13 @@ def test_articulated_classes_reference_real_parts():
         if hc.articulation is None:
             continue
         # the articulated object is the hazard (an open fridge) or the target it is in (a microwave with a fork inside)
-        names = kb.hazard_candidates(hc) if hc.articulation.variable == hc.hazard_variable else hc.target_assets
+        var = hc.articulation.variable
+        if var == hc.hazard_variable:
+            names = kb.hazard_candidates(hc)
+        elif var == "$target":
+            names = hc.target_assets
+        else:  # a composed class's other object: the lit burner a towel lies on
+            names = kb.static_candidates(hc, var)
         for name in names:
             part = kb.articulation_part(hc, name)
             assert part is not None and part in {p.label for p in kb.objects[name].parts}, (hc.id, name)

@@ -96,7 +96,9 @@ NEGATIVE = {
 
 
 def test_every_class_has_a_positive_and_negative_scene():
-    assert set(POSITIVE) == set(load_kb().hazard_classes) == set(NEGATIVE)
+    """Every hand-written class here; the classes composed from mechanisms in test_mechanisms.py."""
+    hand_written = {cid for cid, hc in load_kb().hazard_classes.items() if hc.composition is None or hc.composition.legacy}
+    assert set(POSITIVE) == hand_written == set(NEGATIVE)
 
 
 @pytest.mark.parametrize("class_id", sorted(POSITIVE))

@@ -34,6 +34,7 @@ PLACEMENT_SUPPORT: dict[str, str] = {
     "counter": "counter",
     "counter_edge": "counter",
     "shelf": "shelf",
+    "shelf_edge": "shelf",
 }
 
 
@@ -57,6 +58,30 @@ class KnowledgeBase:
         self.objects: dict[str, ObjectInfo] = {o.name: o for o in objects}
         self.roles: dict[str, RoleProfile] = {r.id: r for r in roles}
         self._candidates: dict[tuple[str, str], list[str]] = {}
+
+    def add_composed(self, composed: list[HazardClass]) -> None:
+        """Add the classes composed from mechanisms: a legacy row only tags its hand-written class with
+        its composition; every other row is a class of its own, with ``near:{other}``-style placements
+        spelled out over the objects that can fill the related variable."""
+        for hc in composed:
+            own = self.hazard_classes.get(hc.id)
+            if hc.composition is not None and hc.composition.legacy and own is not None:
+                self.hazard_classes[hc.id] = own.model_copy(update={"composition": hc.composition})
+                continue
+            self.hazard_classes[hc.id] = hc
+            if any("{other}" in p for p in hc.placements):
+                self.hazard_classes[hc.id] = hc.model_copy(update={"placements": self._spelled_placements(hc)})
+
+    def _spelled_placements(self, hc: HazardClass) -> list[str]:
+        from anomalygen.knowledge.mechanisms import load_mechanisms
+
+        place = load_mechanisms().places[hc.composition.place]
+        var = place.relation.variable if place.relation else None
+        others = self.static_candidates(hc, var) if var else []
+        out: list[str] = []
+        for p in hc.placements:
+            out += [p.replace("{other}", o) for o in others] if "{other}" in p else [p]
+        return out
 
     # ------------------------------------------------------------------ simple views
     @property
@@ -128,7 +153,7 @@ class KnowledgeBase:
             if p.startswith("inside:"):
                 if info is None or p.split(":", 1)[1] in info.containers or p.split(":", 1)[1] == "Refrigerator":
                     out.append(p)
-            elif info is None or not info.supports or PLACEMENT_SUPPORT.get(p) in info.supports or p.startswith("on:"):
+            elif info is None or not info.supports or PLACEMENT_SUPPORT.get(p) in info.supports or p.startswith(("on:", "near:")):
                 out.append(p)
         return out or list(hc.placements)
 
@@ -193,6 +218,9 @@ class KnowledgeBase:
                 out.append(f"{where}: hazard_objects {bad} do not meet the class's intrinsic preconditions")
             if not self.hazard_candidates(hc):
                 out.append(f"{where}: no catalogue object can be its hazard")
+        from anomalygen.knowledge.mechanisms import load_mechanisms, mechanism_problems
+
+        out += mechanism_problems(load_mechanisms(), names)
         for r in self.roles.values():
             out += [f"role {r.id}: unknown class {c}" for c in r.class_interests if c not in self.hazard_classes]
             out += [f"role {r.id}: unknown object {o}" for o in r.object_interests if o not in names]
@@ -235,4 +263,8 @@ def load_kb() -> KnowledgeBase:
     classes = [HazardClass.model_validate(c) for c in _data("hazard_classes.json")["classes"]]
     objects = [ObjectInfo.model_validate({"name": n, **o}) for n, o in _data("objects.json")["objects"].items()]
     roles = [RoleProfile.model_validate(r) for r in _data("roles.json")["roles"]]
-    return KnowledgeBase(classes, objects, roles)
+    kb = KnowledgeBase(classes, objects, roles)
+    from anomalygen.knowledge.mechanisms import composed_classes
+
+    kb.add_composed(composed_classes())
+    return kb

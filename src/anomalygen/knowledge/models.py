@@ -33,12 +33,21 @@ PROPERTIES: tuple[str, ...] = (
     "furniture",
     "appliance",
     "soft",
+    "heat_source",  # makes heat or a flame when on: a burner, heater, iron, candle, toaster
+    "combustible",  # catches fire from a heat source: towels, blankets, curtains, paper
+    "food",  # something people eat or drink (chemicals must not be stored among it)
+    "water_source",  # holds or gives water: a sink, a bathtub
 )
 
 #: Properties that make an object part of *some* hazard; objects with none of them are safe clutter.
 HAZARD_PROPERTIES: frozenset[str] = frozenset(
     {"sharp", "choking_size", "toxic", "medication", "perishable", "spoiled", "fragile", "hot", "heavy", "flammable", "cable", "litter"}
 )
+
+#: Instance states a scene records per object (``GraphObject.states``, read by ``has_state``): what the
+#: object's category cannot say. Water in a sink is set up by the builder; a pose-dependent state
+#: (a pan's handle out over the edge, an iron face down) is read from the settled simulation.
+STATES: tuple[str, ...] = ("contains_water", "wet", "on", "lit", "handle_out", "face_down")
 
 #: Support surfaces and their typical top heights (metres). The scene builder uses these heights; the
 #: predicates' height thresholds (0.55 m "low", 0.6 m "raised", 1.0 m "child reach") rely on them.
@@ -61,8 +70,10 @@ PLACEMENTS: tuple[str, ...] = (
     "counter",
     "counter_edge",
     "shelf",
+    "shelf_edge",
 )
-PLACEMENT_PREFIXES: tuple[str, ...] = ("inside:", "on:")
+#: ``near:<name>``: the object stands beside the named one (on the floor or the same support).
+PLACEMENT_PREFIXES: tuple[str, ...] = ("inside:", "on:", "near:")
 
 ROOMS: tuple[str, ...] = (
     "kitchen",
@@ -87,6 +98,10 @@ RecipeAction = Literal[
     "close_lid",
     "open_lid",
     "take_out_of",
+    "move_away",
+    "take_off",
+    "rotate_inward",
+    "stand_upright",
 ]
 
 #: Arguments each recipe action takes (all values are role variables or literal labels).
@@ -102,6 +117,10 @@ RECIPE_ARGS: dict[str, tuple[str, ...]] = {
     "close_lid": ("object",),  # every lid or flap of a portable container
     "open_lid": ("object",),
     "take_out_of": ("object", "container"),  # lift it out (through an opened door) and keep holding it
+    "move_away": ("object", "from", "distance"),  # carry or slide it at least `distance` m from `from`
+    "take_off": ("object", "support"),  # lift it off what it lies on (a hob, a stair) onto a safe support
+    "rotate_inward": ("object",),  # turn a pan's handle back over the hob or counter
+    "stand_upright": ("object",),  # stand an iron on its heel instead of its hot soleplate
 }
 
 
@@ -135,6 +154,17 @@ class ArticulationTemplate(KBModel):
     function: str = ""
 
 
+class Composed(KBModel):
+    """What a class is made of (``knowledge/mechanisms.py``): the hazard's mechanism and its fragments."""
+
+    mechanism: str = Field(description="mechanism id: the danger, e.g. ignition_near_combustible")
+    kind: str = Field(description="what the object at fault is, e.g. combustible")
+    place: str = Field(description="where it is or what it is on, in or near, e.g. near_source")
+    fix: str = Field(description="the fix's id, e.g. off_and_clear")
+    condition: str | None = Field(None, description="its dangerous state, e.g. switched_on")
+    legacy: bool = Field(False, description="a hand-written class this composition equals")
+
+
 class HazardClass(KBModel):
     """One kind of household anomaly: how to see it in a scene graph, how to fix it, how to check the fix."""
 
@@ -164,6 +194,7 @@ class HazardClass(KBModel):
     mechanism: str = Field("", description="the hazard mechanism in a short phrase (borrowed in brainstorming)")
     solution: str = Field("", description="the fix in words, with {hazard}/{container}/{support} slots")
     success_text: str = Field("", description="the safe end state in words, same slots")
+    composition: Composed | None = Field(None, description="the mechanism and fragments it is composed of")
 
     def variable_names(self) -> list[str]:
         """Variables in first-use order across preconditions (the order match_class binds them)."""

@@ -24,6 +24,13 @@ from anomalygen.schema import CLOSED_TOL, GraphObject, PredicateCall, PredicateR
 WALKWAY_CLEARANCE = 0.3
 #: Properties of the objects that line a room (a floor object close to one of them is out of the way).
 ROOM_FIXTURES = ("furniture", "appliance")
+#: Joint labels of the controls that switch something on (a tap runs water). Until one part-label
+#: table owns these words, the list lives here and in detect/observation.py.
+SWITCH_LABELS = ("knob", "switch", "button", "dial", "tap", "faucet")
+#: Open fraction of a control from which it counts as on (``switch_off_appliance`` uses the same 0.5).
+ON_FRACTION = 0.5
+#: Instance states that say a control-less thing is on (a lit candle).
+ON_STATES = ("on", "lit")
 
 
 class PredicateError(ValueError):
@@ -295,6 +302,34 @@ def _in_walkway(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
     if close:
         return False, f"{obj.name} lies beside {close[0].name}, out of the way"
     return True, f"{obj.name} lies in the open walkway"
+
+
+@_predicate(
+    "has_state",
+    {"object": "variable or instance", "state": "a state word, or alternatives 'a|b' (any of them)"},
+    "The instance shows the state (GraphObject.states: contains_water, wet, lit, handle_out, face_down).",
+)
+def _has_state(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    obj = ctx.obj(call)
+    wanted = _alternatives(call.args.get("state", ""))
+    found = [w for w in wanted if w in obj.states]
+    return bool(found), f"{obj.name} is {'/'.join(found) or 'not ' + '/'.join(wanted)}"
+
+
+@_predicate(
+    "is_on",
+    {"object": "variable or instance"},
+    f"The object is switched on: a knob, switch, button, dial or tap of it is at least {ON_FRACTION:.0%} "
+    "open, or, for a thing with no such control, its states say on or lit.",
+)
+def _is_on(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
+    obj = ctx.obj(call)
+    controls = [j for j in obj.joints if j.label in SWITCH_LABELS]
+    if controls:
+        best = max(controls, key=lambda j: j.open_fraction)
+        return best.open_fraction >= ON_FRACTION, f"{obj.name} {best.label} is {best.open_fraction:.0%} on"
+    lit = [s for s in ON_STATES if s in obj.states]
+    return bool(lit), f"{obj.name} is {lit[0] if lit else 'off (no control, not lit)'}"
 
 
 @_predicate("room_is", {"room": "room name or alternatives 'a|b'"}, "The scene's room is one of the given rooms.")

@@ -225,6 +225,7 @@ def scene_graph(model: mujoco.MjModel, data: mujoco.MjData, spec: SceneSpec) -> 
                 distance_to_edge=edge,
                 child_reachable=height <= CHILD_REACH and not enclosed,
                 joints=joints[i],
+                states=list(obj.states),
             )
         )
         if on_floor:

@@ -76,6 +76,9 @@ class PlacedObject(Artefact):
     inside: str | None = Field(None, description="instance it is contained in, if any")
     joint_states: list[JointState] = Field(default_factory=list)
     fixed: bool = Field(False, description="welded to the world (furniture) rather than free")
+    states: list[str] = Field(
+        default_factory=list, description="instance states the builder set up: contains_water, wet, lit, ..."
+    )
 
 
 class ValidationCheck(Strict):
@@ -151,6 +154,10 @@ class GraphObject(Strict):
     distance_to_edge: float | None = Field(None, description="to the edge of the surface it rests on")
     child_reachable: bool
     joints: list[JointState] = Field(default_factory=list)
+    states: list[str] = Field(
+        default_factory=list,
+        description="what can be seen of this instance beyond its category: contains_water, wet, lit, handle_out, face_down",
+    )
 
 
 class Relation(Strict):

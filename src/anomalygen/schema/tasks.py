@@ -49,6 +49,10 @@ class Scenario(Strict):
     person_at_risk: str = ""
     container: str | None = Field(None, description="catalogue name of the safe destination, if the fix stores it")
     co_objects: list[str] = Field(default_factory=list, description="other catalogue objects in the story")
+    states: dict[str, list[str]] = Field(
+        default_factory=dict,
+        description="instance states the scene must show, by catalogue name: {'Sink': ['contains_water'], 'candle': ['lit']}",
+    )
 
 
 class GroundingMatch(Strict):
@@ -56,13 +60,17 @@ class GroundingMatch(Strict):
 
     Kept in the artefact so a reader can audit every loose name: what was written, what it became,
     by which step (exact, normalised spelling, alias, Sentence-BERT retrieval, a class default, or
-    dropped) and how similar the retrieved match was (1.0 for the deterministic steps).
+    dropped; for a user's line also the words parsed into an object, state or relation, the hazard
+    composed from mechanisms, or refused) and how similar the retrieved match was (1.0 for the
+    deterministic steps).
     """
 
     field: str = Field(description="where the name was written, e.g. 'scenario.container'")
     written: str
     grounded: str | None = Field(None, description="the knowledge-base name; None when the name was dropped")
-    method: Literal["exact", "normalised", "alias", "retrieval", "class_default", "other", "dropped"]
+    method: Literal[
+        "exact", "normalised", "alias", "retrieval", "class_default", "other", "dropped", "parsed", "composed", "refused"
+    ]
     similarity: float = 1.0
     alternatives: list[str] = Field(default_factory=list, description="the next retrieval candidates, best first")
 
@@ -85,3 +93,8 @@ class TaskProposal(Artefact):
     success_condition: str = Field("", description="the safe end state, in words")
     provenance: Provenance
     grounding: list[GroundingMatch] = Field(default_factory=list, description="loose names resolved to catalogue names")
+    source: Literal["engine", "user_text", "user_tasks"] = Field(
+        "engine",
+        description="who wrote it: a brainstorming engine, a user's plain line (built as stated: no hazard-free "
+        "variant, no extra hazard), or a user's tasks.jsonl",
+    )
