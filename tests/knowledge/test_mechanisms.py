@@ -10,7 +10,13 @@ import pytest
 
 from anomalygen.knowledge import HazardClass, load_kb
 from anomalygen.knowledge.base import KNOWLEDGE_DIR
-from anomalygen.knowledge.mechanisms import MechanismSet, compose, composed_classes, load_mechanisms, same_calls
+from anomalygen.knowledge.mechanisms import (
+    MechanismSet,
+    compose,
+    composed_classes,
+    load_mechanisms,
+    same_calls,
+)
 from anomalygen.knowledge.predicates import evaluate, match_class
 from anomalygen.schema import PredicateCall
 
