@@ -53,3 +53,37 @@ def test_a_built_scene_carries_a_real_second_hazard_and_a_near_miss_no_class_fir
     for o in decoys:
         assert not any(obj == o.name for _, obj in fired), o
         assert o.distance_to_edge is not None and o.distance_to_edge > 0.12
+
+
+def test_a_users_own_line_is_never_hazard_free_nor_given_a_second_hazard():
+    from anomalygen.scene.mix import is_hazard_free
+
+    kb = load_kb()
+    always = Settings(build={"near_misses": 1, "multi_hazard": 1.0, "hazard_free": 1.0})
+    assert is_hazard_free("t1", always) and not is_hazard_free("t1", always, source="user_text")
+    items = choose_judgement_items("t1", "store_sharp_objects", set(), kb, always, source="user_text")
+    assert items.second_hazard is None and items.bin is None and len(items.near_misses) == 1
+
+
+def test_near_placements_build_the_composed_hazard_and_bind_its_other_object(tmp_path):
+    """'near:<name>': a cleaner on the bread's counter within reach of it, and a candle's flame as a
+    state; the composed class's other variable is bound in the scene's bindings."""
+    from anomalygen.knowledge.predicates import match_class
+    from anomalygen.runfolder import read_model
+    from anomalygen.scene.build import build_scene
+    from anomalygen.schema import SceneGraph
+
+    settings = Settings(build={"clutter": 0, "near_misses": 0, "multi_hazard": 0.0, "hazard_free": 0.0})
+    task = make_task("t-near", "separate_chemical_from_food", "StorageFurniture", "cleaning_spray", "near:bread_loaf",
+                     co=["bread_loaf"])
+    spec = build_scene(task, seed=0, settings=settings, out_dir=tmp_path / "s")
+    graph = read_model(tmp_path / "s" / "scene_graph.json", SceneGraph)
+    hc = load_kb().hazard_classes["separate_chemical_from_food"]
+    food = spec.bindings["$food"]
+    assert graph.get(food).category == "bread_loaf"
+    assert [m.bindings for m in match_class(hc, graph, fixed={"$hazard": spec.bindings["$hazard"]})] == [
+        {"$hazard": spec.bindings["$hazard"], "$food": food}]
+    candle = make_task("t-candle", "move_hot_item_from_edge", "Table", "candle", "table_edge")
+    build_scene(candle, seed=0, settings=settings, out_dir=tmp_path / "c")
+    lit = read_model(tmp_path / "c" / "scene_graph.json", SceneGraph)
+    assert next(o for o in lit.objects if o.category == "candle").states == ["lit"]

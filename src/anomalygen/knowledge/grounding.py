@@ -45,6 +45,7 @@ PLACEMENT_TEXTS: dict[str, str] = {
     "counter": "on the kitchen counter",
     "counter_edge": "at the edge of the kitchen counter, overhanging",
     "shelf": "on a high shelf",
+    "shelf_edge": "at the very edge of a high shelf, about to fall",
 }
 
 _SPLIT_CAMEL = re.compile(r"(?<=[a-z0-9])(?=[A-Z])")

@@ -231,6 +231,7 @@ class ObjectInfo(KBModel):
     supports: list[str] = Field(default_factory=list, description="surfaces it usually rests on")
     containers: list[str] = Field(default_factory=list, description="catalogue names it can be stored in")
     parts: list[PartInfo] = Field(default_factory=list)
+    states: list[str] = Field(default_factory=list, description="states every instance shows (a candle's flame: lit)")
 
     def has(self, prop: str) -> bool:
         return prop in self.properties

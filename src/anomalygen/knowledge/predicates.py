@@ -409,5 +409,19 @@ def match_class(hc, graph: SceneGraph, *, fixed: dict[str, str] | None = None) -
     return matches
 
 
+def bind_others(hc, graph: SceneGraph, bindings: dict[str, str]) -> dict[str, str]:
+    """``bindings`` plus the class's other precondition variables (the lit burner a towel lies on),
+    bound by matching the class with the given ones fixed; unchanged when nothing matches."""
+    fixed = {v: n for v, n in bindings.items() if v in hc.variable_names()}
+    missing = [v for v in hc.variable_names() if v not in fixed]
+    if not missing:
+        return dict(bindings)
+    try:
+        matches = match_class(hc, graph, fixed=fixed)
+    except PredicateError:
+        return dict(bindings)
+    return {**bindings, **{v: matches[0].bindings[v] for v in missing}} if matches else dict(bindings)
+
+
 def iter_calls(hc) -> itertools.chain:
     return itertools.chain(hc.preconditions, hc.success)

@@ -23,6 +23,10 @@ from anomalygen.schema import (
 )
 
 LIFT_HEIGHT = 0.12  # metres above the start height for a pick
+#: Recipe actions the knowledge base knows but no skill performs yet: a plan with one fails with that
+#: reason rather than doing something else (the skills come with the robot's skill library).
+NO_SKILL_YET = ("move_away", "rotate_inward", "stand_upright")
+ROLE_VARIABLES = ("$hazard", "$target", "$container", "$support")  # what the builder binds in SceneSpec.bindings
 CLOSURES = ("lid", "flap", "drawer", "door")  # part labels that can shut a container
 LID_LABELS = "lid|flap"  # the parts close_lid / open_lid act on (a cardboard box has flaps, not a lid)
 _LIFTED_OUT = 1.0  # m: reward target height for an object taken out of a counter-top appliance
@@ -51,9 +55,17 @@ def _height_of(spec: SceneSpec | None, instance: str) -> float:
     return 0.0
 
 
+def plannable(action: str) -> bool:
+    """Can a plan carry out this recipe action today?"""
+    return action not in NO_SKILL_YET
+
+
 def step_to_subtask(index: int, action: str, args: dict[str, str], bindings: dict[str, str],
                     spec: SceneSpec | None, final_success: list[PredicateCall]) -> SubTask:
     """One recipe step -> one sub-task (primitive, with a reward spec for RL fallback)."""
+    if not plannable(action):
+        raise ItemFailed(f"no skill for {action} yet: the step {action}({', '.join(f'{k}={v}' for k, v in args.items())}) "
+                         "cannot be planned")
     obj = _resolve(args.get("object", "$hazard"), bindings)
     sid = f"s{index + 1}_{action}"
     # Success of a step: the class predicates that talk about this step's arguments.
@@ -218,9 +230,23 @@ def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, s
     # A step goes to SAC when the knowledge base says so (``"method": "sac"``: a contact-rich part
     # motion with a shipped warm start, such as switch_off) or the user lists its action in
     # ``learn.sac_actions``; it keeps its reward spec either way.
+    # the four role variables keep their old reading (a scene-less plan names them); any other one (the
+    # lit burner of a composed class) must be bound, or the step would act on a '$source' that is nothing
+    unbound = [v for v in cls.recipe_variable_names() if v not in bindings and v not in ROLE_VARIABLES]
+    if unbound:
+        raise ItemFailed(f"{hazard_class}: the recipe's {', '.join(unbound)} is not bound to a scene object")
+    blocked = [step.action for step in cls.recipe if not plannable(step.action)]
+    if blocked:
+        raise ItemFailed(f"no skill for {blocked[0]} yet: {hazard_class}'s fix needs it")
     subtasks = []
     for i, step in enumerate(cls.recipe):
         method = SkillMethod.SAC if step.method == "sac" or step.action in sac_actions else SkillMethod.PRIMITIVE
+        if step.action == "take_off":  # off a hob or a stair onto a safe surface: a pick and a place
+            pick = step_to_subtask(i, "pick", {"object": step.args["object"]}, bindings, spec, list(cls.success))
+            place = step_to_subtask(i, "place_on", dict(step.args), bindings, spec, list(cls.success))
+            subtasks += [pick.model_copy(update={"id": f"s{i + 1}_take_off_pick"}),
+                         place.model_copy(update={"id": f"s{i + 1}_take_off_place"})]
+            continue
         if step.action == "switch_off":
             subtasks += switch_off_subtasks(i, dict(step.args), bindings, spec, list(cls.success), method)
             continue

@@ -116,6 +116,10 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
     spec = _scene_spec(task, seed, lay, placed, bindings, model, data)
     graph = scene_graph(model, data, spec)
     hc = load_kb().hazard_classes.get(task.hazard_class)
+    if hc is not None and not hazard_free:  # a composed class's other objects (the lit burner) by matching
+        from anomalygen.knowledge.predicates import bind_others
+
+        spec = spec.model_copy(update={"bindings": bind_others(hc, graph, spec.bindings)})
     report = val.validate(model, data, spec, graph, None if hazard_free else hc)
     if hazard_free and report.ok:
         report = check_hazard_free(report, graph, task.hazard_class)
@@ -177,6 +181,7 @@ def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, mo
                 inside=p.inside,
                 joint_states=joints,
                 fixed=p.fixed,
+                states=_states(task, ref.category),
             )
         )
     return SceneSpec(
@@ -188,6 +193,16 @@ def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, mo
         robot_base=[float(v) for v in lay.base],
         bindings=bindings,
     )
+
+
+def _states(task, category: str) -> list[str]:
+    """What an instance shows: its kind's own states (a candle's flame) and those the task asks for
+    that the builder can set up (``scene/capabilities.py``)."""
+    from anomalygen.scene.capabilities import can_show
+
+    info = load_kb().objects.get(category)
+    asked = [s for s in task.scenario.states.get(category, []) if can_show(s)]
+    return list(dict.fromkeys([*(info.states if info else []), *asked]))
 
 
 def scene_id_for(task_id: str) -> str:

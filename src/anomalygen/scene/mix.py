@@ -12,6 +12,9 @@ names the most alarming object scores perfectly without judging anything. So the
   state instead (shut in its container, well inside its surface, its door or lid closed), so the
   scene holds a near-miss where the hazard would have been.
 
+A user's own line (``TaskProposal.source == "user_text"``) is built as stated: never hazard-free and
+never given a second hazard (near-misses, which are safe, still dress it).
+
 Every draw comes from a generator of its own (``item_rng(seed, task, "mix")``), so with both
 features off a scene is exactly what it was without this module. Whatever ends up hazardous or safe
 is read back from the settled scene by ``scene.truth``, so the manifest never trusts these intentions.
@@ -61,10 +64,13 @@ class JudgementItems:
     rng: np.random.Generator | None = None
 
 
+USER_TEXT = "user_text"  # TaskProposal.source of a user's plain line: built as stated
+
+
 def choose_judgement_items(task_id: str, hazard_class: str, in_scene: set[str], kb, settings: Settings,
-                           *, hazard_free: bool = False) -> JudgementItems:
+                           *, hazard_free: bool = False, source: str = "engine") -> JudgementItems:
     """The near-misses and second hazard for one scene, drawn from the scene's own mix generator
-    (a hazard-free scene gets no second hazard: it is meant to hold none)."""
+    (a hazard-free scene gets no second hazard: it is meant to hold none; nor does a user's line)."""
     cfg = settings.build
     rng = item_rng(settings.seed, task_id, "mix")
     items = JudgementItems(rng=rng)
@@ -73,7 +79,7 @@ def choose_judgement_items(task_id: str, hazard_class: str, in_scene: set[str], 
         picks = rng.choice(len(names), size=min(cfg.near_misses, len(names)), replace=False)
         items.near_misses = [names[i] for i in sorted(picks)]
     second = rng.random() < cfg.multi_hazard if cfg.multi_hazard > 0 else False
-    if second and not hazard_free and hazard_class != SECOND_HAZARD_CLASS:
+    if second and not hazard_free and hazard_class != SECOND_HAZARD_CLASS and source != USER_TEXT:
         hc = kb.hazard_classes[SECOND_HAZARD_CLASS]
         cands = [n for n in kb.hazard_candidates(hc) if n not in in_scene
                  and kb.objects[n].size_range[0] <= MAX_ITEM_SIZE]
@@ -85,7 +91,8 @@ def choose_judgement_items(task_id: str, hazard_class: str, in_scene: set[str], 
     return items
 
 
-def is_hazard_free(task_id: str, settings: Settings) -> bool:
-    """Whether this task's scene is built with its hazard made safe (``build.hazard_free`` of the scenes)."""
-    share = settings.build.hazard_free
+def is_hazard_free(task_id: str, settings: Settings, *, source: str = "engine") -> bool:
+    """Whether this task's scene is built with its hazard made safe (``build.hazard_free`` of the scenes;
+    never a user's own line)."""
+    share = settings.build.hazard_free if source != USER_TEXT else 0.0
     return share > 0 and float(item_rng(settings.seed, task_id, "hazard-free").random()) < share

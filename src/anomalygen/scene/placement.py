@@ -30,7 +30,8 @@ if TYPE_CHECKING:
     from anomalygen.config import Settings
 
 
-SURFACE_PLACEMENTS = {"table", "low_table", "table_edge", "counter", "counter_edge", "shelf"}
+SURFACE_PLACEMENTS = {"table", "low_table", "table_edge", "counter", "counter_edge", "shelf", "shelf_edge"}
+NEAR_GAP = (0.03, 0.12)  # m between a 'near:<name>' hazard and that object (the knowledge base's near: <= 0.2-0.3)
 LOOSE_ON_SUPPORT_MAX = 0.35  # m: a loose task object smaller than this goes on the support, not the floor
 FACING_TRIES = 16  # draws of a parent's spot on its support until its door faces the robot
 
@@ -131,7 +132,7 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
             placed[p.name] = p
 
     items = mix.choose_judgement_items(sel.task.id, sel.task.hazard_class, set(sel.by_catalogue) | set(clutter),
-                                       sel.kb, settings, hazard_free=sel.hazard_free)
+                                       sel.kb, settings, hazard_free=sel.hazard_free, source=sel.task.source)
     place_judgement_items(sel, lay, placed, [s for s in (side, support) if s is not None], items)
 
     focus = placed[hazard.name]
@@ -170,18 +171,68 @@ def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], suppor
         lay.place_on_surface(
             hp, support, surface_of(support), edge=edge, inward=0.0 if edge else INWARD, near_side=HAZARD_NEAR_SIDE
         )
-    elif kind in ("inside", "on") and parent is not None:
+    elif kind in ("inside", "on", "near") and parent is not None:
         ppl = placed.get(parent.name)
         if ppl is None:
             ppl = placed[parent.name] = placed_instance(parent)
-            _stand_parent(sel, lay, placed, ppl)
-        if kind == "inside":
+            if kind == "near":
+                _stand_on_its_own_surface(sel, lay, placed, ppl)
+            else:
+                _stand_parent(sel, lay, placed, ppl)
+        if kind == "near":
+            _place_near(lay, hp, ppl, placed)
+        elif kind == "inside":
             lo, hi, _ = cavity_world(ppl)
             lay.place_in_cavity(hp, ppl, (lo, hi))
         else:
             lay.place_on_surface(hp, ppl, surface_of(ppl), inward=0.0)
     else:
         raise ItemFailed(f"unsupported placement {sel.task.scenario.placement!r}")
+
+
+def _place_near(lay: Layout, hp: Placed, ppl: Placed, placed: dict[str, Placed]) -> None:
+    """The hazard right beside the object the scenario names: on the floor against it when it stands
+    on the floor, else on the same surface a few centimetres from it (a spray bottle by the bread)."""
+    if ppl.support == "floor":
+        was = ppl.fixed
+        ppl.fixed = True  # place_beside tucks things against fixed bodies only
+        try:
+            lay.place_beside(hp, [ppl])
+        finally:
+            ppl.fixed = was
+        if _h_gap(hp, ppl) <= NEAR_GAP[1] + 0.05:
+            return
+        lay.items.remove(hp)
+        raise ItemFailed(f"no room on the floor beside {ppl.name} for {hp.name}")
+    holder = placed.get(str(ppl.support).split(":", 1)[0])
+    if holder is None:
+        raise ItemFailed(f"{ppl.name} stands on nothing {hp.name} could share")
+    for _ in range(FACING_TRIES):
+        lay.place_on_surface(hp, holder, surface_of(holder), inward=0.02)
+        if _h_gap(hp, ppl) <= NEAR_GAP[1]:
+            return
+        lay.items.remove(hp)
+    raise ItemFailed(f"found no spot on {holder.name} within {NEAR_GAP[1]:.2f} m of {ppl.name} for {hp.name}")
+
+
+def _stand_on_its_own_surface(sel: Selection, lay: Layout, placed: dict[str, Placed], ppl: Placed) -> None:
+    """A small thing another object stands near (a loaf of bread) goes where it usually rests: on a
+    table or counter of its own when the knowledge base says it is not kept on the floor."""
+    info = sel.kb.objects.get(ppl.catalogue)
+    kinds = [k for k in (info.supports if info else []) if k in furniture.CATEGORY]
+    if info is None or "floor" in info.supports or not kinds:
+        lay.place_on_floor(ppl, relevant=True, face=True)
+        return
+    surface = placed_support(kinds[0], instance_name(furniture.CATEGORY[kinds[0]], sel.used), sel.rng)
+    lay.place_on_floor(surface, relevant=True, face=True)
+    placed[surface.name] = surface
+    lay.place_on_surface(ppl, surface, surface_of(surface), inward=INWARD, near_side=HAZARD_NEAR_SIDE)
+
+
+def _h_gap(a: Placed, b: Placed) -> float:
+    """Horizontal gap between two placed boxes (0 when they overlap)."""
+    ac, ah, bc, bh = a.world_center(), a.world_half(), b.world_center(), b.world_half()
+    return float(np.linalg.norm(np.maximum(0.0, np.abs(ac[:2] - bc[:2]) - ah[:2] - bh[:2])))
 
 
 def _on_a_support(sel: Selection) -> bool:

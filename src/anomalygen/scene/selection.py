@@ -27,7 +27,7 @@ OPPOSITE_STATE = {"open": "closed", "closed": "open", "on": "off", "off": "on"}
 
 
 def _parse_placement(placement: str) -> tuple[str, str | None]:
-    for prefix in ("inside:", "on:"):
+    for prefix in ("inside:", "on:", "near:"):
         if placement.startswith(prefix):
             return prefix[:-1], placement[len(prefix) :]
     return placement, None

@@ -42,7 +42,7 @@ def build_item(item_id: str, payload: str, ctx: StageContext) -> str:
 
             hints = plan_scene(task, settings)
         spec = build_scene(task, seed=settings.seed, settings=settings, out_dir=out_dir, hints=hints,
-                           hazard_free=is_hazard_free(task.id, settings))
+                           hazard_free=is_hazard_free(task.id, settings, source=task.source))
     if hints is not None:
         write_model(out_dir / "llm_layout.json", hints)  # what the LLM said, before the builder's corrections
     return spec.scene_id
