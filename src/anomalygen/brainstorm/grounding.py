@@ -51,7 +51,10 @@ def _class_targets(kb: KnowledgeBase, hc: HazardClass) -> list[str]:
 
 
 def classes_for_target(kb: KnowledgeBase, target: str) -> list[HazardClass]:
-    return [hc for hc in kb.hazard_classes.values() if target in class_targets(kb, hc)]
+    """The classes a proposal around ``target`` can be of, among those that can be built today."""
+    from anomalygen.brainstorm.drawable import drawable
+
+    return [hc for hc in kb.hazard_classes.values() if target in class_targets(kb, hc) and drawable(kb, hc)]
 
 
 def usable_targets(kb: KnowledgeBase) -> list[str]:
@@ -141,14 +144,16 @@ class Grounder:
         round_: int,
         avoid_hazard: str | None = None,
     ) -> Idea:
+        from anomalygen.brainstorm.drawable import hazards_for, placements_for, relation_variable
+
         kb = self.kb
-        candidates = kb.hazard_candidates(hc)
+        candidates = hazards_for(kb, hc)
         if target in candidates and (avoid_hazard != target) and (len(candidates) == 1 or rng.random() < 0.7):
             hazard = target
         else:
             pool = [c for c in candidates if c != avoid_hazard] or candidates
             hazard = weighted(rng, pool, self._w("object", pool))
-        placements = kb.placements_for(hc, hazard)
+        placements = placements_for(kb, hc, hazard)
         placement = weighted(rng, placements, self._w("placement", placements))
         rooms = [r for r in hc.rooms if r in kb.objects[hazard].rooms] or list(hc.rooms)
         room = weighted(rng, rooms, self._w("room", rooms))
@@ -159,8 +164,12 @@ class Grounder:
             support = target if target in hc.default_supports else weighted(rng, list(hc.default_supports))
         person = hc.people[int(rng.integers(len(hc.people)))] if (self.rich and hc.people) else hc.at_risk
         co: list[str] = []
+        related = relation_variable(hc)
         for var in secondary_variables(hc):
-            co.append(weighted(rng, self.kb.static_candidates(hc, var)))
+            if var == related and ":" in placement:  # the burner the towel is on: the placement's object
+                co.append(placement.split(":", 1)[1])
+            else:
+                co.append(weighted(rng, self.kb.static_candidates(hc, var)))
         if self.rich:
             fitting = [b for b in self.benign if room in kb.objects[b].rooms and b not in co]
             for _ in range(int(rng.integers(0, 3))):
@@ -230,6 +239,8 @@ class Grounder:
         return None
 
     def _apply(self, rng, plan, *, agent, agent_index, round_) -> Idea | None:
+        from anomalygen.brainstorm.drawable import placements_for, relation_variable
+
         kb = self.kb
         mech = next((src for _, a, src in plan if a == "mechanism"), None)
         if mech is not None:
@@ -243,7 +254,7 @@ class Grounder:
         for _, aspect, src in plan:
             if aspect == "location":
                 rooms_ok = src.room in hc.rooms or src.room in kb.objects[idea.hazard].rooms
-                place_ok = src.placement in kb.placements_for(hc, idea.hazard)
+                place_ok = src.placement in placements_for(kb, hc, idea.hazard) and not relation_variable(hc)
                 if not (rooms_ok or place_ok):
                     return None
                 idea = replace(idea, room=src.room if rooms_ok else idea.room, placement=src.placement if place_ok else idea.placement)

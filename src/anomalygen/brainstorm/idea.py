@@ -74,7 +74,7 @@ def articulations_for(idea: Idea, kb: KnowledgeBase) -> list[ArticulationUse]:
     hc = kb.hazard_classes[idea.class_id]
     out: list[ArticulationUse] = []
     if hc.articulation is not None:
-        obj = idea.hazard if hc.articulation.variable == hc.hazard_variable else idea.target
+        obj = object_of(idea, hc, hc.articulation.variable)
         part = kb.articulation_part(hc, obj)
         if part:
             out.append(
@@ -97,6 +97,28 @@ def articulations_for(idea: Idea, kb: KnowledgeBase) -> list[ArticulationUse]:
                 target_state="closed",
             )
         )
+    return out
+
+
+def object_of(idea: Idea, hc, variable: str) -> str:
+    """The catalogue object that plays ``variable`` in an idea: the hazard, the target, or the
+    co-object drawn for it (co-objects start with one per other precondition variable, in order)."""
+    if variable == hc.hazard_variable:
+        return idea.hazard
+    others = [v for v in hc.variable_names() if v != hc.hazard_variable]
+    if variable in others and others.index(variable) < len(idea.co_objects) and variable != "$target":
+        return idea.co_objects[others.index(variable)]
+    return idea.target
+
+
+def scene_states(idea: Idea, kb: KnowledgeBase) -> dict[str, list[str]]:
+    """The instance states the class needs (a sink holding water), by catalogue name."""
+    from anomalygen.knowledge.mechanisms import load_mechanisms, setup_states
+
+    hc = kb.hazard_classes[idea.class_id]
+    out: dict[str, list[str]] = {}
+    for var, states in setup_states(load_mechanisms(), hc).items():
+        out.setdefault(object_of(idea, hc, var), []).extend(states)
     return out
 
 
@@ -136,6 +158,7 @@ def to_proposal(
             person_at_risk=idea.person,
             container=idea.container,
             co_objects=list(idea.co_objects),
+            states=scene_states(idea, kb),
         ),
         auxiliary_items=auxiliary_items(idea, kb),
         articulations=articulations_for(idea, kb),

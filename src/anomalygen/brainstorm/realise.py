@@ -65,6 +65,8 @@ _ACTION_VERBS = {
     "switch_off": ["Switch off", "Turn off", "Power down"],
     "move_away_from_edge": ["Move back", "Push back", "Re-centre", "Secure"],
     "push_to": ["Push aside", "Slide away", "Move"],
+    "take_off": ["Take down", "Clear", "Lift off", "Move"],
+    "move_away": ["Move away", "Shift", "Clear"],
     "close_lid": ["Close", "Shut", "Lower the lid of"],
     "place_on": ["Put away", "Lift up", "Pick up"],
 }
@@ -267,8 +269,8 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     adj = "" if articulated else _adjective(kb, idea.hazard, rng)
     verbs = _VERBS.get(hc.id) or _ACTION_VERBS.get(hc.recipe[-1].action) or ["Fix"]
     verb = _choice(rng, verbs)
-    risk = _choice(rng, b["risk_word"][hc.id])
-    pshort = "" if articulated else place_phrase_bank(idea.placement, room, rng)
+    risk = _choice(rng, class_bank(b, "risk_word", hc))
+    pshort = "" if articulated else place_phrase_bank(idea.placement, room, rng, fragment=_place_fragment(hc))
     co_names = [nice(c) for c in idea.co_objects if c not in (idea.hazard, idea.container)]
     if "co_objects" not in idea.borrowed and len(co_names) > 1:
         # background clutter is detail: name one piece, unless borrowing the setting is the idea's point
@@ -326,7 +328,7 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
         scene = f"{np_} {_choice(rng, b['lie'])} {place}{co}"
         if room not in scene:
             scene += _choice(rng, b["room_mention"]).format(room=room)
-    harm = _choice(rng, b["harm"][hc.id])
+    harm = _choice(rng, class_bank(b, "harm", hc))
     if not re.match(r"(a|an|the|our|any|whoever|someone|everyone) ", person):  # plural people: no "'s"
         harm = re.sub(r"\{person\}'s (\w+)", r"the \1 of {person}", harm)
     harm = harm.format(person=person, obj=hazard)
@@ -383,8 +385,25 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     )
 
 
-def place_phrase_bank(placement: str, room: str, rng: np.random.Generator) -> str:
-    """Where the object is, from the phrase bank (containers/supports name the catalogue object)."""
+def class_bank(b: dict, slot: str, hc) -> list[str]:
+    """A class's own phrases for a slot (harm, risk word), else its mechanism's (composed classes)."""
+    own = b[slot].get(hc.id)
+    if own:
+        return own
+    mechanism = hc.composition.mechanism if hc.composition is not None else ""
+    return b[f"{slot}_by_mechanism"].get(mechanism) or ["[a|the] hazard"]
+
+
+def _place_fragment(hc) -> str | None:
+    return hc.composition.place if hc.composition is not None and not hc.composition.legacy else None
+
+
+def place_phrase_bank(placement: str, room: str, rng: np.random.Generator, *, fragment: str | None = None) -> str:
+    """Where the object is, from the phrase bank (containers/supports name the catalogue object); a
+    composed class's place may have words of its own (a heavy pan 'on the top shelf', not any shelf)."""
+    own = bank().get("place_by_fragment", {}).get(fragment or "")
+    if own:
+        return _choice(rng, own).format(room=room)
     for prefix, options in _HOLDER_PLACES.items():
         if placement.startswith(prefix):
             return _choice(rng, options).format(x=nice(placement[len(prefix) :]))
@@ -398,5 +417,6 @@ def place_phrase_bank(placement: str, room: str, rng: np.random.Generator) -> st
 _HOLDER_PLACES = {
     "inside:": ["inside the {x}", "at the back of the {x}", "tucked into the {x}", "deep in the {x}", "in the {x}"],
     "on:": ["on top of the {x}", "on the {x}", "atop the {x}", "perched on the {x}"],
+    "near:": ["right next to the {x}", "beside the {x}", "up against the {x}", "a hand's width from the {x}", "by the {x}"],
 }
 _KITCHEN_ONLY = ("sink", "hob", "chopping", "kettle", "toaster", "bread bin")

@@ -1,0 +1,148 @@
+"""What brainstorming may draw: the classes (and, per class, the objects and placements) that can be
+built and fixed today.
+
+The knowledge base composes classes over objects and places the builder or the robot may not have
+yet (a sink that holds water, a skill to turn a pan handle). Proposing those would make tasks that
+fail later, so the engine draws from the intersection of the composed space with what the asset
+catalogue holds (``assets``), the placements and states the builder sets up (``scene/capabilities``)
+and the recipe actions the planner can carry out (``plan/planner.plannable``). Nothing is listed by
+hand: a new asset, placement or skill becomes drawable as soon as it exists.
+"""
+
+from __future__ import annotations
+
+import functools
+
+from anomalygen.knowledge import HazardClass, KnowledgeBase
+
+
+@functools.cache
+def catalogue() -> frozenset[str]:
+    """Every name the asset catalogue can build."""
+    from anomalygen.scene.select import catalogue_names
+
+    return frozenset(catalogue_names())
+
+
+def relation_variable(hc: HazardClass) -> str | None:
+    """The variable a composed class's placement parent fills (the burner in ``on:Stove``), if any."""
+    if hc.composition is None or hc.composition.legacy:
+        return None
+    from anomalygen.knowledge.mechanisms import load_mechanisms
+
+    place = load_mechanisms().places.get(hc.composition.place)
+    return place.relation.variable if place is not None and place.relation is not None else None
+
+
+def needed_states(kb: KnowledgeBase, hc: HazardClass) -> dict[str, list[str]]:
+    """Instance states, by variable, a scene of ``hc`` must show."""
+    if hc.composition is None:
+        return {}
+    from anomalygen.knowledge.mechanisms import load_mechanisms, setup_states
+
+    return setup_states(load_mechanisms(), hc)
+
+
+def state_shown(kb: KnowledgeBase, obj: str, state: str) -> bool:
+    """Can a scene show ``obj`` in ``state``: the builder sets it up, or every such object shows it."""
+    from anomalygen.scene.capabilities import can_show
+
+    info = kb.objects.get(obj)
+    return can_show(state) or (info is not None and state in info.states)
+
+
+@functools.cache
+def asset_parts(obj: str) -> frozenset[str]:
+    """The knowledge-base joint labels the catalogue's asset of ``obj`` has (a knob, a door)."""
+    from anomalygen.assets.core import generate
+    from anomalygen.scene.select import kb_label
+
+    return frozenset(kb_label(j.label) for j in generate(obj, 0).joints)
+
+
+def has_part(obj: str, part: str) -> bool:
+    """Does the asset have a joint for ``part`` ('knob|switch': either; a button is a switch)?"""
+    wanted = part.split("|")
+    if any(w in ("knob", "switch") for w in wanted):
+        wanted = [*wanted, "knob", "switch"]
+    return bool(set(wanted) & asset_parts(obj))
+
+
+def _part_ok(hc: HazardClass, variable: str | None, obj: str) -> bool:
+    art = hc.articulation
+    return art is None or variable is None or art.variable != variable or has_part(obj, art.part)
+
+
+def buildable_placement(placement: str) -> bool:
+    from anomalygen.scene.capabilities import can_place
+
+    if not can_place(placement):
+        return False
+    parent = placement.split(":", 1)[1] if ":" in placement else None
+    if parent is None:
+        return True
+    return parent in catalogue() and (not placement.startswith("inside:") or has_interior(parent))
+
+
+@functools.cache
+def has_interior(obj: str) -> bool:
+    from anomalygen.assets.core import generate
+
+    return bool(generate(obj, 0).cavities)
+
+
+@functools.cache
+def _plannable(actions: tuple[str, ...]) -> bool:
+    from anomalygen.plan.planner import plannable
+
+    return all(plannable(a) for a in actions)
+
+
+def hazards_for(kb: KnowledgeBase, hc: HazardClass) -> list[str]:
+    """The class's hazard candidates that have an asset and can show the states asked of them."""
+    states = needed_states(kb, hc).get(hc.hazard_variable, [])
+    return [o for o in kb.hazard_candidates(hc) if o in catalogue() and all(state_shown(kb, o, s) for s in states)
+            and _part_ok(hc, hc.hazard_variable, o)]
+
+
+def placements_for(kb: KnowledgeBase, hc: HazardClass, hazard: str) -> list[str]:
+    """The class's placements for ``hazard`` that the builder can set up with objects it has."""
+    var = relation_variable(hc)
+    states = needed_states(kb, hc).get(var, []) if var else []
+    out = []
+    for p in kb.placements_for(hc, hazard):
+        if not buildable_placement(p):
+            continue
+        parent = p.split(":", 1)[1] if ":" in p else None
+        if parent is not None and var is not None and not (all(state_shown(kb, parent, s) for s in states)
+                                                           and _part_ok(hc, var, parent)):
+            continue
+        out.append(p)
+    return out
+
+
+_DRAWABLE: dict[tuple[int, str], bool] = {}
+
+
+def drawable(kb: KnowledgeBase, hc: HazardClass) -> bool:
+    """Can a proposal of ``hc`` be built and its fix planned with today's assets, builder and skills?"""
+    key = (id(kb), hc.id)
+    if key not in _DRAWABLE:
+        _DRAWABLE[key] = _drawable(kb, hc)
+    return _DRAWABLE[key]
+
+
+def _drawable(kb: KnowledgeBase, hc: HazardClass) -> bool:
+    if not _plannable(tuple(step.action for step in hc.recipe)):
+        return False
+    cat = catalogue()
+    if hc.default_containers and not any(c in cat for c in hc.default_containers):
+        return False
+    if hc.default_supports and not any(s in cat for s in hc.default_supports):
+        return False
+    var = relation_variable(hc)
+    others = [v for v in hc.variable_names() if v not in (hc.hazard_variable, var)]
+    for v in others:  # a co-object plays it (the fume source of a stuffy room)
+        if v != "$target" and not [o for o in kb.static_candidates(hc, v) if o in cat]:
+            return False
+    return any(placements_for(kb, hc, h) for h in hazards_for(kb, hc))
