@@ -1,29 +1,34 @@
-"""Free-text tasks (``brainstorm --tasks-text FILE``): one plain description per line, grounded offline.
+"""Free-text tasks (``brainstorm --tasks-text FILE``): one plain description per line, built as stated.
 
-A person writes "Grandma's pills are on the coffee table" rather than a TaskProposal. Without a model,
-the same grounding the LLM engine uses reads the line: the object, room and placement it mentions
-(spelling and aliases), the hazard class by Sentence-BERT retrieval among the classes its objects can
-be the hazard of, and, when no object is named, the class's hazard object retrieved from the text.
-The rest of the scenario (target asset, container, person) is filled from the knowledge base so the
-proposal can be built; the line itself stays the description. With an LLM configured, the LLM
+A person writes "Grandma's pills are on the coffee table" rather than a TaskProposal. Offline, each
+line is read (``line_parse``) into the object at fault, the objects it relates to and the words that
+say where and in what state, and the hazard is composed from the mechanisms (``line_compose``); the
+names are the catalogue's own words or aliases, never a retrieved look-alike. A line that states no
+hazard the mechanisms can build, or names an object the catalogue or its assets lack, fails alone
+with a reason that names the closest thing; the other lines go on. Every choice is recorded in the
+task's ``grounding`` (which words became which object, state, place and mechanism, and what was a
+class default), the line itself is the description, and the task is marked ``source="user_text"``
+so the builder adds no hazard-free variant and no second hazard. With an LLM configured, the LLM
 engine structures each line instead (``LLMEngine.from_texts``) and grounds its names the same way.
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 
 from anomalygen.brainstorm.grounding import Grounder, class_targets
-from anomalygen.brainstorm.idea import Texts, task_id, to_proposal
+from anomalygen.brainstorm.idea import Idea, Texts, task_id, to_proposal
+from anomalygen.brainstorm.line_compose import Composition, Refused, compose_line, placement_for
+from anomalygen.brainstorm.line_parse import ParsedLine, parse_line
 from anomalygen.brainstorm.realise import realise
 from anomalygen.errors import UserError
 from anomalygen.knowledge import KnowledgeBase
 from anomalygen.knowledge.grounding import NameGrounder
+from anomalygen.knowledge.mechanisms import load_mechanisms
 from anomalygen.rng import item_rng
 from anomalygen.schema import BrainstormMode, Engine, GroundingMatch, TaskProposal
 
-WHERE = "text"
+USER_TEXT = "user_text"
 
 
 def read_lines(path: str | Path) -> list[str]:
@@ -41,62 +46,111 @@ def read_lines(path: str | Path) -> list[str]:
 class TextGrounder:
     """Turns one plain description into a buildable TaskProposal, recording every grounding step."""
 
-    def __init__(self, kb: KnowledgeBase, grounder: NameGrounder | None = None, *, seed: int = 0):
+    def __init__(self, kb: KnowledgeBase, grounder: NameGrounder | None = None, *, seed: int = 0,
+                 catalogue: set[str] | None = None):
         self.kb = kb
         self.g = grounder or NameGrounder(kb)
         self.seed = seed
+        self.ms = load_mechanisms()
         self.filler = Grounder(kb, None, rich=False)
+        self._catalogue = catalogue
 
-    def hazard_and_class(self, line: str) -> tuple[str, str, list[GroundingMatch]]:
-        """(class id, hazard object, matches); raises ValueError when no class fits the text."""
-        kb, g = self.kb, self.g
-        mentioned = g.objects.mentions(line)
-        cls = g.hazard_class("", line, hazard_objects=mentioned).model_copy(update={"written": line})
-        if cls.grounded in (None, "other"):
-            raise ValueError(f"fits no hazard class (closest {cls.alternatives[:1] or ['-']}, similarity {cls.similarity:.2f})")
-        hc = kb.hazard_classes[cls.grounded]
-        candidates = kb.hazard_candidates(hc)
-        named = [m for m in mentioned if m in candidates]
-        if named:  # the text names it (by spelling or alias)
-            hazard = GroundingMatch(field="scenario.hazard_object", written=line, grounded=named[0], method="normalised")
-        else:  # the text only describes it: the class's candidate closest to the words
-            ranked = g.objects.ranked(line, set(candidates), 3)
-            hazard = GroundingMatch(
-                field="scenario.hazard_object", written=line, grounded=ranked[0][0], method="retrieval",
-                similarity=round(ranked[0][1], 4), alternatives=[n for n, _ in ranked[1:]],
-            )
-        return hc.id, hazard.grounded or candidates[0], [cls, hazard]
+    @property
+    def catalogue(self) -> set[str]:
+        if self._catalogue is None:
+            from anomalygen.brainstorm.drawable import catalogue
+
+            self._catalogue = set(catalogue())
+        return self._catalogue
+
+    def compose(self, line: str) -> tuple[ParsedLine, Composition]:
+        """The line read and its hazard composed; raises Refused (a ValueError) with the reason."""
+        parsed = parse_line(line, self.g)
+        comp = compose_line(parsed, self.kb, self.ms, self.g)
+        missing = [m.name for m in (comp.fault, comp.other) if m is not None and m.name not in self.catalogue]
+        if missing:
+            raise Refused(f"'{missing[0]}' is known but has no asset in the catalogue yet, so it cannot be built")
+        return parsed, comp
 
     def proposal(self, line: str, index: int) -> TaskProposal:
-        kb, g = self.kb, self.g
-        class_id, hazard, matches = self.hazard_and_class(line)
-        hc = kb.hazard_classes[class_id]
-        mentioned = g.objects.mentions(line)
+        kb = self.kb
+        parsed, comp = self.compose(line)
+        hc = comp.hc
+        hazard = comp.fault.name
+        placement, placement_said = placement_for(parsed, hc, comp, self.ms)
+        rooms_said = [r for r in parsed.rooms]
+        fitting = [r for r in hc.rooms if r in kb.objects[hazard].rooms] or list(hc.rooms) or list(kb.objects[hazard].rooms)
+        room = rooms_said[0] if rooms_said else (fitting[0] if fitting else "living_room")
+        mentioned = [m.name for m in parsed.mentions]
         targets = class_targets(kb, hc)
-        target = next((m for m in [hazard, *mentioned] if m in targets), targets[0])
-        rng = item_rng(self.seed, "tasks-text", index)
-        idea = self.filler.ground(rng, hc, target, agent=None, agent_index=0, round_=1)
-        placements = kb.placements_for(hc, hazard)
-        said = g.placements.mentions(line, placements)
-        placement = said[0] if said else (g.placements.ranked(line, set(placements), 1) or [(placements[0], 0.0)])[0][0]
-        rooms = g.rooms.mentions(line)
-        room = rooms[0] if rooms else ([r for r in hc.rooms if r in kb.objects[hazard].rooms] or list(hc.rooms) or [idea.room])[0]
+        target = next((m for m in [hazard, *mentioned] if m in targets), targets[0] if targets else hazard)
         containers = kb.containers_for(hc, hazard)
         container = next((m for m in mentioned if m in containers), containers[0] if containers else None)
-        idea = replace(idea, hazard=hazard, placement=placement, room=room, container=container, co_objects=idea.co_objects)
-        matches += [
-            GroundingMatch(field="target_asset", written=line, grounded=target, method="class_default" if target not in mentioned else "normalised"),
-            GroundingMatch(field="scenario.placement", written=line, grounded=placement, method="normalised" if said else "retrieval"),
-            GroundingMatch(field="scenario.room", written=line, grounded=room, method="normalised" if rooms else "class_default"),
-        ]
+        support = next((s for s in hc.default_supports if s in mentioned), hc.default_supports[0] if hc.default_supports else None)
+        others = self._others(hc, comp, mentioned, hazard, container)
+        rng = item_rng(self.seed, "tasks-text", index)
+        idea = Idea(class_id=hc.id, target=target, hazard=hazard, placement=placement, room=room, person=hc.at_risk,
+                    container=container, support=support, co_objects=tuple(others))
         words = realise(idea, kb, rng, perspective=False)
         texts = Texts(words.name, words.explanation, line, words.solution, words.success_condition)
         proposal = to_proposal(idea, texts, index, kb, engine=Engine.KNOWLEDGE, mode=BrainstormMode.PLAIN, seed=self.seed)
-        return proposal.model_copy(update={"grounding": matches, "id": task_id(index, line)})
+        matches = self._record(line, parsed, comp, placement, placement_said, room, bool(rooms_said), target,
+                               container, mentioned)
+        return proposal.model_copy(update={"grounding": matches, "id": task_id(index, line), "source": USER_TEXT})
+
+    def _others(self, hc, comp: Composition, mentioned: list[str], hazard: str, container: str | None) -> list[str]:
+        """Co-objects: the object each other precondition variable needs (the related one when the line
+        names it), then whatever else the line names; nothing the line does not mention is added."""
+        from anomalygen.brainstorm.drawable import relation_variable
+
+        related = relation_variable(hc)
+        out: list[str] = []
+        for var in [v for v in hc.variable_names() if v != hc.hazard_variable]:
+            if var == related and comp.other is not None:
+                out.append(comp.other.name)
+            elif var != "$target":
+                fits = [m for m in mentioned if m in self.kb.static_candidates(hc, var)]
+                out.append(fits[0] if fits else self.kb.static_candidates(hc, var)[0])
+        for m in mentioned:
+            if m not in out and m not in (hazard, container) and not self.g.is_room(m):
+                out.append(m)
+        return out
+
+    def _record(self, line, parsed, comp: Composition, placement, placement_said, room, room_said, target,
+                container, mentioned) -> list[GroundingMatch]:
+        hc = comp.hc
+        out = [GroundingMatch(field="scenario.hazard_object", written=comp.fault.words, grounded=comp.fault.name,
+                              method="parsed")]
+        if comp.other is not None:
+            out.append(GroundingMatch(field=f"relation.{comp.other.relation}", written=f"{comp.other.prep} {comp.other.words}",
+                                      grounded=comp.other.name, method="parsed"))
+        if comp.condition_words:
+            out.append(GroundingMatch(field="state", written=", ".join(comp.condition_words),
+                                      grounded=hc.composition.condition, method="parsed"))
+        elif comp.assumed:
+            out.append(GroundingMatch(field="state", written="", grounded=hc.composition.condition, method="class_default"))
+        if comp.place_words:
+            out.append(GroundingMatch(field="place", written=", ".join(comp.place_words), grounded=hc.composition.place,
+                                      method="parsed"))
+        c = hc.composition
+        out.append(GroundingMatch(field="mechanism", written=line, grounded=c.mechanism, method="composed",
+                                  alternatives=[x for x in (c.kind, c.condition, c.place, c.fix) if x]))
+        out.append(GroundingMatch(field="hazard_class", written=line, grounded=hc.id, method="composed"))
+        out += [
+            GroundingMatch(field="scenario.placement", written=line, grounded=placement,
+                           method="parsed" if placement_said else "class_default"),
+            GroundingMatch(field="scenario.room", written=line, grounded=room, method="normalised" if room_said else "class_default"),
+            GroundingMatch(field="target_asset", written=line, grounded=target,
+                           method="normalised" if target in mentioned else "class_default"),
+        ]
+        if container is not None:
+            out.append(GroundingMatch(field="scenario.container", written=line, grounded=container,
+                                      method="normalised" if container in mentioned else "class_default"))
+        return out
 
 
 def tasks_from_lines(lines: list[str], kb: KnowledgeBase, *, seed: int = 0) -> tuple[list[TaskProposal], dict[str, str]]:
-    """One proposal per line; a line that fits no class fails alone (``line<N>``: reason)."""
+    """One proposal per line; a line that states no buildable hazard fails alone (``line<N>``: reason)."""
     tg = TextGrounder(kb, seed=seed)
     tasks: list[TaskProposal] = []
     errors: dict[str, str] = {}

@@ -41,7 +41,7 @@ class Relation(KBModel):
     """How a place relates the object at fault to another named object, for reading a user's line:
     ``on``/``inside``/``near`` another object that fills ``variable`` or is of ``category``."""
 
-    type: Literal["on", "inside", "near"]
+    type: str = Field(description="on, inside or near; alternatives 'on|inside' (a blanket 'in' the crib lies on it)")
     variable: str | None = None
     category: str | None = None
 
@@ -86,6 +86,7 @@ class Composition(KBModel):
     targets: list[str] = Field(default_factory=list)
     rooms: list[str] = Field(default_factory=list)
     placements: list[str] = Field(default_factory=list, description="overrides the place's placements")
+    assume_condition: bool = Field(False, description="a user's line need not state the condition (a heater is on)")
 
 
 class Mechanism(KBModel):
@@ -101,12 +102,20 @@ class Mechanism(KBModel):
     compositions: list[Composition]
 
 
+class Unsupported(KBModel):
+    """Words that say a hazard no mechanism can build, and why (a line with them is refused)."""
+
+    cues: list[str]
+    reason: str
+
+
 class MechanismSet(KBModel):
     kinds: dict[str, Fragment]
     conditions: dict[str, Fragment]
     places: dict[str, Fragment]
     fixes: dict[str, Fix]
     mechanisms: list[Mechanism]
+    unsupported: list[Unsupported] = Field(default_factory=list)
 
     def mechanism(self, mechanism_id: str) -> Mechanism:
         return next(m for m in self.mechanisms if m.id == mechanism_id)

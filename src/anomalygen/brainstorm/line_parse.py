@@ -1,0 +1,226 @@
+"""Reading one plain hazard line: which objects it names, how they relate, which words it uses.
+
+No model is needed: the catalogue's names and aliases are matched word by word (longest phrase
+first), the preposition before a name says how it relates to the object at fault ("on the stove",
+"next to the curtains", "in the sink"), and noun phrases the catalogue does not know are kept so that
+a line about a toaster-oven or paint thinner can be refused by name instead of being read as
+something else. Which hazard the words make is decided in ``line_compose.py`` from the mechanisms.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from anomalygen.knowledge.grounding import NameGrounder, singular
+
+_WORD = re.compile(r"[a-z0-9]+(?:'[a-z]+)?|[,.;:!?]")
+
+#: Preposition phrases (longest first) and the relation they put the next named object in.
+RELATIONS: tuple[tuple[str, str], ...] = (
+    ("on top of", "on"), ("right on", "on"), ("draped over", "on"), ("resting on", "on"), ("lying on", "on"),
+    ("sitting on", "on"), ("on", "on"), ("onto", "on"), ("atop", "on"), ("over", "on"), ("across", "on"),
+    ("at the bottom of", "inside"), ("inside", "inside"), ("into", "inside"), ("in", "inside"), ("within", "inside"),
+    ("next to", "near"), ("close to", "near"), ("near to", "near"), ("right by", "near"), ("up against", "near"),
+    ("beside", "near"), ("besides", "near"), ("by", "near"), ("near", "near"), ("against", "near"), ("alongside", "near"),
+    ("touching", "near"), ("around", "near"), ("from", "near"), ("under", "under"), ("underneath", "under"),
+    ("beneath", "under"), ("below", "under"), ("behind", "near"),
+)
+#: Words that may stand between a preposition and the name it governs ("on the old kitchen stove").
+FILLER = frozenset({
+    "the", "a", "an", "my", "our", "your", "his", "her", "their", "its", "this", "that", "these", "those", "some",
+    "one", "two", "open", "old", "hot", "lit", "full", "running", "kitchen", "bathroom", "bedroom", "living", "room",
+    "baby's", "child's", "front", "back", "top", "edge", "of", "low", "high", "big", "small", "little", "wet", "empty",
+    "gas", "electric", "main", "nearby", "very", "same", "wooden", "glass",
+})
+DETERMINERS = frozenset({"a", "an", "the", "some", "my", "our", "your", "his", "her", "their", "this", "that",
+                         "these", "those", "several", "few", "two", "three", "loose", "any", "someone's", "grandma's"})
+#: Words that end a noun phrase (verbs, auxiliaries, prepositions, conjunctions).
+STOP = frozenset({
+    "is", "are", "was", "were", "be", "been", "being", "has", "have", "had", "left", "lying", "lies", "lie", "sitting",
+    "sits", "sit", "stands", "standing", "stand", "hanging", "hangs", "rests", "resting", "placed", "put", "kept",
+    "stored", "and", "or", "but", "with", "while", "where", "which", "that", "so", "because", "since", "of", "to",
+    "for", "at", "as", "can", "could", "might", "may", "will", "would", "should", "still", "not", "no", "too",
+    "there", "here", "it", "they", "them", "keeps", "gets", "got", "runs", "run", "near", "next", "on", "in", "into",
+    "by", "from", "under", "over", "beside", "against", "inside", "onto", "within", "up", "down", "out", "away",
+    "all", "just", "right", "again", "unattended", "without", "after", "before", "when", "if", "lit", "plugged",
+})
+#: Heads of noun phrases that are not objects at fault (places, people, time, generic words).
+NOT_OBJECTS = frozenset({
+    "floor", "ground", "edge", "side", "corner", "middle", "top", "bottom", "front", "back", "reach", "height",
+    "room", "kitchen", "bathroom", "bedroom", "hallway", "hall", "nursery", "office", "house", "home", "flat",
+    "toddler", "child", "children", "kid", "kids", "baby", "babies", "infant", "grandma", "grandpa", "guest", "guests",
+    "someone", "somebody", "anyone", "everyone", "people", "person", "family", "parent", "parents", "adult", "adults",
+    "dog", "cat", "pet", "pets", "minute", "minutes", "hour", "hours", "day", "days", "night", "week", "weeks",
+    "morning", "evening", "time", "while", "way", "path", "walkway", "doorway", "corridor", "thing", "things", "stuff",
+    "lot", "pair", "bunch", "pile", "set", "piece", "couple", "bit", "handful", "few", "hand", "hands", "fingers",
+    "lunch", "dinner", "breakfast", "use", "water", "heat", "fire", "flame", "flames", "fumes", "smoke", "air", "risk",
+    "hazard", "danger", "level", "area", "spot", "place", "position", "wall", "window sill", "sill", "handle", "lid",
+    "door", "drawer", "knob", "switch", "tap", "plug", "outlet", "socket", "cord", "cable", "shelf", "one", "ones",
+    "inch", "inches", "foot", "feet", "metre", "metres", "meter", "meters", "cm", "little",
+})
+#: Catalogue names that, right after another name, are a part of it ("fridge door", "toilet lid").
+PART_NAMES = frozenset({"Door", "Window"})
+#: Catalogue containers whose "X of Y" names Y as the thing ("a bottle of bleach", "a box of matches").
+CONTAINER_WORDS = frozenset({"Bottle", "Box", "Bucket", "bowl", "cup", "mug", "glass", "basket", "storage_box", "plate"})
+
+
+@dataclass
+class Mention:
+    """A catalogue name in the line: its token span, the words, and how it relates to the object at fault."""
+
+    start: int
+    end: int
+    name: str
+    words: str
+    relation: str | None = None  # on / inside / near / under, from the preposition before it
+    prep: str | None = None
+
+
+@dataclass
+class ParsedLine:
+    line: str
+    tokens: list[str]
+    mentions: list[Mention] = field(default_factory=list)
+    unknown: list[tuple[int, str]] = field(default_factory=list)  # (token index, phrase) the catalogue does not know
+    rooms: list[str] = field(default_factory=list)
+
+    @property
+    def text(self) -> str:
+        return " " + " ".join(t for t in self.tokens if t.isalnum() or "'" in t) + " "
+
+    def says(self, cue: str) -> bool:
+        """Does the line use the phrase (whole words, any case)?"""
+        words = " ".join(_WORD.findall(cue.lower()))
+        return bool(words) and f" {words} " in self.text
+
+    def said(self, cues) -> list[str]:
+        return [c for c in cues if self.says(c)]
+
+    def subjects(self) -> list[Mention]:
+        """Named objects not governed by a preposition, in order: candidates for the object at fault."""
+        return [m for m in self.mentions if m.relation is None]
+
+
+def tokens_of(line: str) -> list[str]:
+    return _WORD.findall(line.lower().replace("’", "'"))
+
+
+def relation_before(tokens: list[str], start: int) -> tuple[str | None, str | None]:
+    """The preposition that governs the name starting at ``start`` (through up to four determiners
+    and modifiers: 'next to the hot flat iron'), if any."""
+    i = start
+    while i > 0 and start - i < 4 and tokens[i - 1].isalnum() and (tokens[i - 1] in FILLER or tokens[i - 1] not in STOP) \
+            and not _is_preposition_end(tokens, i):
+        i -= 1
+    for phrase, relation in RELATIONS:
+        words = phrase.split()
+        if i - len(words) >= 0 and tokens[i - len(words):i] == words:
+            return relation, phrase
+    return None, None
+
+
+def _is_preposition_end(tokens: list[str], i: int) -> bool:
+    """Does a relation phrase end just before position ``i``?"""
+    return any(i - len(ph.split()) >= 0 and tokens[i - len(ph.split()):i] == ph.split() for ph, _ in RELATIONS)
+
+
+def parse_line(line: str, g: NameGrounder, *, longest: int = 4) -> ParsedLine:
+    """Mentions of catalogue objects (spelling and aliases), with relations; unknown noun phrases; rooms."""
+    tokens = tokens_of(line)
+    words = [t.removesuffix("'s") for t in tokens]
+    pool = set(g.kb.objects)
+    taken = [False] * len(words)
+    found: list[Mention] = []
+    for n in range(longest, 0, -1):
+        for i in range(len(words) - n + 1):
+            if any(taken[i:i + n]) or not all(w.isalnum() for w in words[i:i + n]):
+                continue
+            phrase = " ".join(words[i:i + n])
+            hit = g.objects.spelled(phrase, pool)
+            if hit is None:
+                continue
+            found.append(Mention(i, i + n, hit[0], phrase))
+            taken[i:i + n] = [True] * n
+    found.sort(key=lambda m: m.start)
+    found = [_with_modifier(m, words, taken, g, pool) for m in found]
+    found = _merge(found, words)
+    for m in found:
+        m.relation, m.prep = relation_before(words, m.start)
+    parsed = ParsedLine(line, tokens, found, rooms=g.rooms.mentions(line))
+    parsed.unknown = _unknown_phrases(words, taken, g)
+    return parsed
+
+
+def gerund_compound(words: list[str], m: Mention, states: frozenset[str]) -> str | None:
+    """'curling iron', 'ironing board': a name right after an -ing word that says no state is a
+    different thing with a compound name (a burning candle or a running tap is the candle or the tap)."""
+    k = m.start - 1
+    if m.end - m.start != 1 or k < 0:
+        return None
+    w = words[k]
+    if w.endswith("ing") and len(w) > 5 and w not in states and w not in STOP:
+        return f"{w} {words[m.start]}"
+    return None
+
+
+def _with_modifier(m: Mention, words: list[str], taken: list[bool], g: NameGrounder, pool: set[str]) -> Mention:
+    """'plastic shopping bag': a modifier one or two words before a one-word name may make a longer
+    name ('plastic bag'), which wins over the bare word ('bag')."""
+    if m.end - m.start != 1:
+        return m
+    for back in (1, 2):
+        k = m.start - back
+        if k < 0 or taken[k] or not words[k].isalnum() or words[k] in STOP:
+            continue
+        hit = g.objects.spelled(f"{words[k]} {words[m.start]}", pool)
+        if hit is not None:
+            return Mention(k, m.end, hit[0], " ".join(words[k:m.end]))
+    return m
+
+
+def _merge(found: list[Mention], words: list[str]) -> list[Mention]:
+    """'bottle of bleach' -> the bleach; 'fridge door' -> the fridge; a name said twice -> once."""
+    out: list[Mention] = []
+    for m in found:
+        prev = out[-1] if out else None
+        if prev is not None and m.name in PART_NAMES and m.start == prev.end:
+            continue  # the fridge('s) door
+        if prev is not None and m.start == prev.end:
+            out[-1] = m  # 'bread knife', 'glass vase': the last noun names the thing
+            continue
+        if prev is not None and prev.name in CONTAINER_WORDS and words[prev.end:prev.end + 1] == ["of"] \
+                and m.start - prev.end <= 3:
+            out[-1] = m  # a bottle of bleach is the bleach
+            continue
+        if prev is not None and m.name in PART_NAMES and words[m.end:m.end + 1] == ["of"]:
+            pass
+        out.append(m)
+    # "the door of the oven": the part goes, the owner stays
+    return [m for i, m in enumerate(out) if not (m.name in PART_NAMES and i + 1 < len(out)
+                                                  and words[m.end:m.end + 1] == ["of"] and out[i + 1].start - m.end <= 3)]
+
+
+def _unknown_phrases(words: list[str], taken: list[bool], g: NameGrounder) -> list[tuple[int, str]]:
+    """Noun phrases (after a determiner, or opening the line) that name no catalogue object."""
+    out: list[tuple[int, str]] = []
+    starts = [0] + [i + 1 for i, w in enumerate(words) if w in DETERMINERS or w == "of"]
+    for s in starts:
+        chunk: list[int] = []
+        i = s
+        while i < len(words) and len(chunk) < 3 and words[i].isalnum() and words[i] not in STOP \
+                and words[i] not in DETERMINERS:
+            chunk.append(i)
+            i += 1
+        if not chunk or any(taken[k] for k in chunk):
+            continue
+        head = singular(words[chunk[-1]])
+        if head in NOT_OBJECTS or words[chunk[-1]] in NOT_OBJECTS or g.is_room(words[chunk[-1]]) or len(head) < 3:
+            continue
+        phrase = " ".join(words[k] for k in chunk)
+        if g.placements.spelled(phrase, set(g.placements.names)) is not None:
+            continue
+        if i < len(words) and words[i] == "of" and any(taken[i + 1:i + 4]):
+            continue  # 'a loaf of', 'a tray of': a quantity of the named thing that follows
+        out.append((chunk[0], phrase))
+    return sorted(set(out))

@@ -1,0 +1,73 @@
+"""``--tasks-text`` offline: a line becomes the hazard it states, composed from the mechanisms, or is
+refused with a reason that names the closest thing; it is never read as another object or danger."""
+
+from __future__ import annotations
+
+import pytest
+
+from anomalygen.brainstorm.free_text import TextGrounder, tasks_from_lines
+from anomalygen.brainstorm.line_compose import Refused
+from anomalygen.knowledge import load_kb
+
+
+@pytest.fixture(scope="module")
+def reader():
+    kb = load_kb()
+    return TextGrounder(kb, catalogue=set(kb.objects))  # the knowledge's objects, assets or not
+
+
+@pytest.mark.parametrize(("line", "cls", "hazard", "placement"), [
+    ("A towel lies on the stove and the burner is lit.", "clear_burning_risk_off_heat_source", "towel", "on:Stove"),
+    ("A power strip is lying in the bathroom sink, which is full of water.", "take_electrical_out_of_water", "PowerStrip",
+     "inside:Sink"),
+    ("The iron was left switched on, lying on the floor.", "switch_off_tool_on_floor", "iron", "floor"),
+    ("The space heater stands right next to the curtains.", "switch_off_heater_near_fabric", "SpaceHeater", "near:Curtains"),
+    ("Toys are lying all over the stairs.", "clear_item_from_stairs", "toy_block", "on:Stairs"),
+    ("A pot on the stove has its handle turned outward.", "turn_pan_handle_inward", "KitchenPot", "on:Stove"),
+    ("Paper towels are sitting right beside a lit burner.", "clear_burning_risk_near_heat_source", "PaperTowels", "near:Stove"),
+    ("The baby gate at the top of the stairs was left open.", "close_baby_gate", "BabyGate", "floor"),
+])
+def test_a_line_becomes_the_hazard_it_states(reader, line, cls, hazard, placement):
+    task = reader.proposal(line, 1)
+    assert (task.hazard_class, task.scenario.hazard_object, task.scenario.placement) == (cls, hazard, placement)
+    assert task.description == line and task.source == "user_text"
+    by_field = {m.field: m for m in task.grounding}
+    assert by_field["mechanism"].method == "composed" and by_field["scenario.hazard_object"].method == "parsed"
+    assert by_field["hazard_class"].grounded == cls
+
+
+def test_the_scene_is_told_the_states_and_parts_the_line_needs(reader):
+    water = reader.proposal("A power strip is lying in the bathroom sink, which is full of water.", 1)
+    assert water.scenario.states == {"Sink": ["contains_water"]} and "Sink" in water.scenario.co_objects
+    fire = reader.proposal("A towel lies on the stove and the burner is lit.", 2)
+    assert [(a.object, a.part, a.initial_state) for a in fire.articulations] == [("Stove", "knob", "on")]
+    heater = reader.proposal("The space heater stands right next to the curtains.", 3)
+    state = next(m for m in heater.grounding if m.field == "state")
+    assert state.method == "class_default" and state.grounded == "switched_on"  # not said: recorded as assumed
+
+
+@pytest.mark.parametrize(("line", "reason"), [
+    ("Shards of a broken glass are scattered on the kitchen floor.", "broken"),
+    ("A curling iron was left on by the bathroom sink.", "no object 'curling iron'"),
+    ("A bottle of cooking oil stands right on the hob.", "no object 'cooking oil'"),
+    ("An extension cord runs under the living room rug.", "under rug"),
+    ("A laptop is lying on the sofa.", "closest"),
+])
+def test_a_line_no_mechanism_covers_is_refused_with_a_reason(reader, line, reason):
+    with pytest.raises(Refused, match=reason):
+        reader.compose(line)
+
+
+def test_one_bad_line_fails_alone_and_an_object_without_an_asset_says_so():
+    lines = ["A chef's knife was left at the edge of the kitchen counter.",
+             "Shards of a broken glass are scattered on the kitchen floor.",
+             "A power strip is lying in the bathroom sink, which is full of water.",
+             "Grandma's pill bottle was left on the low coffee table."]
+    tasks, errors = tasks_from_lines(lines, load_kb())
+    assert [t.scenario.hazard_object for t in tasks] == ["kitchen_knife", "pill_bottle"]
+    assert set(errors) == {"line2", "line3"}
+    assert "broken" in errors["line2"]
+    from anomalygen.brainstorm.drawable import catalogue
+
+    if "PowerStrip" not in catalogue():  # until the asset lands, the line cannot be built and says so
+        assert "no asset" in errors["line3"] and "PowerStrip" in errors["line3"]
