@@ -124,6 +124,10 @@ class RunFolder:
 
     def __init__(self, root: str | Path):
         self.root = Path(root)
+        if (self.root / "knowledge").is_dir():  # hazard classes an LLM proposed for this run
+            from anomalygen.knowledge.base import add_run_classes
+
+            add_run_classes(self.root)
 
     # -- opening
     @classmethod

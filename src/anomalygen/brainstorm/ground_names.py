@@ -1,10 +1,17 @@
-"""Ground every name of one LLM-written proposal before it is validated (issue 15).
+"""Ground every name of one LLM-written proposal before it is validated (issues 15 and 25).
 
 The model writes what it means ("kettle", "cabinet", "household_hazard"); this turns each name into
 the knowledge-base name with ``knowledge.grounding.NameGrounder`` and keeps a record of every
-resolution. A name is reported as a problem (and goes back to the model) only when even retrieval
-finds nothing close enough; a room written as an object is dropped as context; a hazard that fits no
-class becomes ``other`` with the model's own words kept.
+resolution, but never reads one thing as another:
+- an object found only by retrieval counts only when it is close and clearly ahead of the runner-up
+  (``RETRIEVAL_FLOOR``/``RETRIEVAL_MARGIN``): "sofa" is not a chair, it goes back to the model;
+- a hazard class is its exact name, else the hazard the proposal's own text states, composed from
+  the mechanisms like a user's line (for ``--tasks-text`` the user's line itself); a category word
+  ("household_hazard") or "other" is never turned into a class by retrieval: it is composed, or the
+  model's own ``new_class``, or goes back to the model;
+- a catalogue object written as the target that is no target category keeps its role as the hazard,
+  and the class supplies the target;
+- "none", "null" and the like mean empty; a room written as an object is context and is dropped.
 """
 
 from __future__ import annotations
@@ -12,8 +19,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from anomalygen.brainstorm.llm_reply import LLMProposal
-from anomalygen.knowledge.grounding import NameGrounder
-from anomalygen.schema import GroundingMatch
+from anomalygen.knowledge.grounding import GENERIC_CLASS_WORDS, NameGrounder, normalise
+from anomalygen.schema import GroundingMatch, HazardCategory
+
+#: Values that mean "no such thing" (an empty container, no co-objects).
+EMPTY_WORDS = frozenset({"", "none", "null", "n_a", "na", "nothing", "no", "empty", "no_container", "not_applicable", "nil"})
 
 
 @dataclass
@@ -28,6 +38,7 @@ class GroundedNames:
     co_objects: list[str]
     matches: list[GroundingMatch] = field(default_factory=list)
     problems: list[str] = field(default_factory=list)
+    new_class: object | None = None  # a HazardClass the model proposed, validated
 
 
 def _closest(m: GroundingMatch) -> str:
@@ -35,8 +46,14 @@ def _closest(m: GroundingMatch) -> str:
     return f" (closest: {', '.join(shown)})" if shown else ""
 
 
-def ground_llm_names(raw: LLMProposal, g: NameGrounder) -> GroundedNames:
-    """Every name of ``raw`` grounded; unresolved ones keep their written form and add a problem."""
+def is_empty(value: str | None) -> bool:
+    return value is None or normalise(str(value)) in EMPTY_WORDS
+
+
+def ground_llm_names(raw: LLMProposal, g: NameGrounder, *, reader=None) -> GroundedNames:
+    """Every name of ``raw`` grounded; unresolved ones keep their written form and add a problem.
+
+    ``reader`` (a ``free_text.TextGrounder``) composes the hazard the proposal's text states."""
     kb = g.kb
     matches: list[GroundingMatch] = []
     problems: list[str] = []
@@ -51,40 +68,98 @@ def ground_llm_names(raw: LLMProposal, g: NameGrounder) -> GroundedNames:
             return m.written
         return m.grounded
 
-    context = " ".join(t for t in (raw.hazard_other, raw.name, raw.description, raw.explanation) if t)
     category = getattr(raw.category, "value", raw.category)
-    target = keep(g.target(raw.target_asset))
     hazard = keep(g.object(raw.hazard_object, "scenario.hazard_object"))
-    cls = g.hazard_class(raw.hazard_class, context, category=str(category), hazard_objects=[hazard] if hazard in kb.objects else [])
-    matches.insert(0, cls)
-    hazard_class = cls.grounded or "other"
-    hazard_other = raw.hazard_other
-    if hazard_class == "other":
-        hazard_other = raw.hazard_other or raw.explanation or raw.description  # the model's own words
-    hc = kb.hazard_classes.get(hazard_class)
+    spelled_target = g.objects.spelled(raw.target_asset, set(kb.objects))
+    target = None
+    if spelled_target is not None and spelled_target[0] not in kb.targets:
+        matches.append(GroundingMatch(field="target_asset", written=raw.target_asset, grounded=None, method="dropped"))
+    else:
+        target = keep(g.target(raw.target_asset))
+    cls, hazard_other, new_class = _hazard_class(raw, g, hazard, str(category), matches, problems, reader)
+    hc = kb.hazard_classes.get(cls) or new_class
+    if target is None:
+        from anomalygen.brainstorm.grounding import class_targets
+
+        options = ([hazard] if hazard in kb.targets else []) + (class_targets(kb, hc) if hc is not None and hc.id in kb.hazard_classes else [])
+        target = options[0] if options else (hc.target_assets[0] if hc is not None and hc.target_assets else "Table")
+        matches.append(GroundingMatch(field="target_asset", written=raw.target_asset, grounded=target, method="class_default"))
     room = keep(g.room(raw.room))
     placement = keep(g.placement(raw.placement))
     container = None
-    if raw.container:
-        if g.is_room(raw.container):
-            defaults = kb.containers_for(hc, hazard) if hc is not None and hazard in kb.objects else []
-            container = defaults[0] if defaults else None
-            matches.append(
-                GroundingMatch(
-                    field="scenario.container",
-                    written=raw.container,
-                    grounded=container,
-                    method="class_default" if container else "dropped",
-                )
-            )
-        else:
-            container = keep(g.object(raw.container, "scenario.container"))
+    if is_empty(raw.container):
+        if raw.container is not None:
+            matches.append(GroundingMatch(field="scenario.container", written=raw.container, grounded=None, method="dropped"))
+    elif g.is_room(raw.container):
+        defaults = kb.containers_for(hc, hazard) if hc is not None and hazard in kb.objects else []
+        container = defaults[0] if defaults else None
+        matches.append(GroundingMatch(field="scenario.container", written=raw.container, grounded=container,
+                                      method="class_default" if container else "dropped"))
+    else:
+        container = keep(g.object(raw.container, "scenario.container"))
     co_objects: list[str] = []
     for c in raw.co_objects:
-        if g.is_room(c):
+        if is_empty(c) or g.is_room(c):
             matches.append(GroundingMatch(field="scenario.co_objects", written=c, grounded=None, method="dropped"))
             continue
         name = keep(g.object(c, "scenario.co_objects"))
         if name not in co_objects:
             co_objects.append(name)
-    return GroundedNames(hazard_class, hazard_other, target, hazard, room, placement, container, co_objects, matches, problems)
+    return GroundedNames(cls, hazard_other, target, hazard, room, placement, container, co_objects, matches, problems,
+                         new_class)
+
+
+def _hazard_class(raw: LLMProposal, g: NameGrounder, hazard: str, category: str, matches: list, problems: list,
+                  reader) -> tuple[str, str | None, object | None]:
+    """(class id, hazard_other, proposed class): exact name, else what the text composes, else the
+    model's new class, else retrieval for a specific name; never retrieval for a category word."""
+    kb = g.kb
+    written = raw.hazard_class
+    hit = g.classes.spelled(written, set(kb.hazard_classes))
+    if hit is not None:
+        matches.insert(0, GroundingMatch(field="hazard_class", written=written, grounded=hit[0], method=hit[1]))
+        return hit[0], None, None
+    if reader is not None:
+        from anomalygen.brainstorm.line_compose import Refused
+
+        text = raw.description
+        try:
+            _, comp = reader.compose(text)
+        except Refused:
+            comp = None
+        if comp is not None and comp.fault.name == hazard:
+            matches.insert(0, GroundingMatch(field="hazard_class", written=written, grounded=comp.hc.id, method="composed",
+                                             alternatives=[comp.hc.composition.mechanism]))
+            return comp.hc.id, None, None
+    if raw.new_class is not None:
+        from anomalygen.brainstorm.new_class import to_class
+
+        placement = g.placement(raw.placement).grounded or "floor"
+        target = g.target(raw.target_asset).grounded or ""
+        container = None if is_empty(raw.container) else g.object(raw.container or "", "new_class").grounded
+        hc, bad = to_class(raw.new_class, kb, category=HazardCategory(category), placement=placement, target=target,
+                           container=container, support=None)
+        if hc is not None:
+            matches.insert(0, GroundingMatch(field="hazard_class", written=written, grounded=hc.id, method="composed",
+                                             alternatives=["new_class"]))
+            return hc.id, None, hc
+        problems.extend(bad)
+        return written, None, None
+    key = normalise(written)
+    if key == "other" and raw.hazard_other:  # the model says no class fits, in its own words
+        matches.insert(0, GroundingMatch(field="hazard_class", written=written, grounded="other", method="other"))
+        return "other", raw.hazard_other, None
+    if key in GENERIC_CLASS_WORDS or key in {c.value for c in HazardCategory}:
+        matches.insert(0, GroundingMatch(field="hazard_class", written=written, grounded=None, method="refused"))
+        problems.append(f"hazard_class '{written}' is a category, not a hazard class, and the text states no hazard the "
+                        "mechanisms compose: give a class id from the list, or describe a new one in new_class")
+        return written, None, None
+    cls = g.hazard_class(written, f"{raw.name}. {raw.description}", category=category,
+                         hazard_objects=[hazard] if hazard in kb.objects else [])
+    fits = cls.grounded in kb.hazard_classes and hazard in kb.hazard_candidates(kb.hazard_classes[cls.grounded])
+    if not fits:  # a retrieved class whose hazard could not be this object would be another hazard
+        cls = cls.model_copy(update={"grounded": "other", "method": "other"})
+    matches.insert(0, cls)
+    if cls.grounded in (None, "other"):
+        return "other", raw.hazard_other or raw.explanation or raw.description, None
+    return cls.grounded, None, None

@@ -23,8 +23,9 @@ from anomalygen.brainstorm.idea import ASPECTS, task_id
 from anomalygen.brainstorm.knowledge_engine import agent_roles, split_quota
 from anomalygen.brainstorm.llm_reply import LLMProposal
 from anomalygen.brainstorm.validate import proposal_problems
-from anomalygen.knowledge import PLACEMENTS, ROOMS, KnowledgeBase, load_kb
+from anomalygen.knowledge import PLACEMENTS, RECIPE_ARGS, ROOMS, KnowledgeBase, load_kb
 from anomalygen.knowledge.grounding import NameGrounder, shared_grounder
+from anomalygen.knowledge.predicates import PREDICATES
 from anomalygen.llm.schema_tools import reply_token_budget
 from anomalygen.rng import item_rng
 from anomalygen.schema import (
@@ -68,10 +69,15 @@ class LLMEngine:
     errors: dict[str, str] = field(default_factory=dict)
     accepted: list[TaskProposal] = field(default_factory=list)
     grounder: NameGrounder | None = None
+    new_classes: list = field(default_factory=list)  # classes the model proposed (validated), for the run folder
 
     def __post_init__(self) -> None:
+        from anomalygen.brainstorm.free_text import TextGrounder
+
         if self.grounder is None:
             self.grounder = NameGrounder(self.kb)
+        # reads the hazard a proposal's text states, as for a user's line (objects known, assets or not)
+        self.reader = TextGrounder(self.kb, self.grounder, seed=self.seed, catalogue=set(self.kb.objects))
 
     @property
     def token_cap(self) -> int | None:
@@ -138,7 +144,9 @@ class LLMEngine:
             if isinstance(reply, Exception):
                 self.errors[f"line{n}"] = str(reply)
                 continue
-            self._accept(reply.model_copy(update={"description": lines[n - 1]}), conv, 1, None, set(), f"line{n}", budget)
+            # the person's words stay the description (a repair may reword them: they are put back)
+            self._accept(reply.model_copy(update={"description": lines[n - 1]}), conv, 1, None, set(), f"line{n}", budget,
+                         line=lines[n - 1])
         return list(self.accepted)
 
     # ------------------------------------------------------------------ prompts
@@ -158,6 +166,9 @@ class LLMEngine:
         parts += [
             ROBOT_LIMITS,
             "Hazard classes (use the id, or 'other' with hazard_other):\n" + classes,
+            "If no class fits, you may instead describe the hazard as new_class: preconditions and success as "
+            "predicate calls over $hazard (predicates: " + ", ".join(sorted(PREDICATES)) + "), and a recipe of actions ("
+            + ", ".join(RECIPE_ARGS) + ").",
             "Target categories: " + ", ".join(kb.targets),
             "Other catalogue objects: " + ", ".join(kb.household),
             "Rooms: " + ", ".join(ROOMS),
@@ -193,8 +204,8 @@ class LLMEngine:
         return [{"role": "system", "content": self.system_prompt(role)}, {"role": "user", "content": ask}]
 
     # ------------------------------------------------------------------ validation and repair
-    def _accept(self, raw: LLMProposal, conv, r, role, shown_ids, item, budget) -> TaskProposal | None:
-        """Ground and validate one proposal; only names that even retrieval cannot place go back."""
+    def _accept(self, raw: LLMProposal, conv, r, role, shown_ids, item, budget, *, line: str | None = None) -> TaskProposal | None:
+        """Ground and validate one proposal; what cannot be grounded without a substitute goes back."""
         proposal, problems = self._convert(raw, r, role, shown_ids)
         for _ in range(self.repair_retries):
             if not problems:
@@ -202,7 +213,7 @@ class LLMEngine:
             fixed = self._repair(conv, raw, problems, budget)
             if fixed is None:
                 break
-            raw = fixed
+            raw = fixed if line is None else fixed.model_copy(update={"description": line})
             proposal, problems = self._convert(raw, r, role, shown_ids)
         if problems or proposal is None:
             self.errors[item] = "; ".join(problems)[:500]
@@ -210,7 +221,10 @@ class LLMEngine:
         if proposal.name.lower() in {p.name.lower() for p in self.accepted}:
             self.errors[item] = f"duplicate of an accepted proposal named '{proposal.name}'"
             return None
-        proposal = proposal.model_copy(update={"id": task_id(len(self.accepted) + 1, proposal.name)})
+        update = {"id": task_id(len(self.accepted) + 1, proposal.name)}
+        if line is not None:
+            update["source"] = "user_text"
+        proposal = proposal.model_copy(update=update)
         self.accepted.append(proposal)
         return proposal
 
@@ -232,7 +246,11 @@ class LLMEngine:
 
     def _convert(self, raw: LLMProposal, r: int, role: str | None, shown_ids: set[str]) -> tuple[TaskProposal | None, list[str]]:
         kb = self.kb
-        g = ground_llm_names(raw, self.grounder)
+        g = ground_llm_names(raw, self.grounder, reader=self.reader)
+        if g.new_class is not None and not g.problems:  # known to every later check in this process
+            kb.hazard_classes.setdefault(g.new_class.id, g.new_class)
+            if g.new_class not in self.new_classes:
+                self.new_classes.append(g.new_class)
         hc = kb.hazard_classes.get(g.hazard_class)
         category = hc.category if hc is not None else raw.category
         articulations = []

@@ -10,6 +10,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from anomalygen.brainstorm.new_class import LLMClass
 from anomalygen.schema import HazardCategory
 
 
@@ -37,3 +38,6 @@ class LLMProposal(BaseModel):
     success_condition: str = ""
     builds_on: list[str] = Field(default_factory=list, description="ids of other participants' proposals used")
     borrowed: list[str] = Field(default_factory=list, description="what was borrowed: mechanism, location, co_objects, person_at_risk")
+    new_class: LLMClass | None = Field(
+        None, description="only when no listed class fits: the hazard as a new class in the predicate language"
+    )

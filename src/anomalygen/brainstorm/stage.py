@@ -58,9 +58,7 @@ def generate(settings: Settings, run: RunFolder | None = None) -> tuple[list[Tas
         llm = LLMEngine.from_settings(settings)
         tasks = llm.run(cfg.n)
         if run is not None:
-            from anomalygen.llm import record_usage
-
-            record_usage(run, llm.client.reset_usage())
+            _keep_llm_output(run, llm)
         return tasks, llm.errors
     from anomalygen.brainstorm.knowledge_engine import KnowledgeEngine
 
@@ -82,13 +80,20 @@ def tasks_from_text(settings, run: RunFolder | None = None) -> tuple[list[TaskPr
         llm = LLMEngine.from_settings(settings)
         tasks = llm.from_texts(lines)
         if run is not None:
-            from anomalygen.llm import record_usage
-
-            record_usage(run, llm.client.reset_usage())
+            _keep_llm_output(run, llm)
         return tasks, llm.errors
     from anomalygen.knowledge import load_kb
 
     return tasks_from_lines(lines, load_kb(), seed=settings.seed)
+
+
+def _keep_llm_output(run: RunFolder, llm) -> None:
+    """The LLM's usage in the manifest, and the classes it proposed in the run's knowledge."""
+    from anomalygen.brainstorm.new_class import save_run_classes
+    from anomalygen.llm import record_usage
+
+    record_usage(run, llm.client.reset_usage())
+    save_run_classes(run.root, llm.new_classes)
 
 
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False) -> StageSummary:

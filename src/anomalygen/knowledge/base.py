@@ -13,6 +13,8 @@ from pathlib import Path
 from typing import Any
 
 from anomalygen.knowledge.models import (
+    DATA_DIR,
+    KNOWLEDGE_DIR,
     PLACEMENT_PREFIXES,
     PLACEMENTS,
     PROPERTIES,
@@ -38,8 +40,6 @@ PLACEMENT_SUPPORT: dict[str, str] = {
 }
 
 
-DATA_DIR = Path(__file__).resolve().parent.parent / "data"
-KNOWLEDGE_DIR = DATA_DIR / "knowledge"
 
 
 def _data(name: str) -> Any:
@@ -167,9 +167,51 @@ class KnowledgeBase:
         return next((a for a in alts if a in labels), None)
 
     # ------------------------------------------------------------------ consistency
+    def class_problems(self, hc: HazardClass) -> list[str]:
+        """What is wrong with one class against this knowledge base and the vocabulary (empty: usable).
+
+        Also the check a class an LLM proposes must pass before it is used (``brainstorm/new_class.py``)."""
+        from anomalygen.knowledge.predicates import PREDICATES
+
+        out: list[str] = []
+        names = set(self.objects)
+        voc = vocabulary()
+        where = f"class {hc.id}"
+        if not hc.preconditions or not hc.recipe or not hc.success:
+            out.append(f"{where}: needs preconditions, recipe and success")
+        declared = set(hc.variables)
+        if hc.hazard_variable not in declared:
+            out.append(f"{where}: hazard_variable {hc.hazard_variable} not declared")
+        for call in [*hc.preconditions, *hc.success]:
+            out += [f"{where}: {m}" for m in _call_problems(call, PREDICATES, names, declared)]
+        for step in hc.recipe:
+            allowed = RECIPE_ARGS[step.action]
+            if set(step.args) - set(allowed) or "object" not in step.args:
+                out.append(f"{where}: recipe step {step} has wrong arguments (wants {allowed})")
+            for v in step.args.values():
+                if v.startswith("$") and v not in declared:
+                    out.append(f"{where}: recipe uses undeclared variable {v}")
+        for p in hc.placements:
+            ok = p in PLACEMENTS or any(p.startswith(x) and p[len(x):] in names for x in PLACEMENT_PREFIXES)
+            if not ok:
+                out.append(f"{where}: unknown placement {p}")
+        out += [f"{where}: unknown container {c}" for c in hc.default_containers if c not in names]
+        out += [f"{where}: unknown support {c}" for c in hc.default_supports if c not in names]
+        out += [f"{where}: target {t} is not a target category" for t in hc.target_assets if t not in voc["targets"]]
+        out += [f"{where}: unknown room {r}" for r in hc.rooms if r not in ROOMS]
+        if "$container" in declared and not hc.default_containers:
+            out.append(f"{where}: uses $container but has no default_containers")
+        if "$support" in declared and not hc.default_supports:
+            out.append(f"{where}: uses $support but has no default_supports")
+        bad = [n for n in hc.hazard_objects if n not in self.static_candidates(hc, hc.hazard_variable)]
+        if bad:
+            out.append(f"{where}: hazard_objects {bad} do not meet the class's intrinsic preconditions")
+        if not self.hazard_candidates(hc):
+            out.append(f"{where}: no catalogue object can be its hazard")
+        return out
+
     def problems(self) -> list[str]:
         """Every broken reference in the data; empty when the knowledge base is consistent."""
-        from anomalygen.knowledge.predicates import PREDICATES
 
         out: list[str] = []
         names = set(self.objects)
@@ -186,38 +228,7 @@ class KnowledgeBase:
             if not 0 < lo <= hi:
                 out.append(f"object {o.name}: bad size_range {o.size_range}")
         for hc in self.hazard_classes.values():
-            where = f"class {hc.id}"
-            if not hc.preconditions or not hc.recipe or not hc.success:
-                out.append(f"{where}: needs preconditions, recipe and success")
-            declared = set(hc.variables)
-            if hc.hazard_variable not in declared:
-                out.append(f"{where}: hazard_variable {hc.hazard_variable} not declared")
-            for call in [*hc.preconditions, *hc.success]:
-                out += [f"{where}: {m}" for m in _call_problems(call, PREDICATES, names, declared)]
-            for step in hc.recipe:
-                allowed = RECIPE_ARGS[step.action]
-                if set(step.args) - set(allowed) or "object" not in step.args:
-                    out.append(f"{where}: recipe step {step} has wrong arguments (wants {allowed})")
-                for v in step.args.values():
-                    if v.startswith("$") and v not in declared:
-                        out.append(f"{where}: recipe uses undeclared variable {v}")
-            for p in hc.placements:
-                ok = p in PLACEMENTS or any(p.startswith(x) and p[len(x):] in names for x in PLACEMENT_PREFIXES)
-                if not ok:
-                    out.append(f"{where}: unknown placement {p}")
-            out += [f"{where}: unknown container {c}" for c in hc.default_containers if c not in names]
-            out += [f"{where}: unknown support {c}" for c in hc.default_supports if c not in names]
-            out += [f"{where}: target {t} is not a target category" for t in hc.target_assets if t not in voc["targets"]]
-            out += [f"{where}: unknown room {r}" for r in hc.rooms if r not in ROOMS]
-            if "$container" in declared and not hc.default_containers:
-                out.append(f"{where}: uses $container but has no default_containers")
-            if "$support" in declared and not hc.default_supports:
-                out.append(f"{where}: uses $support but has no default_supports")
-            bad = [n for n in hc.hazard_objects if n not in self.static_candidates(hc, hc.hazard_variable)]
-            if bad:
-                out.append(f"{where}: hazard_objects {bad} do not meet the class's intrinsic preconditions")
-            if not self.hazard_candidates(hc):
-                out.append(f"{where}: no catalogue object can be its hazard")
+            out += self.class_problems(hc)
         from anomalygen.knowledge.mechanisms import load_mechanisms, mechanism_problems
 
         out += mechanism_problems(load_mechanisms(), names)
@@ -255,6 +266,29 @@ def _call_problems(call: PredicateCall, predicates, names: set[str], declared: s
     if call.name == "room_is":
         out += [f"unknown room {r}" for r in str(call.args.get("room", "")).split("|") if r not in ROOMS]
     return out
+
+
+#: In a run folder: the classes an LLM proposed for that run (validated), used like any other class.
+RUN_CLASSES = Path("knowledge") / "classes.json"
+
+
+def add_run_classes(root: str | Path) -> list[str]:
+    """Add the classes a run folder carries to this process's knowledge base; returns the new ids.
+
+    Every process that opens the run (each stage, each worker) calls this through ``RunFolder``, so
+    a class proposed while brainstorming is known to the builder, the detector, the planner and the
+    referee. A class id already known is left as it is."""
+    path = Path(root) / RUN_CLASSES
+    if not path.is_file():
+        return []
+    kb = load_kb()
+    added = []
+    for raw in json.loads(path.read_text(encoding="utf-8")).get("classes", []):
+        hc = HazardClass.model_validate(raw)
+        if hc.id not in kb.hazard_classes:
+            kb.hazard_classes[hc.id] = hc
+            added.append(hc.id)
+    return added
 
 
 @functools.cache

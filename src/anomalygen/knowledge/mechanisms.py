@@ -20,7 +20,14 @@ from typing import Literal
 
 from pydantic import Field
 
-from anomalygen.knowledge.models import ArticulationTemplate, Composed, HazardClass, KBModel, RecipeStep
+from anomalygen.knowledge.models import (
+    KNOWLEDGE_DIR,
+    ArticulationTemplate,
+    Composed,
+    HazardClass,
+    KBModel,
+    RecipeStep,
+)
 from anomalygen.schema import HazardCategory, PredicateCall
 
 FAULT = "$F"  # the placeholder the fragments use for the mechanism's object at fault
@@ -123,8 +130,6 @@ class MechanismSet(KBModel):
 
 @functools.cache
 def load_mechanisms() -> MechanismSet:
-    from anomalygen.knowledge.base import KNOWLEDGE_DIR
-
     raw = json.loads((KNOWLEDGE_DIR / "mechanisms.json").read_text(encoding="utf-8"))
     return MechanismSet.model_validate({k: v for k, v in raw.items() if not k.startswith("_")})
 

@@ -7,11 +7,15 @@ weakening a hazard rule that detection, planning and evaluation all rely on.
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
 from anomalygen.schema import HazardCategory, PredicateCall, ScalarArg
+
+DATA_DIR = Path(__file__).resolve().parent.parent / "data"
+KNOWLEDGE_DIR = DATA_DIR / "knowledge"
 
 #: Hazard-relevant object properties. Every ``has_property`` argument and every object's
 #: ``properties`` entry must be one of these.
