@@ -10,7 +10,7 @@ from anomalygen.plan.bind import choose_container, ends_hazard
 
 def _scene():
     marble = obj("marble_0", "marble", at="floor", xy=(0.0, 0.0), size=(0.02, 0.02, 0.02))
-    carton = furniture("box_0", "Box", xy=(0.3, 0.0), size=(0.5, 0.5, 0.3), joints=[joint("flap", 0.0)])
+    carton = furniture("box_0", "Box", xy=(0.3, 0.0), size=(0.5, 0.5, 0.3))  # open: no lid, no flaps
     cabinet = furniture("storagefurniture_0", "StorageFurniture", xy=(1.5, 0.0), joints=[joint("drawer", 0.0)])
     trash = furniture("trashcan_0", "TrashCan", xy=(0.4, 0.4), size=(0.3, 0.3, 0.4), joints=[joint("lid", 0.0)])
     paper = obj("paper_ball_0", "paper_ball", at="floor", xy=(0.2, 0.3), size=(0.08, 0.08, 0.08))
@@ -22,9 +22,21 @@ def test_a_choking_hazard_goes_behind_a_drawer_not_into_the_nearer_open_carton()
     hc = kb.hazard_classes["remove_choking_hazards"]
     marble = next(o for o in g.objects if o.name == "marble_0")
     by = {o.name: o for o in g.objects}
-    assert not ends_hazard([hc], marble, by["box_0"], g)  # flaps do not keep a toddler out
+    assert not ends_hazard([hc], marble, by["box_0"], g)  # an open carton does not keep a toddler out
     assert ends_hazard([hc], marble, by["storagefurniture_0"], g)
     assert choose_container(hc, marble, g, kb) == "storagefurniture_0"
+
+
+def test_a_cardboard_box_whose_flaps_shut_keeps_a_choking_hazard_out_of_reach_as_a_lid_does():
+    kb, g = load_kb(), _scene()
+    hc = kb.hazard_classes["remove_choking_hazards"]
+    marble = next(o for o in g.objects if o.name == "marble_0")
+    carton = next(o for o in g.objects if o.name == "box_0")
+    flapped = carton.model_copy(update={"joints": [joint("flap", 0.0)]})
+    lidded = carton.model_copy(update={"joints": [joint("lid", 0.0)]})
+    assert ends_hazard([hc], marble, flapped, g) and ends_hazard([hc], marble, lidded, g)
+    g = g.model_copy(update={"objects": [flapped if o is carton else o for o in g.objects]})
+    assert choose_container(hc, marble, g, kb) == "box_0"  # the nearest container that ends it
 
 
 def test_litter_is_done_with_once_in_the_nearest_bin():

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 from anomalygen.knowledge import KnowledgeBase
 from anomalygen.schema import (
+    DOOR,
     ArticulationUse,
     AuxiliaryItem,
     BrainstormMode,
@@ -87,7 +88,7 @@ def articulations_for(idea: Idea, kb: KnowledgeBase) -> list[ArticulationUse]:
                 )
             )
     if idea.container and any(s.action == "open_joint" and s.args.get("object") == "$container" for s in hc.recipe):
-        part = next((s.args["label"] for s in hc.recipe if s.action == "open_joint"), "door")
+        part = next((s.args["label"] for s in hc.recipe if s.action == "open_joint"), DOOR)
         out.append(
             ArticulationUse(
                 object=idea.container,

@@ -13,8 +13,9 @@ import numpy as np
 from anomalygen.control.driver import PrimitiveResult
 from anomalygen.control.geometry import HINGE, static_box
 from anomalygen.control.parts import _world, actuate_part, grasp_candidates
+from anomalygen.schema import DOOR, DRAWER, ENCLOSING_LABELS, LID_LABELS
 
-LIDS = ("lid", "flap")
+LIDS = LID_LABELS
 OPEN_FRACTION = 0.85  # how far a lid, flap or drawer is opened to put something in
 
 
@@ -89,11 +90,11 @@ def holding_closure(drv, obj: str, contents: str):
     cup comes in, is the one whose compartment holds the object's centre."""
     lo_c, hi_c = drv.aabb(contents)
     c = (lo_c + hi_c) / 2
-    for js in closure_joints(drv, obj, ["door"]):
+    for js in closure_joints(drv, obj, [DOOR]):
         lo, hi, out = _compartment_when_shut(drv, obj, js)
         if np.all(c >= lo - 0.03) and np.all(c <= hi + 0.03):
             return js, (lo, hi, out)
-    for js in closure_joints(drv, obj, ["drawer"]):
+    for js in closure_joints(drv, obj, [DRAWER]):
         lo, hi = drv.aabb(drv.joint_body(js.name))
         if np.all(c[:2] >= lo[:2]) and np.all(c[:2] <= hi[:2]) and lo[2] <= c[2] <= hi[2] + 0.05:
             return js, None
@@ -129,14 +130,14 @@ def open_for_access(drv, obj: str, labels, contents: str | None = None):
     else:
         chosen = closure_joints(drv, obj, [lab for lab in labels if lab in LIDS])
     if not chosen:
-        drawer = best_drawer(drv, obj, closure_joints(drv, obj, ["drawer"]))
+        drawer = best_drawer(drv, obj, closure_joints(drv, obj, [DRAWER]))
         chosen = [drawer] if drawer is not None else []
     if not chosen and obj in drv.compartments:
         # a second attempt on a door left part open: the door and its compartment were chosen and
         # measured (shut) the first time; now it is open, best_door would not know it any more
-        chosen = [js for js in closure_joints(drv, obj, ["door"]) if js.name in drv.opened.get(obj, [])]
+        chosen = [js for js in closure_joints(drv, obj, [DOOR]) if js.name in drv.opened.get(obj, [])]
     if not chosen:
-        door = best_door(drv, obj, closure_joints(drv, obj, ["door"]))
+        door = best_door(drv, obj, closure_joints(drv, obj, [DOOR]))
         if door is None:
             return PrimitiveResult(False, 0, f"{obj} has no lid, flap, drawer or door with a reachable "
                                              "compartment behind it")
@@ -244,4 +245,4 @@ def close_opened(drv, obj: str, *, every: bool = False):
     return PrimitiveResult(ok, drv.steps - s0, "; ".join(details) or f"nothing of {obj} left open")
 
 
-CLOSURES_ALL = ("lid", "flap", "drawer", "door")
+CLOSURES_ALL = ENCLOSING_LABELS

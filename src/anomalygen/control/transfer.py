@@ -20,6 +20,7 @@ import numpy as np
 from anomalygen.control.driver import PRE_CONTACT, Driver, PrimitiveResult
 from anomalygen.control.geometry import grasp_points, rim_z
 from anomalygen.control.primitives import grasp
+from anomalygen.schema import DOOR
 
 BACK_OUT_CLEAR = 0.1  # m the cup backs out beyond the container's box with the object
 IN_FRONT = 0.2  # m in front of the opening where the cup lines up before going in
@@ -103,7 +104,7 @@ def _swing_door_wide(drv: Driver, container: str) -> None:
     from anomalygen.control.access import closure_joints
     from anomalygen.control.parts import actuate_part
 
-    for js in closure_joints(drv, container, ("door",)):
+    for js in closure_joints(drv, container, (DOOR,)):
         if js.name not in drv.opened.get(container, []) or drv.model.joint(js.name).type[0] != HINGE:
             continue
         lo, hi = js.range

@@ -18,7 +18,6 @@ from anomalygen.schema import GraphObject, JointState, SceneGraph
 # Below this distance to the edge of its support an object is called "near the edge" (same order as
 # the knowledge base's near-edge predicate; the exact number stays visible in the rendering anyway).
 NEAR_EDGE_M = 0.10
-_SWITCH_LABELS = {"knob", "button", "switch", "dial", "tap", "faucet"}
 
 
 def load_graph(path: str | Path) -> SceneGraph:
@@ -31,8 +30,8 @@ def load_graph(path: str | Path) -> SceneGraph:
 def joint_phrase(joint: JointState) -> str:
     """'door 80% open', 'drawer closed', 'knob on' — joint states as a person would say them."""
     frac = joint.open_fraction
-    if joint.label in _SWITCH_LABELS:
-        return f"{joint.label} {'on' if frac > 0.05 else 'off'}"
+    if joint.is_switch:
+        return f"{joint.label} {'off' if joint.is_off() else 'on'}"
     if frac <= 0.02:
         return f"{joint.label} closed"
     return f"{joint.label} {round(frac * 100)}% open"

@@ -18,16 +18,20 @@ from pathlib import Path
 from anomalygen.control.driver import PrimitiveResult
 from anomalygen.control.geometry import surface_centre_of
 from anomalygen.schema import (
+    DOOR,
     ENCLOSING_LABELS,
+    LID,
+    LID_LABELS,
     Plan,
     PredicateResult,
     SkillMethod,
     SkillResult,
     SubTask,
     SubTaskResult,
+    part_labels,
 )
 
-ACCESS_LABELS = (*ENCLOSING_LABELS, "flap")  # parts that open a way into a container
+ACCESS_LABELS = ENCLOSING_LABELS  # parts that open a way into a container
 NEARLY_CLOSED_TOL = 0.1  # open fraction under which a part still blocks the way in
 OPEN_FRACTION = 0.6  # how far an opened part goes unless the recipe says (a window for air: a crack)
 
@@ -129,7 +133,7 @@ def run_subtask(drv, st: SubTask, plan: Plan):
                 return g
         into = any(c.name == "inside" and not c.negate for c in st.success.predicates) or prim == "place_inside"
         res = P.move_to(drv, obj, region, release_after=bool(prm.get("release", True)), into=into)
-        shut = [lab for lab in _closed_parts(drv, region) if lab != "door" or not drv.opened.get(region)]
+        shut = [lab for lab in _closed_parts(drv, region) if lab != DOOR or not drv.opened.get(region)]
         if shut and into and not drv.opened.get(region):  # say why an 'inside' will fail
             res.detail += f"; {region}'s {', '.join(shut)} closed and the plan did not open it"
         return res
@@ -142,13 +146,13 @@ def run_subtask(drv, st: SubTask, plan: Plan):
 
         return take_out_of(drv, obj, str(prm.get("region") or prm.get("container") or ""))
     if prim in ("close_lid", "open_lid"):  # every lid or flap of a portable container
-        prm.setdefault("part", "lid|flap")
+        prm.setdefault("part", part_labels.any_of(LID_LABELS))
         return _drive_joints(drv, st, obj, "push" if prim == "close_lid" else "pull", prm)
     if prim in ("push", "pull") and prm.get("access"):  # open a container to put something in / shut it again
         from anomalygen.control import access
 
         if prim == "pull":
-            return access.open_for_access(drv, obj, str(prm.get("part", "lid")).split("|"), prm.get("contents"))
+            return access.open_for_access(drv, obj, str(prm.get("part", LID)).split("|"), prm.get("contents"))
         return access.close_opened(drv, obj, every=bool(prm.get("contents")))
     if prim in ("push", "pull", "close_joint", "open_joint", "switch_off"):
         return _drive_joints(drv, st, obj, prim, prm)

@@ -33,7 +33,7 @@ from anomalygen.errors import ItemFailed
 from anomalygen.knowledge import load_kb
 from anomalygen.rng import item_rng, stable_hash
 from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
-from anomalygen.scene import robot, robot_model, select
+from anomalygen.scene import robot, robot_model
 from anomalygen.scene.compose import compose_scene, hold_gravity_hinges, latch_switched_on, set_joints
 from anomalygen.scene.judgement import check_hazard_free
 from anomalygen.scene.layout import Layout, Placed
@@ -48,6 +48,7 @@ from anomalygen.schema import (
     TaskProposal,
     ValidationCheck,
     ValidationReport,
+    part_labels,
 )
 
 if TYPE_CHECKING:
@@ -147,7 +148,7 @@ def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, mo
             joints = [
                 JointState(
                     name=f"{p.name}/{j.name}",
-                    label=select.kb_label(j.label),
+                    label=part_labels.canonical(j.label),
                     type=j.type,
                     value=float(data.joint(f"{p.name}/{j.name}").qpos[0]),
                     range=(float(j.range[0]), float(j.range[1])),

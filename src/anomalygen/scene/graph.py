@@ -131,7 +131,8 @@ def _joint_states(model, data, obj, jids) -> list[JointState]:
 
 
 def _is_closed_enclosure(joints: list[JointState]) -> bool:
-    """True when every door/drawer/lid of the object is (nearly) closed; False if it has none."""
+    """True when every enclosing part of the object (door, drawer, lid, flap) is (nearly) closed;
+    False if it has none."""
     enclosing = [j for j in joints if j.encloses]
     return bool(enclosing) and all(j.is_closed(ENCLOSED_TOL) for j in enclosing)
 

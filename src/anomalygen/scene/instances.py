@@ -14,7 +14,7 @@ import numpy as np
 from anomalygen.errors import ItemFailed
 from anomalygen.scene import furniture, layout, select
 from anomalygen.scene.layout import Placed
-from anomalygen.schema import CLOSURE_LABELS, SWINGING_CLOSURES, ObjectRole
+from anomalygen.schema import DOOR, DRAWER, ObjectRole, part_labels
 
 INWARD = 0.13  # m kept from a support's edge by things that are not the edge hazard
 HAZARD_NEAR_SIDE = 0.4  # m: the hazard's centre at most this far from the robot-facing edge (arm's reach)
@@ -32,7 +32,7 @@ def instance_name(catalogue: str, used: set[str]) -> str:
 
 def _front(asset) -> np.ndarray | None:
     """Local direction the asset's doors/drawers open to (the catalogue convention is -y)."""
-    if any(j.label in CLOSURE_LABELS for j in asset.joints) or asset.cavities:
+    if any(part_labels.is_closure(j.label) for j in asset.joints) or asset.cavities:
         return np.array([0.0, -1.0])
     return None
 
@@ -47,7 +47,7 @@ def _sweep(asset, values: dict[str, float]) -> float:
             continue
         if j.type == "slide":
             out = max(out, abs(v - j.closed_value) + 0.02)
-        elif j.label in SWINGING_CLOSURES:
+        elif part_labels.swings(j.label):
             out = max(out, min(float(max(ext[0], ext[2] if abs(j.axis[2]) < 0.5 else ext[0])), 1.0))
     return out
 
@@ -62,10 +62,10 @@ def _swing(asset) -> float:
     width (the asset's width shared among its side-hinged doors), a door hinged at its foot its
     height; capped at ``SWING_MAX``."""
     ext = asset.aabb[1] - asset.aabb[0]
-    side = [j for j in asset.joints if j.type == "hinge" and j.label == "door" and abs(j.axis[2]) >= 0.5]
+    side = [j for j in asset.joints if j.type == "hinge" and j.label == DOOR and abs(j.axis[2]) >= 0.5]
     out = 0.0
     for j in asset.joints:
-        if j.label not in ("door", "drawer"):
+        if j.label not in (DOOR, DRAWER):
             continue
         if j.type == "slide":
             out = max(out, abs(j.range[1] - j.range[0]) + 0.02)

@@ -20,7 +20,7 @@ from anomalygen.scene.instances import (
 )
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.selection import Selection
-from anomalygen.schema import ENCLOSING_LABELS, ObjectRole, ValidationCheck, ValidationReport
+from anomalygen.schema import ObjectRole, ValidationCheck, ValidationReport, part_labels
 
 
 def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed], surfaces: list[Placed],
@@ -65,7 +65,7 @@ def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], 
         lo, hi, _ = cavity_world(holder)
         lay.place_in_cavity(hp, holder, (lo, hi))
         for joint in container.asset.joints:  # shut every lid, door and drawer of the container
-            if select.kb_label(joint.label) in ENCLOSING_LABELS:
+            if part_labels.encloses(joint.label):
                 holder.joint_values[joint.name] = float(joint.closed_value)
         holder.sweep = 0.0
         return

@@ -17,7 +17,7 @@ from anomalygen.knowledge import load_kb
 from anomalygen.scene import select
 from anomalygen.scene.instances import cavity_cap, container_room, instance_name
 from anomalygen.scene.layout import Placed
-from anomalygen.schema import ENCLOSING_LABELS, ObjectRole, TaskProposal
+from anomalygen.schema import ObjectRole, TaskProposal, part_labels
 
 MAX_AUX = 3
 CONTAINER_REDRAWS = 4  # other container sizes drawn before a smaller hazard is tried
@@ -237,7 +237,7 @@ def set_initial_joints(sel: Selection) -> None:
     if sel.kind == "inside" and parent is not None:
         cav = max(parent.asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
         if cav.joint is not None and not any(
-            p in ENCLOSING_LABELS and s == "closed" for p, s in uses.get(parent.catalogue, [])
+            part_labels.encloses(p) and s == "closed" for p, s in uses.get(parent.catalogue, [])
         ):
             label = parent.asset.joint(cav.joint).label
             uses.setdefault(parent.catalogue, []).append((label, "open"))
