@@ -15,7 +15,7 @@ import pytest
 from anomalygen.config import Settings
 from anomalygen.errors import ItemFailed
 from anomalygen.rng import item_rng
-from anomalygen.scene import build, instances, select
+from anomalygen.scene import asset_choice, build, instances
 from anomalygen.schema import TaskProposal
 
 ATTEMPTS = 4  # a build makes repair_attempts + 1 = 4 by default
@@ -77,14 +77,14 @@ def test_bag_and_bucket_fail_with_does_not_fit_after_redrawing_the_bucket(monkey
     task's target, so it keeps its draw; the bag is drawn smaller and the item fails saying so."""
     task = _litter("plastic_bag", "Bucket", "Bucket")
     drawn: list = []
-    real = select.pick_asset
+    real = asset_choice.pick_asset
 
     def counting(catalogue, **kw):
         asset = real(catalogue, **kw)
         drawn.append((catalogue, asset))
         return asset
 
-    monkeypatch.setattr(select, "pick_asset", counting)
+    monkeypatch.setattr(asset_choice, "pick_asset", counting)
     outcomes = _outcomes(task)
     _assert_fits_or_says_so(outcomes)
     assert all(o[0] == "failed" for o in outcomes)

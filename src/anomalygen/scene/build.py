@@ -3,12 +3,12 @@
 This module runs the attempts and writes the outputs; each step has a module of its own. Pipeline of
 one attempt (all randomness from ``item_rng(seed, task.id, attempt)``):
 
-1. select assets (selection.py, with select.py for each asset): hazard, target, the object the hazard
+1. select assets (casting.py, with asset_choice.py for each asset): hazard, target, the object the hazard
    sits in/on, the container of the fix, task co-objects, unrelated clutter; sizes from the knowledge
    base, clamped by spatial rules; initial joint states that make the hazard real;
 2. place them (placement.py on layout.py; instances.py for holders' surfaces and cavities;
    judgement.py for near-misses, a second hazard and hazard-free scenes) and move the robot base
-   within reach; bind the role variables to instance names (selection.py);
+   within reach; bind the role variables to instance names (casting.py);
 3. compose one MjSpec (compose.py: robot + room + objects), compile, reject initial interpenetration;
 4. settle the physics for ``settings.build.settle_s``;
 5. validate (validate.py): interpenetration <= 1 mm, velocities settled, and the hazard class's
@@ -34,11 +34,11 @@ from anomalygen.knowledge import load_kb
 from anomalygen.rng import item_rng, stable_hash
 from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
 from anomalygen.scene import robot, robot_model
+from anomalygen.scene.casting import bind_roles, select_objects, set_initial_joints
 from anomalygen.scene.compose import compose_scene, hold_gravity_hinges, latch_switched_on, set_joints
 from anomalygen.scene.judgement import check_hazard_free
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.placement import place
-from anomalygen.scene.selection import bind_roles, select_objects, set_initial_joints
 from anomalygen.schema import (
     AssetRef,
     AssetSource,

@@ -1,6 +1,6 @@
 """One chosen object as a placed instance, and where other things can go on it.
 
-A ``select.Chosen`` becomes a ``layout.Placed`` (its box, front and the sweep of open doors); a holder's
+An ``asset_choice.Chosen`` becomes a ``layout.Placed`` (its box, front and the sweep of open doors); a holder's
 top surface and biggest cavity are given in world coordinates, and a container's room says what lies
 flat in it. The margins every placement keeps from a support's edge are defined here too.
 """
@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from anomalygen.errors import ItemFailed
-from anomalygen.scene import furniture, layout, select
+from anomalygen.scene import asset_choice, furniture, layout
 from anomalygen.scene.layout import Placed
 from anomalygen.schema import DOOR, DRAWER, ObjectRole, part_labels
 
@@ -76,7 +76,7 @@ def _swing(asset) -> float:
     return min(out, SWING_MAX)
 
 
-def placed_instance(chosen: select.Chosen) -> Placed:
+def placed_instance(chosen: asset_choice.Chosen) -> Placed:
     lo, hi = (np.asarray(v, float) for v in chosen.asset.aabb)
     p = Placed(
         name=chosen.name,

@@ -9,7 +9,8 @@ from __future__ import annotations
 from anomalygen.errors import ItemFailed
 from anomalygen.knowledge import load_kb
 from anomalygen.knowledge.predicates import ROOM_FIXTURES
-from anomalygen.scene import mix, select
+from anomalygen.scene import asset_choice, mix
+from anomalygen.scene.casting import Selection
 from anomalygen.scene.instances import (
     HAZARD_NEAR_SIDE,
     INWARD,
@@ -19,7 +20,6 @@ from anomalygen.scene.instances import (
     surface_of,
 )
 from anomalygen.scene.layout import Layout, Placed
-from anomalygen.scene.selection import Selection
 from anomalygen.schema import ObjectRole, ValidationCheck, ValidationReport, part_labels
 
 
@@ -29,8 +29,8 @@ def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed]
     on the floor, with its bin when the scene has none."""
     rng = items.rng
     for cat in items.near_misses if surfaces else []:
-        asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng)
-        p = placed_instance(select.Chosen(instance_name(cat, sel.used), cat, ObjectRole.CLUTTER, asset))
+        asset = asset_choice.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng)
+        p = placed_instance(asset_choice.Chosen(instance_name(cat, sel.used), cat, ObjectRole.CLUTTER, asset))
         holder = surfaces[int(rng.integers(len(surfaces)))]
         try:
             lay.place_on_surface(p, holder, surface_of(holder), inward=INWARD)
@@ -40,8 +40,8 @@ def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed]
     for cat, role, face in ((items.second_hazard, ObjectRole.HAZARD, False), (items.bin, ObjectRole.CONTAINER, True)):
         if cat is None:
             continue
-        asset = select.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng)
-        p = placed_instance(select.Chosen(instance_name(cat, sel.used), cat, role, asset))
+        asset = asset_choice.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng)
+        p = placed_instance(asset_choice.Chosen(instance_name(cat, sel.used), cat, role, asset))
         lay.place_on_floor(p, relevant=True, face=face)
         placed[p.name] = p
 

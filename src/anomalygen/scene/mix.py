@@ -38,7 +38,7 @@ MAX_ITEM_SIZE = 0.3  # m: near-misses and the second hazard are hand-sized
 
 def near_miss_names(kb, exclude: set[str]) -> list[str]:
     """Catalogue objects that look like a hazard class's object but are safe on a table's middle."""
-    from anomalygen.scene.select import catalogue_names
+    from anomalygen.scene.asset_choice import catalogue_names
 
     out = []
     for name in catalogue_names():

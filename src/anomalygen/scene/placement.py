@@ -11,7 +11,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from anomalygen.errors import ItemFailed
-from anomalygen.scene import furniture, mix, select
+from anomalygen.scene import asset_choice, furniture, mix
+from anomalygen.scene.casting import Selection, clutter_names
 from anomalygen.scene.instances import (
     HAZARD_NEAR_SIDE,
     INWARD,
@@ -23,7 +24,6 @@ from anomalygen.scene.instances import (
 )
 from anomalygen.scene.judgement import place_hazard_safely, place_judgement_items, room_fixtures
 from anomalygen.scene.layout import Layout, Placed, face_robot_yaw
-from anomalygen.scene.selection import Selection, clutter_names
 from anomalygen.schema import ObjectRole
 
 if TYPE_CHECKING:
@@ -118,9 +118,9 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
     if side is not None:
         for cat in clutter:
             want = sel.hints.size_for(cat) if sel.hints is not None else None
-            asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng,
+            asset = asset_choice.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng,
                                       size=want)
-            ch = select.Chosen(instance_name(cat, used), cat, ObjectRole.CLUTTER, asset)
+            ch = asset_choice.Chosen(instance_name(cat, used), cat, ObjectRole.CLUTTER, asset)
             p = placed_instance(ch)
             try:
                 lay.place_on_surface(p, side, surface_of(side), inward=INWARD)

@@ -1,4 +1,5 @@
-"""Asset selection and configuration: which catalogue assets a scene uses, how big, in which state.
+"""The choice of one asset: which catalogue entry a name means, which generated variant, how big, in
+which state. (Which objects a scene holds and the role each plays is ``casting.py``.)
 
 The paper has an LLM name objects, retrieves assets by Sentence-BERT and asks a VLM whether they fit.
 Offline we do the same with the knowledge base: target candidates are generated variants of the
@@ -64,20 +65,16 @@ _ALWAYS_FIXED = {
 
 
 @lru_cache(maxsize=1)
-def _catalogue() -> tuple[str, ...]:
+def catalogue_names() -> tuple[str, ...]:
+    """Every catalogue name the builder can instantiate."""
     from anomalygen.assets.core import available_names
 
     return tuple(available_names())
 
 
-def catalogue_names() -> tuple[str, ...]:
-    """Every catalogue name the builder can instantiate."""
-    return _catalogue()
-
-
 def resolve_name(name: str) -> str:
     """A catalogue name for ``name``: itself, a case-insensitive match, or the SBERT nearest entry."""
-    names = _catalogue()
+    names = catalogue_names()
     if name in names:
         return name
     lowered = {n.lower(): n for n in names}
