@@ -3,7 +3,7 @@
 Runs the real pipeline through the CLI: ``brainstorm --engine knowledge --n N --seed S``, ``build``
 (default judgement mix: near-misses, second hazards, hazard-free scenes), ``detect --detector rules``,
 then plan and learn twice from the same scenes and detections: from perception (the default,
-``plan_source = detected``) and with the oracle (``ground_truth``: the builder's class and bindings).
+``plan.source = detected``) and with the oracle (``ground_truth``: the builder's class and bindings).
 Prints the detection scores and, per mode, the table by class (hazards present, detected, planned,
 resolved; runs that created a hazard or acted on a safe object), then one JSON line.
 
@@ -94,11 +94,11 @@ def main() -> int:
         out["detectors"] = _compare_detectors(root, base, ids, a.compare_detectors, env)
     for mode, folder in (() if a.skip_learn else (("detected", base), ("ground_truth", root / "oracle"))):
         t = time.perf_counter()
-        menv = {**env, "ANOMALYGEN_LEARN__PLAN_SOURCE": mode}
+        menv = {**env, "ANOMALYGEN_PLAN__SOURCE": mode}
         _cli("plan", "--run", str(folder), env=menv)
         _cli("learn", "--run", str(folder), "--seeds", str(a.seeds), "--workers", str(a.workers), env=menv)
         table = hazard_table(RunFolder(folder), ids, a.seeds)
-        print(markdown(table, f"plan_source = {mode}"))
+        print(markdown(table, f"plan.source = {mode}"))
         tot = table.total
         out[mode] = {"hazards": tot.hazards, "detected": tot.detected, "planned": tot.planned, "runs": tot.runs,
                      "resolved": tot.resolved, "resolved_rate": round(tot.resolved / tot.runs, 3) if tot.runs else None,

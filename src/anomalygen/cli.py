@@ -202,7 +202,7 @@ def plan(
 ):
     """Stage 4a: decompose each fix into sub-tasks with rewards and success checks (writes plans/)."""
     settings = _common(config, None, quiet, backend=backend, model=model,
-                       **{"learn.plan_source": source, "learn.engine": engine})
+                       **{"plan.source": source, "plan.engine": engine})
     folder = _open_run(run)
     _finish(_run_stage("plan", folder, settings, force=force, only=only), as_json)
 

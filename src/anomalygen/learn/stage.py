@@ -48,7 +48,7 @@ def learn_item(item_id: str, payload: dict, ctx: StageContext) -> dict:
                           sac_steps=settings.learn.sac_steps, retries=settings.learn.retries,
                           reward_mode=settings.learn.reward_mode, final_graph_path=final_graph,
                           n_envs=settings.learn.n_envs,
-                          recheck_fixes=settings.learn.max_fixes if settings.learn.recheck else 0)
+                          recheck_fixes=settings.plan.max_fixes if settings.learn.recheck else 0)
     if result.video:
         result = result.model_copy(update={"video": "video.mp4"})
     result = result.model_copy(update={"outcome": referee_verdict(run.scene_dir(task_id), final_graph)})

@@ -219,7 +219,7 @@ def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, s
         raise ItemFailed(f"hazard class {hazard_class!r} is not in the knowledge base; no recipe to plan from")
     # A step goes to SAC when the knowledge base says so (``"method": "sac"``: a contact-rich part
     # motion with a shipped warm start, such as switch_off) or the user lists its action in
-    # ``learn.sac_actions``; it keeps its reward spec either way.
+    # ``plan.sac_actions``; it keeps its reward spec either way.
     subtasks = []
     for i, step in enumerate(cls.recipe):
         method = SkillMethod.SAC if step.method == "sac" or step.action in sac_actions else SkillMethod.PRIMITIVE

@@ -4,7 +4,8 @@ Every artefact is a file in the run folder, so each class is strict (unknown fie
 silently dropped) and carries a ``schema_version`` so old runs can be detected rather than misread.
 Stages depend on these classes, never on each other's internals. One module per stage owns its
 artefacts (``tasks``, ``scenes``, ``detection``, ``skills``, ``run``) over the shared ``base`` and
-``vocabulary``; import every name from ``anomalygen.schema``.
+``vocabulary``; import every name from ``anomalygen.schema``. ``part_labels`` is the one table of
+joint labels (what shuts, encloses, switches) that every stage decides by.
 """
 
 from __future__ import annotations
