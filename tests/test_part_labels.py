@@ -120,7 +120,7 @@ def test_the_table_answers_for_labels_aliases_and_imported_compounds():
     pl = part_labels
     assert [pl.canonical(w) for w in ("sash", "button", "dial", "flap", "rotation_door", "blade", "part")] == [
         "window", "switch", "knob", "flap", "door", "blade", "part"]
-    assert pl.encloses("flap") and pl.swings("flap") and pl.is_lid_like("flap")
+    assert pl.encloses("flap") and pl.swings("flap") and pl.part_label("flap").lid_like
     assert pl.is_closure("window") and not pl.encloses("window") and pl.swings("sash")
     assert not pl.swings("drawer") and pl.encloses("drawer")
     assert all(pl.is_switch(w) for w in ("knob", "dial", "switch", "button", "tap")) and not pl.is_switch("door")

@@ -118,12 +118,6 @@ def swings(label: str) -> bool:
     return row is not None and row.swings
 
 
-def is_lid_like(label: str) -> bool:
-    """Opened and shut all at once from above: a lid or a box's flaps."""
-    row = part_label(label)
-    return row is not None and row.lid_like
-
-
 def any_of(labels) -> str:
     """Several labels as one predicate or sub-task argument: ``"lid|flap"``."""
     return "|".join(labels)

@@ -56,11 +56,6 @@ class JointState(Artefact):
         return part_labels.encloses(self.label)
 
     @property
-    def is_closure(self) -> bool:
-        """A part that shuts something (a window too)."""
-        return part_labels.is_closure(self.label)
-
-    @property
     def is_switch(self) -> bool:
         """An on/off control: its closed value is off."""
         return part_labels.is_switch(self.label)
