@@ -212,7 +212,9 @@ def text_judge_diagnostic(run: RunFolder, detections: Sequence[Detection], tasks
         task, truth = by_task.get(d.task_id), manifests.get(d.task_id)
         if task is None or (truth is not None and not truth.hazards):
             continue
-        judge = judges.setdefault(d.detector, make_judge(settings, d.detector))
+        if d.detector not in judges:
+            judges[d.detector] = make_judge(settings, d.detector)
+        judge = judges[d.detector]
         spec = try_read_model(run.scene_dir(d.task_id) / "scene.json", SceneSpec)
         graph = try_read_model(run.scene_dir(d.task_id) / "scene_graph.json", SceneGraph)
         hc = kb.hazard_classes.get(task.hazard_class)
