@@ -15,21 +15,22 @@ from support.processes import depth_below, descendants, wait_gone
 # A parent that starts a worker (anomalygen.procs.child_pool) which starts its own isolation child,
 # both blocking forever, as learn's pool worker and its per-execution process do.
 PARENT = textwrap.dedent("""
-    import sys, time
+    import pathlib, sys, time
     from anomalygen.procs import child_pool
 
-    def grandchild():
+    def grandchild(marker):
         print("a library talking on stdout")  # must reach stderr, never the parent's stdout
         sys.stdout.flush()
+        pathlib.Path(marker).write_text("printed")
         time.sleep(600)
 
-    def worker():
+    def worker(marker):
         with child_pool(1) as pool:
-            pool.submit(grandchild).result()
+            pool.submit(grandchild, marker).result()
 
     if __name__ == "__main__":
         with child_pool(1) as pool:
-            pool.submit(worker).result()
+            pool.submit(worker, sys.argv[1]).result()
 """)
 
 
@@ -37,17 +38,14 @@ PARENT = textwrap.dedent("""
 def test_killing_the_parent_takes_its_workers_and_their_children_along(tmp_path):
     script = tmp_path / "parent.py"
     script.write_text(PARENT)
-    proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    marker = tmp_path / "printed"
+    proc = subprocess.Popen([sys.executable, str(script), str(marker)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
-        deadline = time.monotonic() + 120  # spawn imports the package twice over on a loaded machine
-        below: set[int] = set()
-        while time.monotonic() < deadline:
-            below = descendants(proc.pid)
-            if any(depth_below(proc.pid, p) == 2 for p in below):
-                break
+        deadline = time.monotonic() + 180  # spawn imports the package twice over on a loaded machine
+        while time.monotonic() < deadline and not marker.is_file():
             time.sleep(0.2)
-        assert any(depth_below(proc.pid, p) == 2 for p in below), "the grandchild never started"
-        time.sleep(1.0)  # let the grandchild print
+        below = descendants(proc.pid)
+        assert marker.is_file() and any(depth_below(proc.pid, p) == 2 for p in below), "the grandchild never ran"
         proc.send_signal(signal.SIGKILL)
         proc.wait(timeout=10)
         assert wait_gone(below, 15.0) == set()
