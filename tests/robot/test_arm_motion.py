@@ -138,10 +138,9 @@ def test_unreachable_target_moves_nothing():
 def test_held_object_is_carried_and_checked():
     from anomalygen.robot.arm_motion import CarryingChecker, move_arm_planned
     from anomalygen.robot.ik import quat_z_to
-    from anomalygen.skills.scripted.primitives import grasp
-
     from anomalygen.schema import SceneSpec
     from anomalygen.skills.episode import Episode
+    from anomalygen.skills.scripted.primitives import grasp
 
     m, d = _scene()
     ep = Episode(m, d, SceneSpec(scene_id="tb", task_id="t", room="kitchen", seed=0, objects=[]))

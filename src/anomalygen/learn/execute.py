@@ -93,7 +93,7 @@ def _run_skill(ep, st: SubTask, method: str) -> tuple[object, str | None]:
     from anomalygen.skills.catalogue import SkillOutcome, UnknownSkill, lookup, skill_for
 
     try:
-        skill = skill_for(ep, st) if method == st.method.value else lookup(method, st.primitive or "")
+        skill = skill_for(ep, st) if method == str(st.method) else lookup(method, st.primitive or "")
     except UnknownSkill as exc:
         return SkillOutcome(False, 0, str(exc)), None
     return skill().run(ep, st), skill.key()
@@ -103,7 +103,7 @@ def _run_once(ep, st: SubTask, plan: Plan) -> tuple[object, str | None]:
     """One execution of ``st``; a SAC sub-task that fails gives way to the primitive of its action."""
     from anomalygen.skills.catalogue import SkillOutcome
 
-    res, by = _run_skill(ep, st, st.method.value)
+    res, by = _run_skill(ep, st, str(st.method))
     if st.method != SkillMethod.SAC:
         return res, by
     ep.settle(10)

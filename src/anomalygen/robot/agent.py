@@ -360,8 +360,9 @@ class Agent:
 
         ``a[:6]`` as in :meth:`move_target` with the agent's step size (``STEP_POS``, ``STEP_ROT``);
         ``dp``/``dr`` exist for an env that documents a different one (none does today). ``a[6] > 0``
-        grabs by :meth:`grab` (the nearest graspable body in range), ``<= 0`` releases. Returns the
-        clipped action as a fresh float64 array (reward action penalties read it).
+        grabs by :meth:`grab` (the nearest graspable body in range) unless something is held already,
+        ``<= 0`` releases (nothing is held afterwards). Returns the clipped action as a fresh float64
+        array (reward action penalties read it).
         """
         try:
             raw = action.tolist()
@@ -372,10 +373,11 @@ class Agent:
         # np.clip's values, cheaper (this runs every env step)
         a = np.array([v if -1.0 <= v <= 1.0 else (1.0 if v > 0 else -1.0) for v in raw], dtype=float)
         self.move_target(data, a, dp=dp, dr=dr)
-        if len(self._eq_list):
-            held = self.held(data)
-            if a[6] > 0 and held is None:
+        if not self._eq_list:
+            return a
+        if a[6] > 0:
+            if self.held(data) is None:
                 self.grab(data)
-            elif a[6] <= 0 and held is not None:
-                self.release(data)
+        else:  # a no-op when nothing is held, and cheaper than asking first (every env step runs it)
+            self.release(data)
         return a

@@ -147,12 +147,12 @@ class SceneEnv(gym.Env):
 
     def step(self, action):
         d = self.data
-        self.agent.apply_action(d, action, dp=self.max_delta_pos, dr=self.max_delta_rot)
+        a = self.agent.apply_action(d, action, dp=self.max_delta_pos, dr=self.max_delta_rot)
         self._mj.mj_step(self.model, d, self.frameskip)
         self.t += 1
-        if self._use_sensors:  # inlined _observe fast path
+        if self._use_sensors:  # inlined _observe fast path; suction off releases, so only 'on' asks
             self._o_sens[:] = self._v_sens
-            self._obs[-1] = 0.0 if self.agent.held(d) is None else 1.0
+            self._obs[-1] = 0.0 if a[6] <= 0.0 or self.agent.held(d) is None else 1.0
             obs = self._obs.copy()
         else:
             obs = self._observe()

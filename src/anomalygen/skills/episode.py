@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -74,15 +73,6 @@ class Episode:
         self.driver = Driver(model, data, rng=rng, on_step=on_step, planned_motion=planned_motion)
         self.agent = self.driver.agent
         self.memory = SkillMemory()
-
-    @classmethod
-    def load(cls, scene_dir: str | Path, **kwargs) -> Episode:
-        """An episode on a built scene folder, acting on the perceived spec (no bindings, no roles)."""
-        from anomalygen.perception import perceived_spec
-        from anomalygen.scene.graph import load_scene
-
-        model, data, spec = load_scene(scene_dir)
-        return cls(model, data, perceived_spec(spec), **kwargs)
 
     @property
     def bindings(self) -> dict[str, str]:

@@ -99,7 +99,7 @@ def lookup(method: str, action: str) -> type[Skill]:
 def skill_for(episode, subtask: SubTask) -> type[Skill]:
     """The skill that runs ``subtask``: a family skill of its method that claims it, else
     ``lookup(method, primitive)``."""
-    method = subtask.method.value
+    method = str(subtask.method)  # a SkillMethod (a StrEnum) or its value
     for (m, _), cls in sorted(_SKILLS.items()):
         if m == method and cls.claims(episode, subtask):
             return cls

@@ -70,3 +70,39 @@ def test_sac_improves_the_evaluation_return_within_a_small_budget():
     initial = res.curve[0]["return"]
     assert res.curve[0]["step"] == 0 and res.best_step > 0
     assert max(c["return"] for c in res.curve[1:]) > initial + 20.0
+
+
+def test_evaluation_reads_is_success_and_the_callback_replaces_evalcallback_as_a_basecallback():
+    """Success is the final step's ``info["is_success"]`` (Gymnasium's and SB3's key), and the
+    success-keeping evaluation is a BaseCallback of its own, not an EvalCallback with its insides
+    overridden. The env and the policy here are test doubles: one step, success by the action's sign."""
+    import gymnasium as gym
+    from gymnasium import spaces
+    from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
+
+    from anomalygen.skills.learned.sac import SACResult, evaluate_policy, success_eval_callback
+
+    class OneStep(gym.Env):
+        observation_space = spaces.Box(-1.0, 1.0, shape=(1,))
+        action_space = spaces.Box(-1.0, 1.0, shape=(1,))
+
+        def reset(self, *, seed=None, options=None):
+            super().reset(seed=seed)
+            return np.zeros(1, dtype=np.float32), {}
+
+        def step(self, action):
+            ok = bool(action[0] > 0)
+            return np.zeros(1, dtype=np.float32), 1.0, True, False, {"is_success": ok, "success": not ok}
+
+    class Sign:
+        def __init__(self, a):
+            self.a = a
+
+        def predict(self, obs, deterministic=True):
+            return np.array([self.a], dtype=np.float32), None
+
+    assert evaluate_policy(Sign(1.0), OneStep(), 3, seed=0) == (1.0, 1.0)
+    assert evaluate_policy(Sign(-1.0), OneStep(), 3, seed=0) == (0.0, 1.0)
+    result = SACResult(best_success=-1.0, best_return=-np.inf, best_step=0, steps=0, wall_s=0.0)
+    cb = success_eval_callback(OneStep(), eval_every=10, episodes=1, seed=0, result=result, stop_at=None)
+    assert isinstance(cb, BaseCallback) and not isinstance(cb, EvalCallback)

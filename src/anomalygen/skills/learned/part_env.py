@@ -28,7 +28,7 @@ from gymnasium import spaces
 
 from anomalygen.schema import SceneSpec, SubTask
 from anomalygen.skills.learned.part_skill import OBS_DIM, PartReadout
-from anomalygen.skills.learned.subtask_env import FRAMESKIP, SubTaskReadout
+from anomalygen.skills.learned.subtask_env import FRAMESKIP, SubTaskReadout, registered_horizon
 
 PART_ENV_ID = "anomalygen/PartTurn-v0"
 HORIZON = 60  # control steps per episode: the registered TimeLimit
@@ -121,10 +121,8 @@ class PartTurnEnv(gym.Env):
 
     @property
     def horizon(self) -> int:
-        """Episode length: the TimeLimit's (``max_episode_steps``), ``HORIZON`` for an env made bare.
-        The observation's time fraction reads it."""
-        limit = self.spec.max_episode_steps if self.spec is not None else None
-        return int(limit) if limit else HORIZON
+        """Episode length (``registered_horizon``); the observation's time fraction reads it."""
+        return registered_horizon(self, HORIZON)
 
     def close(self) -> None:
         for ld in self._loaded:

@@ -49,6 +49,14 @@ SUCCESS_EVERY = 4
 POS_SCALE = 10.0  # positions in the observation are in dm (~unit scale for the networks)
 
 
+def registered_horizon(env: gym.Env, default: int) -> int:
+    """The episode length of an env that leaves truncation to Gymnasium: its TimeLimit's
+    ``max_episode_steps`` (``gym.make`` puts the registration's into ``env.spec``), ``default`` for an
+    env made bare (whose episodes then run until terminated)."""
+    limit = env.spec.max_episode_steps if env.spec is not None else None
+    return int(limit) if limit else default
+
+
 def _collision_geoms(model, body: int) -> np.ndarray:
     """Ids of the geoms of ``body`` and its descendants, planes left out (they have no finite box)."""
     return np.flatnonzero(subtree_geoms(model, body) & (model.geom_type != 0))
@@ -268,10 +276,9 @@ class SubTaskEnv(gym.Env):
 
     @property
     def horizon(self) -> int:
-        """Episode length: the TimeLimit's (``max_episode_steps``), ``HORIZON`` for an env made bare.
-        The observation's time fraction and the last step's success check read it."""
-        limit = self.spec.max_episode_steps if self.spec is not None else None
-        return int(limit) if limit else HORIZON
+        """Episode length (:func:`registered_horizon`); the observation's time fraction and the last
+        step's success check read it."""
+        return registered_horizon(self, HORIZON)
 
     def close(self) -> None:
         self.readout.close()
