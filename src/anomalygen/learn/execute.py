@@ -19,14 +19,19 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from anomalygen.schema import Plan, PredicateResult, SkillMethod, SkillResult, SubTask, SubTaskResult
+
+if TYPE_CHECKING:  # pragma: no cover
+    from anomalygen.skills.episode import Episode
+    from anomalygen.skills.registry import SkillOutcome
 
 CEM_NOT_EXECUTED = ("not executed: CEM plans the motion of a legged robot (the Gymnasium Ant); household "
                     "scenes carry the wheeled arm")
 SAC_OFF = "not executed: sac_steps is 0"  # a SAC skill that did not run: no primitive runs in its place
 
-def _evaluate(calls, ep, bindings) -> list[PredicateResult]:
+def _evaluate(calls, ep: Episode, bindings) -> list[PredicateResult]:
     from anomalygen.knowledge.predicates import evaluate_all
 
     return evaluate_all(list(calls), ep.graph(), bindings)
@@ -70,7 +75,7 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
                          final_graph_path, n_envs, recheck_fixes)
 
 
-def _look_again(ep, before, plan: Plan, max_fixes: int, retries: int) -> list[SubTaskResult]:
+def _look_again(ep: Episode, before, plan: Plan, max_fixes: int, retries: int) -> list[SubTaskResult]:
     """One pass of :mod:`anomalygen.learn.recheck`: fix the hazards the plan's actions created."""
     from anomalygen.knowledge import load_kb
     from anomalygen.learn.recheck import new_hazards, repair_plan, spec_as_it_stands
@@ -87,7 +92,7 @@ def _look_again(ep, before, plan: Plan, max_fixes: int, retries: int) -> list[Su
     return (run_subtasks(ep, repair, retries) if repair is not None else []) + out
 
 
-def _run_skill(ep, st: SubTask, method: str) -> tuple[object, str | None]:
+def _run_skill(ep: Episode, st: SubTask, method: str) -> tuple[SkillOutcome, str | None]:
     """(outcome, ``method:action`` of the skill that ran) for one run of ``st`` by a ``method`` skill;
     a sub-task no skill is registered for fails with the registry's reason and no skill."""
     from anomalygen.skills.catalogue import SkillOutcome, UnknownSkill, lookup, skill_for
@@ -99,7 +104,7 @@ def _run_skill(ep, st: SubTask, method: str) -> tuple[object, str | None]:
     return skill().run(ep, st), skill.key()
 
 
-def _run_once(ep, st: SubTask, plan: Plan) -> tuple[object, str | None]:
+def _run_once(ep: Episode, st: SubTask, plan: Plan) -> tuple[SkillOutcome, str | None]:
     """One execution of ``st``; a SAC sub-task that fails gives way to the primitive of its action."""
     from anomalygen.skills.catalogue import SkillOutcome
 
@@ -119,7 +124,7 @@ def _run_once(ep, st: SubTask, plan: Plan) -> tuple[object, str | None]:
     return res, by
 
 
-def run_subtasks(ep, plan: Plan, retries: int = 1) -> list[SubTaskResult]:
+def run_subtasks(ep: Episode, plan: Plan, retries: int = 1) -> list[SubTaskResult]:
     """Run ``plan``'s sub-tasks in order in the episode; one SubTaskResult each."""
     ep.plan = plan  # skills resolve role variables through the plan being run
     results: list[SubTaskResult] = []

@@ -62,7 +62,7 @@ class Episode:
 
     def __init__(self, model, data, spec: SceneSpec, *, seed: int = 0, rng: np.random.Generator | None = None,
                  plan: Plan | None = None, budget: TimeBudget | None = None,
-                 learning: LearningSettings | None = None, video=None, planned_motion: bool = True):
+                 learning: LearningSettings | None = None, video=None):
         self.model, self.data, self.spec = model, data, spec
         self.seed = int(seed)
         self.plan = plan  # the plan being run: its bindings resolve role variables in sub-task params
@@ -70,7 +70,7 @@ class Episode:
         self.learning = learning or LearningSettings()
         self.video = video  # a VideoRecorder (skills/video.py) fed every control step, or None
         on_step = (lambda drv: video.capture(drv.data)) if video is not None else None
-        self.driver = Driver(model, data, rng=rng, on_step=on_step, planned_motion=planned_motion)
+        self.driver = Driver(model, data, rng=rng, on_step=on_step)
         self.agent = self.driver.agent
         self.memory = SkillMemory()
 
