@@ -97,13 +97,12 @@ def test_the_scan_catches_a_literal_copy(tmp_path, monkeypatch):
 
 
 def test_every_closure_the_planner_and_skills_use_is_enclosing_in_the_table_and_the_graph():
-    from anomalygen.control import access
-    from anomalygen.learn import execute
     from anomalygen.plan import planner
     from anomalygen.scene.graph import _is_closed_enclosure
+    from anomalygen.skills.scripted import access, joints
 
     used = {*planner.CLOSURES, *planner.LID_PARTS.split("|"), *access.CLOSURES_ALL, *access.LIDS,
-            *execute.ACCESS_LABELS}
+            *joints.ACCESS_LABELS}
     assert part_labels.FLAP in used
     for label in used:
         assert part_labels.encloses(label) and part_labels.is_closure(label), label
