@@ -44,8 +44,8 @@ def bench_rules_speed(repeat: int = 3) -> dict:
 
 
 def bench_judge() -> dict:
-    from anomalygen.detect.calibrate import calibrate, load_pairs, similarities
     from anomalygen.embedding import encoder
+    from anomalygen.referee.calibrate import calibrate, load_pairs, similarities
 
     pairs = load_pairs()
     encoder()  # load once, outside the timing
@@ -61,8 +61,8 @@ def bench_judge() -> dict:
 def bench_run(root: Path, k: int = 3) -> dict:
     """Rule detection + judging on every built scene of a run, in memory."""
     from anomalygen.config import load_settings
-    from anomalygen.detect.report import summarise
     from anomalygen.detect.stage import detect_scene, make_detector, make_judge
+    from anomalygen.referee.detection_report import summarise
     from anomalygen.runfolder import RunFolder, try_read_model
     from anomalygen.schema import SceneGraph, SceneSpec
 

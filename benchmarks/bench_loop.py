@@ -46,8 +46,8 @@ def _copy_run(src: Path, dst: Path) -> None:
 
 def _detection_scores(folder: Path, ids: set[str] | None = None):
     """The run's detections scored against truth.json (only the tasks in ``ids`` when given)."""
-    from anomalygen.detect.score import score_detections
     from anomalygen.evaluate.run_metrics import load_detections, load_manifests
+    from anomalygen.referee.score import score_detections
     from anomalygen.runfolder import RunFolder
 
     run = RunFolder(folder)

@@ -10,9 +10,9 @@ from test_detect_stage import standard_run
 
 from anomalygen.config import load_settings
 from anomalygen.detect.hybrid import HybridDetector
-from anomalygen.detect.report import DetectionReport
 from anomalygen.detect.stage import run_stage, summary_path
 from anomalygen.llm import get_client
+from anomalygen.referee.detection_report import DetectionReport
 from anomalygen.runfolder import read_jsonl, read_model
 from anomalygen.schema import Detection
 from support.fixtures import llm_config_for

@@ -8,9 +8,9 @@ import detect_graphs as g
 import pytest
 
 from anomalygen.config import load_settings
-from anomalygen.detect.report import DetectionReport
 from anomalygen.detect.stage import run_stage, summary_path
 from anomalygen.errors import UserError
+from anomalygen.referee.detection_report import DetectionReport
 from anomalygen.runfolder import RunFolder, read_jsonl, read_model, write_jsonl, write_model
 from anomalygen.schema import Detection, SceneSpec
 

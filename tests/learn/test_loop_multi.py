@@ -45,7 +45,7 @@ def test_two_hazards_are_both_found_planned_and_judged(tmp_path):
     # the referee's verdict is the physical state: each hazard resolved exactly when its class no
     # longer holds in the final scene graph the executor wrote
     from anomalygen.knowledge import load_kb
-    from anomalygen.scene.truth import class_matches
+    from anomalygen.referee.truth import class_matches
     from anomalygen.schema import SceneGraph
 
     final = read_model(run.skill_dir("m", 0) / "final_graph.json", SceneGraph)

@@ -10,8 +10,8 @@ from typing import Literal
 
 from pydantic import Field
 
-from anomalygen.detect.score import DetectionScores
 from anomalygen.evaluate.hazard_table import HazardTable
+from anomalygen.referee.score import DetectionScores
 from anomalygen.schema import Artefact, LLMUsage, StageRecord, Strict
 
 
@@ -49,7 +49,7 @@ class DetectionSummary(Strict):
 
     @property
     def detector_label(self) -> str:
-        from anomalygen.detect.report import detector_label
+        from anomalygen.referee.detection_report import detector_label
 
         return detector_label(self.detectors)
     scores: DetectionScores | None = Field(None, description="per-hazard scores against truth.json")
@@ -63,10 +63,14 @@ class SuccessSummary(Strict):
     by_class: dict[str, Rate] = Field(default_factory=dict)
     by_method: dict[str, Rate] = Field(default_factory=dict, description="sub-task success per skill method")
     errors: int = 0
-    resolved: Rate = Field(default_factory=Rate, description="runs whose every truth-manifest hazard was fixed")
+    resolved: Rate = Field(default_factory=Rate, description="the referee's verdict over runs on scenes with hazards: "
+                           "every hazard fixed and no new hazard created")
     resolved_by_class: dict[str, Rate] = Field(default_factory=dict)
     new_hazards: int = Field(0, description="runs that left a hazard the scene did not have at the start")
     on_safe: int = Field(0, description="runs that acted on a near-miss (an object that was already safe)")
+    hazard_free_runs: int = Field(0, description="runs judged on scenes that held no hazard (never 'resolved')")
+    no_action_needed: int = Field(0, description="of those, runs that left the scene as it was")
+    acted_on_safe: int = Field(0, description="of those, runs that acted on a safe object")
 
 
 class AblationRow(Strict):

@@ -1,4 +1,5 @@
-"""Counting metrics over a run's artefacts: distributions, detection hit@k, success by class.
+"""Counting metrics over a run's artefacts: distributions, detection hit@k, success by class (the
+referee's verdicts, with the robot's own check beside them).
 
 Pure functions of typed artefacts, so they are tested on hand-built runs and reused by the report.
 """
@@ -11,7 +12,7 @@ from pathlib import Path
 
 from anomalygen.evaluate.results import DetectionSummary, Rate, SuccessSummary
 from anomalygen.runfolder import RunFolder, read_jsonl, try_read_model
-from anomalygen.schema import Detection, SceneSpec, SkillResult, TaskProposal
+from anomalygen.schema import Detection, SceneSpec, SkillResult, TaskProposal, Verdict
 
 
 def distribution(values: Iterable[str]) -> dict[str, int]:
@@ -41,7 +42,7 @@ def detection_summary(
     detections: Sequence[Detection], tasks: Sequence[TaskProposal], k: int, manifests=None
 ) -> DetectionSummary:
     """hit@k over every scene, by category; with ``manifests`` (task id -> truth) per-hazard scores too."""
-    from anomalygen.detect.score import score_detections
+    from anomalygen.referee.score import score_detections
 
     k = max([k, *(len(d.hypotheses) for d in detections)]) if detections else k
     category = {t.id: str(t.category) for t in tasks}
@@ -62,8 +63,10 @@ def detection_summary(
     )
 
 
-def success_summary(results: Sequence[SkillResult], tasks: Sequence[TaskProposal]) -> SuccessSummary:
-    """Success over every (task, seed) result, grouped by the task's category and hazard class."""
+def success_summary(results: Sequence[SkillResult], tasks: Sequence[TaskProposal],
+                    verdicts: dict[tuple[str, int], Verdict] | None = None) -> SuccessSummary:
+    """The robot's own check over every (task, seed) result, grouped by the task's category and hazard
+    class, and the referee's verdicts (``verdicts``: (task id, seed) -> Verdict) beside it."""
     by_id = {t.id: t for t in tasks}
     overall = Rate()
     by_category: dict[str, Rate] = {}
@@ -77,7 +80,8 @@ def success_summary(results: Sequence[SkillResult], tasks: Sequence[TaskProposal
 
     resolved = Rate()
     resolved_by_class: dict[str, Rate] = {}
-    harm = {"new": 0, "safe": 0}
+    harm = {"new": 0, "safe": 0, "free": 0, "none": 0, "acted": 0}
+    verdicts = verdicts or {}
     for r in results:
         task = by_id.get(r.task_id)
         overall.n += 1
@@ -86,17 +90,26 @@ def success_summary(results: Sequence[SkillResult], tasks: Sequence[TaskProposal
         bump(by_class, task.hazard_class if task else "unknown", r.success)
         for sub in r.subtasks:
             bump(by_method, str(sub.method), sub.success)
-        if r.outcome is not None:  # the referee's verdict against truth.json
+        v = verdicts.get((r.task_id, r.seed))
+        if v is not None:  # the referee's verdict against truth.json
+            harm["new"] += int(bool(v.new_hazards))
+            harm["safe"] += int(bool(v.interventions_on_safe))
+            if not v.hazards:  # a hazard-free scene is never "resolved"
+                harm["free"] += 1
+                harm["none"] += int(v.status == "no_action_needed")
+                harm["acted"] += int(v.status == "acted_on_safe")
+                continue
             resolved.n += 1
-            resolved.successes += int(r.outcome.resolved)
-            bump(resolved_by_class, task.hazard_class if task else "unknown", r.outcome.resolved)
-            harm["new"] += int(bool(r.outcome.new_hazards))
-            harm["safe"] += int(bool(r.outcome.interventions_on_safe))
+            resolved.successes += int(v.resolved)
+            bump(resolved_by_class, task.hazard_class if task else "unknown", v.resolved)
     return SuccessSummary(
         resolved=resolved,
         resolved_by_class=dict(sorted(resolved_by_class.items())),
         new_hazards=harm["new"],
         on_safe=harm["safe"],
+        hazard_free_runs=harm["free"],
+        no_action_needed=harm["none"],
+        acted_on_safe=harm["acted"],
         results=len(results),
         tasks=len({r.task_id for r in results}),
         overall=overall,
@@ -116,7 +129,7 @@ def load_tasks(run: RunFolder) -> list[TaskProposal]:
 
 def load_manifests(run: RunFolder, tasks: Sequence[TaskProposal]) -> dict:
     """Task id -> the builder's truth manifest, for scenes that have one (the answer key: metrics only)."""
-    from anomalygen.scene.truth import load_manifest
+    from anomalygen.referee.truth import load_manifest
 
     return {t.id: m for t in tasks if (m := load_manifest(run.scene_dir(t.id))) is not None}
 
@@ -127,6 +140,16 @@ def load_detections(run: RunFolder) -> list[Detection]:
     if run.detections_dir.is_dir():  # per-item files before the stage merges them
         return [d for p in sorted(run.detections_dir.glob("*.json")) if (d := try_read_model(p, Detection))]
     return []
+
+
+def load_verdicts(run: RunFolder) -> dict[tuple[str, int], Verdict]:
+    """(task id, seed) -> the referee's verdict, for every judged learn run."""
+    from anomalygen.referee.stage import VERDICT_FILE
+
+    if not run.skills_dir.is_dir():
+        return {}
+    paths = sorted(run.skills_dir.glob(f"*/seed*/{VERDICT_FILE}"))
+    return {(v.task_id, v.seed): v for p in paths if (v := try_read_model(p, Verdict)) is not None and v.seed is not None}
 
 
 def load_skill_results(run: RunFolder) -> list[SkillResult]:

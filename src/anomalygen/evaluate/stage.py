@@ -79,7 +79,7 @@ def evaluate_run(run: RunFolder, settings: Settings) -> Evaluation:
         scenes_failed=len(run.errors("build")),
         detection=(rm.detection_summary(detections, tasks, settings.detect.k, rm.load_manifests(run, tasks))
                    if detections else None),
-        success=rm.success_summary(results, tasks) if results else None,
+        success=rm.success_summary(results, tasks, rm.load_verdicts(run)) if results else None,
         hazards=_hazards(run, tasks, settings),
         timings=dict(manifest.stages),
         llm_usage=manifest.llm_usage,

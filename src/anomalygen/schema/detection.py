@@ -1,4 +1,4 @@
-"""Stage 3 (detect): ranked hypotheses about the hazard and how each was judged."""
+"""Stage 3 (detect): ranked hypotheses about the hazard, and how the referee judged each afterwards."""
 
 from __future__ import annotations
 
@@ -38,4 +38,7 @@ class Detection(Artefact):
     error: str | None = None
     hazard_free: bool = Field(
         False, description="the scene's truth lists no hazard: left out of hit@k (it counts in the false-alarm rate)"
+    )
+    judged: bool = Field(
+        False, description="the referee's judge stage has filled judgements, hit_rank, miss_reason and hazard_free"
     )

@@ -8,9 +8,9 @@ import detect_graphs as g
 import numpy as np
 import pytest
 
-from anomalygen.detect.calibrate import calibrate, calibration_path, load_pairs
-from anomalygen.detect.judge import Judge, best_threshold, calibrated_threshold, first_hit
-from anomalygen.detect.truth import ground_truth
+from anomalygen.referee.calibrate import calibrate, calibration_path, load_pairs
+from anomalygen.referee.ground_truth import ground_truth
+from anomalygen.referee.text_judge import Judge, best_threshold, calibrated_threshold, first_hit
 from anomalygen.schema import Hypothesis, SceneSpec
 
 

@@ -1,8 +1,9 @@
 """Detection figures: hit@1..k overall, per category and per class, a confusion table, and the misses.
 
-Computed from the per-scene ``Detection`` records and the (hidden) tasks only, so the summary can be
-re-made from a run folder at any time. A scene whose detector failed counts as a miss, never as
-absent, so failures cannot flatter the hit rate.
+Computed from the judged per-scene ``Detection`` records and the (hidden) tasks only, so the summary
+can be re-made from a run folder at any time; the judge stage writes it to ``detections_summary.json``
+with the per-hazard scores against truth.json. A scene whose detector failed counts as a miss, never
+as absent, so failures cannot flatter the hit rate.
 """
 
 from __future__ import annotations
@@ -12,8 +13,15 @@ from collections.abc import Sequence
 
 from pydantic import Field
 
-from anomalygen.detect.score import DetectionScores
+from anomalygen.referee.score import DetectionScores
 from anomalygen.schema import Artefact, Detection, Strict, TaskProposal
+
+SUMMARY_FILE = "detections_summary.json"
+
+
+def summary_path(run):
+    """``detections_summary.json`` of a run folder (written by the judge stage)."""
+    return run.root / SUMMARY_FILE
 
 
 class HitRates(Strict):

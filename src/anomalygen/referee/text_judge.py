@@ -22,7 +22,7 @@ from importlib import resources
 import numpy as np
 from pydantic import BaseModel, Field
 
-from anomalygen.detect.truth import GroundTruth, norm_name
+from anomalygen.referee.ground_truth import GroundTruth, norm_name
 from anomalygen.schema import Hypothesis, Judgement, SceneGraph
 
 # Used only if the calibration file is missing (a broken install); the calibrated value wins.
@@ -31,7 +31,7 @@ _FALLBACK_THRESHOLD = 0.6
 
 @functools.cache
 def calibrated_threshold() -> float:
-    """The SBERT threshold chosen by ``anomalygen.detect.calibrate`` and stored with the data."""
+    """The SBERT threshold chosen by ``anomalygen.referee.calibrate`` and stored with the data."""
     try:
         ref = resources.files("anomalygen.data").joinpath("judge/threshold.json")
         return float(json.loads(ref.read_text(encoding="utf-8"))["threshold"])

@@ -1,0 +1,227 @@
+"""Stage "judge": after the robot's items have finished, the referee judges what they left behind.
+
+Per task (one runner item), with the answer key at hand (the task, ``truth.json``):
+
+- the scene's detection, if any: the text judge's hits against the task (``hit_rank``, judgements)
+  and ``judged`` set, written back to ``detections/<task>.json``;
+- every learn run of the scene (``skills/<task>/seed<k>/``): its final simulator state
+  (``final_state.npz``) released and settled, judged against the truth into ``verdict.json``, with
+  the scene graph it was judged on in ``judged_graph.json``. Runs from before the state was saved are
+  judged on their ``final_graph.json`` as it was (``judged_from = "graph"``).
+
+An item is done when its detection is judged and every run has a verdict at least as new as its
+result, so re-running learn (or detect) redoes the judging. After the items: ``detections.jsonl``
+collated, ``detections_summary.json`` (hit@k and the per-hazard scores against truth.json), and the
+fixes table by hazard class — the referee's verdict, with the robot's own check beside it.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from anomalygen.errors import UserError
+from anomalygen.runfolder import RunFolder, try_read_model, write_jsonl, write_model
+from anomalygen.runner import StageContext, StageSummary, run_items
+from anomalygen.schema import Detection, SceneGraph, SceneSpec, SkillResult, TaskProposal, Verdict
+
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
+
+STAGE = "judge"
+VERDICT_FILE = "verdict.json"
+JUDGED_GRAPH = "judged_graph.json"  # the released, settled final state's scene graph the verdict read
+FINAL_GRAPH = "final_graph.json"  # what an old run's learn item left instead of its final state
+TABLE_COUNTS = ("runs", "robot_done", "judged", "resolved", "no_action_needed", "acted_on_safe", "new_hazards", "on_safe")
+
+
+def verdict_path(run: RunFolder, task_id: str, seed: int) -> Path:
+    return run.skill_dir(task_id, seed) / VERDICT_FILE
+
+
+def load_verdict(run: RunFolder | str | Path, task_id: str, seed: int) -> Verdict | None:
+    """The referee's verdict on one learn run (``skills/<task>/seed<k>/verdict.json``), None if not judged."""
+    folder = run if isinstance(run, RunFolder) else RunFolder(run)
+    return try_read_model(verdict_path(folder, task_id, seed), Verdict)
+
+
+def _seeds(run: RunFolder, task_id: str) -> list[int]:
+    """Seeds with a learn result for the task."""
+    root = run.skills_dir / task_id
+    if not root.is_dir():
+        return []
+    return sorted(int(p.parent.name.removeprefix("seed")) for p in root.glob("seed*/result.json")
+                  if p.parent.name.removeprefix("seed").isdigit())
+
+
+def _fresh(out: Path, source: Path) -> bool:
+    return out.is_file() and out.stat().st_mtime >= source.stat().st_mtime
+
+
+def judge_run(run: RunFolder, task_id: str, seed: int, spec: SceneSpec, manifest, kb, scene=None) -> Verdict | None:
+    """The verdict on one learn run, from its saved final state (else its final graph); None without either.
+
+    ``scene``: the (model, data) of the task's scene, loaded once per task and reused here."""
+    from anomalygen.referee.settle import initial_graph, settled_graph
+    from anomalygen.referee.verdict import verdict_on
+    from anomalygen.scene.state import FINAL_STATE, restore_state
+
+    folder = run.skill_dir(task_id, seed)
+    if (folder / FINAL_STATE).is_file():
+        model, data = scene
+        restore_state(folder / FINAL_STATE, model, data)
+        final, released, settled = settled_graph(model, data, spec)
+        write_model(folder / JUDGED_GRAPH, final)
+        return verdict_on(manifest, initial_graph(model, spec), final, kb, task_id=task_id, seed=seed,
+                          released=released, settle_s=settled)
+    initial = try_read_model(run.scene_dir(task_id) / "scene_graph.json", SceneGraph)
+    final = try_read_model(folder / FINAL_GRAPH, SceneGraph)
+    if initial is None or final is None:
+        return None
+    return verdict_on(manifest, initial, final, kb, task_id=task_id, seed=seed, judged_from="graph")
+
+
+def judge_item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str, Any]:
+    from anomalygen.detect.stage import detection_path
+    from anomalygen.knowledge import load_kb
+    from anomalygen.referee.detections import judge_detection, make_judge
+    from anomalygen.referee.truth import load_manifest
+    from anomalygen.scene.graph import load_scene
+
+    run, settings = ctx.run, ctx.settings
+    scene_dir = run.scene_dir(task_id)
+    task = TaskProposal.model_validate(payload["task"])
+    spec = try_read_model(scene_dir / "scene.json", SceneSpec)
+    manifest = load_manifest(scene_dir)
+    out: dict[str, Any] = {"hazard_class": task.hazard_class, "verdicts": {}}
+    det = try_read_model(detection_path(run, task_id), Detection)
+    if det is not None:
+        judge = make_judge(settings)
+        if judge.llm is not None:
+            judge.llm.reset_usage()
+        graph = try_read_model(scene_dir / "scene_graph.json", SceneGraph)
+        det = judge_detection(det, task, spec, graph, manifest, judge)
+        write_model(detection_path(run, task_id), det)
+        out["hit_rank"] = det.hit_rank
+        if judge.llm is not None:
+            out["usage"] = judge.llm.reset_usage().model_dump()
+    seeds = _seeds(run, task_id)
+    if manifest is None or spec is None or not seeds:
+        return out
+    kb = load_kb()
+    model, data, _ = load_scene(scene_dir)
+    for seed in seeds:
+        verdict = judge_run(run, task_id, seed, spec, manifest, kb, (model, data))
+        if verdict is not None:
+            write_model(verdict_path(run, task_id, seed), verdict)
+            out["verdicts"][seed] = verdict.status
+    return out
+
+
+def _is_done_for(run: RunFolder):
+    from anomalygen.detect.stage import detection_path
+
+    def is_done(task_id: str) -> bool:
+        det = try_read_model(detection_path(run, task_id), Detection)
+        if det is not None and not det.judged:
+            return False
+        if not (run.scene_dir(task_id) / "truth.json").is_file():
+            return True
+        return all(_fresh(verdict_path(run, task_id, s), run.skill_dir(task_id, s) / "result.json")
+                   for s in _seeds(run, task_id))
+    return is_done
+
+
+def verdict_table(run: RunFolder, tasks: list[TaskProposal]) -> dict[str, dict[str, float]]:
+    """Per hazard class: learn runs; the referee's verdicts (``judged``: runs with a verdict; ``resolved``
+    on scenes with hazards; ``no_action_needed`` / ``acted_on_safe`` on hazard-free ones; runs that
+    created a new hazard or acted on a near-miss); and, beside it, the robot's own check (``robot_done``)."""
+    acc: dict[str, dict[str, int]] = defaultdict(lambda: dict.fromkeys(TABLE_COUNTS, 0))
+    for t in tasks:
+        for seed in _seeds(run, t.id):
+            row = acc[t.hazard_class]
+            res = try_read_model(run.skill_dir(t.id, seed) / "result.json", SkillResult)
+            row["runs"] += 1
+            row["robot_done"] += int(bool(res is not None and res.success))
+            v = load_verdict(run, t.id, seed)
+            if v is None:
+                continue
+            row["judged"] += 1
+            row["resolved"] += int(v.resolved)
+            row["no_action_needed"] += int(v.status == "no_action_needed")
+            row["acted_on_safe"] += int(v.status == "acted_on_safe")
+            row["new_hazards"] += int(bool(v.new_hazards))
+            row["on_safe"] += int(bool(v.interventions_on_safe))
+    return {hc: dict(row) for hc, row in sorted(acc.items())}
+
+
+def _print_table(table: dict[str, dict[str, float]]) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    t = Table(title="fixes by hazard class: the referee's verdict (robot's own check beside it)")
+    columns = ("hazard class", "runs", "resolved", "hazard-free: no action / acted", "new hazards",
+               "acted on safe", "robot's own check")
+    for col in columns:
+        t.add_column(col, justify="left" if col == "hazard class" else "right", overflow="fold")
+
+    def cells(name: str, row: dict) -> list[str]:
+        with_hazards = row["judged"] - row["no_action_needed"] - row["acted_on_safe"]
+        free = row["no_action_needed"] + row["acted_on_safe"]
+        resolved = f"{row['resolved']}/{with_hazards} ({row['resolved'] / with_hazards:.0%})" if with_hazards else "-"
+        return [name, str(row["runs"]), resolved, f"{row['no_action_needed']}/{row['acted_on_safe']}" if free else "-",
+                str(row["new_hazards"]), str(row["on_safe"]), f"{row['robot_done']}/{row['runs']}"]
+
+    for hc, row in table.items():
+        t.add_row(*cells(hc, row))
+    total = {k: sum(r[k] for r in table.values()) for k in TABLE_COUNTS}
+    t.add_row(*cells("all", total))
+    Console(stderr=True).print(t)
+
+
+def _summarise_detections(run: RunFolder, tasks: list[TaskProposal], settings: Settings):
+    """Collate the judged detections and write detections_summary.json (None when nothing was detected)."""
+    from anomalygen.detect.stage import detection_path
+    from anomalygen.referee.detection_report import summarise, summary_path
+    from anomalygen.referee.score import score_detections
+    from anomalygen.referee.truth import load_manifest
+
+    detections = [d for t in tasks if (d := try_read_model(detection_path(run, t.id), Detection)) is not None]
+    if not detections:
+        return None
+    write_jsonl(run.detections_path, detections)
+    judged = [d for d in detections if d.judged]
+    report = summarise(judged, tasks, settings.detect.k)
+    manifests = {t.id: m for t in tasks if (m := load_manifest(run.scene_dir(t.id))) is not None}
+    report.scores = score_detections(judged, manifests, settings.detect.k) if manifests else None
+    write_model(summary_path(run), report)
+    return report
+
+
+def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
+    from anomalygen.detect.stage import record_llm_usage
+
+    tasks = run.load_tasks()
+    if only:
+        unknown = sorted(set(only) - {t.id for t in tasks})
+        if unknown:
+            raise UserError(f"unknown task id(s): {', '.join(unknown)}")
+    chosen = [t for t in tasks if (not only or t.id in only) and (run.scene_dir(t.id) / "scene.json").is_file()]
+    items = [(t.id, {"task": t.model_dump(mode="json")}) for t in chosen]
+    summary = run_items(run, STAGE, items, judge_item, settings=settings, is_done=_is_done_for(run), force=force,
+                        description="judge")
+    record_llm_usage(run, summary)
+    report = _summarise_detections(run, tasks, settings)
+    table = verdict_table(run, chosen)
+    summary.results["by_class"] = table
+    if report is not None:
+        summary.results["detection"] = report.model_dump(mode="json")
+    if not settings.quiet:
+        from anomalygen.referee.detection_report import print_report
+
+        if report is not None:
+            print_report(report)
+        if table:
+            _print_table(table)
+    return summary
