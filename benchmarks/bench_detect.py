@@ -59,10 +59,12 @@ def bench_judge() -> dict:
 
 
 def bench_run(root: Path, k: int = 3) -> dict:
-    """Rule detection + judging on every built scene of a run, in memory."""
+    """Rule detection on every built scene of a run, then the referee's judging of it, in memory."""
     from anomalygen.config import load_settings
-    from anomalygen.detect.stage import detect_scene, make_detector, make_judge
+    from anomalygen.detect.stage import detect_scene, make_detector
     from anomalygen.referee.detection_report import summarise
+    from anomalygen.referee.detections import judge_detection, make_judge
+    from anomalygen.referee.truth import load_manifest
     from anomalygen.runfolder import RunFolder, try_read_model
     from anomalygen.schema import SceneGraph, SceneSpec
 
@@ -77,7 +79,8 @@ def bench_run(root: Path, k: int = 3) -> dict:
         if graph is None:
             continue
         spec = try_read_model(run.scene_dir(t.id) / "scene.json", SceneSpec)
-        dets.append(detect_scene(t, graph, spec, settings, detector=detector, judge=judge))
+        det = detect_scene(t.id, graph, settings, detector=detector)  # the detector sees the graph alone
+        dets.append(judge_detection(det, t, spec, graph, load_manifest(run.scene_dir(t.id)), judge))
     wall = time.perf_counter() - start
     report = summarise(dets, tasks, k)
     return {

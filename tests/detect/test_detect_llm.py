@@ -10,9 +10,10 @@ from test_detect_stage import standard_run
 
 from anomalygen.config import load_settings
 from anomalygen.detect.hybrid import HybridDetector
-from anomalygen.detect.stage import run_stage, summary_path
+from anomalygen.detect.stage import run_stage as detect_stage
 from anomalygen.llm import get_client
-from anomalygen.referee.detection_report import DetectionReport
+from anomalygen.referee.detection_report import DetectionReport, summary_path
+from anomalygen.referee.stage import run_stage as judge_stage
 from anomalygen.runfolder import read_jsonl, read_model
 from anomalygen.schema import Detection
 from support.fixtures import llm_config_for
@@ -30,6 +31,13 @@ def _system(req) -> str:
 def reply(*hyps):
     return text(json.dumps({"hypotheses": [
         {"problem": p, "solution": s, "target_object": o, "hazard_class": c} for o, c, p, s in hyps]}))
+
+
+def run_stage(run, settings, **kwargs):
+    """Detect, then the referee's judge stage (which scores the claims): what `anomalygen run` does."""
+    summary = detect_stage(run, settings, **kwargs)
+    judge_stage(run, settings, **kwargs)
+    return summary
 
 
 def llm_settings(srv, tmp_path, **over):

@@ -82,8 +82,8 @@ def test_mixed_brainstorm_modes_get_ablation_rows(tmp_path):
     assert rows["modes [mode=plain]"].tasks == 2 and rows["modes [mode=brainstorm]"].tasks == 3
 
 
-def test_the_truth_verdict_is_counted_apart_from_the_robots_own():
-    from anomalygen.schema import FixOutcome, HazardOutcome, SkillResult, TaskProposal
+def test_the_referees_verdict_is_counted_apart_from_the_robots_own():
+    from anomalygen.schema import FixOutcome, HazardOutcome, HazardVerdict, SkillResult, TaskProposal, Verdict
 
     def task(tid, cls):
         return TaskProposal(id=tid, name="n", explanation="e", description="d", category="hygiene",
@@ -91,21 +91,33 @@ def test_the_truth_verdict_is_counted_apart_from_the_robots_own():
                             scenario=dict(hazard_object="rotten_apple", room="kitchen", placement="table"),
                             provenance=dict(engine="knowledge", mode="brainstorm"))
 
-    def verdict(ok, new=(), safe=()):
-        return FixOutcome(hazards=[HazardOutcome(hazard_class="c", object="o", resolved=ok)], resolved=ok,
-                          new_hazards=list(new), interventions_on_safe=list(safe))
+    def verdict(tid, seed, ok, new=(), safe=(), hazards=True):
+        hs = [HazardVerdict(hazard_class="c", object="o", resolved=ok and not new)] if hazards else []
+        status = ("resolved" if ok and not new else "unresolved") if hazards else (
+            "acted_on_safe" if safe else "no_action_needed")
+        return Verdict(task_id=tid, seed=seed, status=status, resolved=hazards and ok and not new, hazards=hs,
+                       new_hazards=list(new), interventions_on_safe=list(safe))
 
     results = [
-        SkillResult(task_id="a", seed=0, success=True, outcome=verdict(True)),
-        SkillResult(task_id="a", seed=1, success=True, outcome=verdict(False, new=["x on y"])),  # fooled itself
-        SkillResult(task_id="b", seed=0, success=False, outcome=verdict(False, safe=["mug_0"])),
-        SkillResult(task_id="b", seed=1, success=True),  # no truth.json: not judged
+        SkillResult(task_id="a", seed=0, success=True),
+        SkillResult(task_id="a", seed=1, success=True),  # fooled itself: it made a new hazard
+        SkillResult(task_id="b", seed=0, success=False),
+        SkillResult(task_id="b", seed=1, success=True),  # no verdict: not judged
+        SkillResult(task_id="c", seed=0, success=True),  # a hazard-free scene, left alone: never "resolved"
+        # an old run, judged inside learn: its outcome is read as a verdict
+        SkillResult(task_id="d", seed=0, success=True, outcome=FixOutcome(
+            hazards=[HazardOutcome(hazard_class="c", object="o", resolved=True)], resolved=True)),
     ]
-    s = rm.success_summary(results, [task("a", "dispose_spoiled_food"), task("b", "store_sharp_objects")])
-    assert (s.overall.successes, s.overall.n) == (3, 4)
-    assert (s.resolved.successes, s.resolved.n) == (1, 3)
-    assert s.resolved_by_class["dispose_spoiled_food"].rate == 0.5 and s.resolved_by_class["store_sharp_objects"].n == 1
+    verdicts = {("a", 0): verdict("a", 0, True), ("a", 1): verdict("a", 1, True, new=["x on y"]),
+                ("b", 0): verdict("b", 0, False, safe=["mug_0"]), ("c", 0): verdict("c", 0, True, hazards=False)}
+    tasks = [task("a", "dispose_spoiled_food"), task("b", "store_sharp_objects"), task("c", "store_sharp_objects"),
+             task("d", "store_sharp_objects")]
+    s = rm.success_summary(results, tasks, verdicts)
+    assert (s.overall.successes, s.overall.n) == (5, 6)  # the robot's own check, beside the verdict
+    assert (s.resolved.successes, s.resolved.n) == (2, 4)
+    assert s.resolved_by_class["dispose_spoiled_food"].rate == 0.5 and s.resolved_by_class["store_sharp_objects"].n == 2
     assert (s.new_hazards, s.on_safe) == (1, 1)
+    assert (s.hazard_free_runs, s.no_action_needed, s.acted_on_safe) == (1, 1, 0)
 
 
 def test_hazard_free_scenes_are_left_out_of_hit_at_k():

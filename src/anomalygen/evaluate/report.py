@@ -42,7 +42,7 @@ class GalleryItem(Strict):
     videos: list[str] = Field(default_factory=list, description="copied videos, relative to report/")
     hit_rank: int | None = None
     detected: bool | None = None
-    success: bool | None = None
+    success: bool | None = Field(None, description="the referee's verdict: resolved in most judged runs (None: not judged)")
 
 
 class Report(Artefact):
@@ -61,6 +61,9 @@ def collect_gallery(run: RunFolder) -> list[GalleryItem]:
     results: dict[str, list] = {}
     for r in rm.load_skill_results(run):
         results.setdefault(r.task_id, []).append(r)
+    verdicts: dict[str, list] = {}
+    for (tid, _), v in rm.load_verdicts(run).items():
+        verdicts.setdefault(tid, []).append(v.resolved)
     ids = [t.id for t in tasks] or sorted(p.parent.name for p in rm.scene_renders(run))
     by_id = {t.id: t for t in tasks}
     items = []
@@ -72,7 +75,7 @@ def collect_gallery(run: RunFolder) -> list[GalleryItem]:
             if _find_video(run, tid, res.seed, res.video) is not None:
                 videos.append(f"videos/{tid}_seed{res.seed}.mp4")
         det = detections.get(tid)
-        seeds = results.get(tid, [])
+        judged = verdicts.get(tid, [])
         items.append(GalleryItem(
             task_id=tid,
             name=t.name if t else tid,
@@ -83,7 +86,7 @@ def collect_gallery(run: RunFolder) -> list[GalleryItem]:
             videos=videos,
             hit_rank=det.hit_rank if det else None,
             detected=(det.hit_rank is not None) if det else None,
-            success=(sum(r.success for r in seeds) * 2 >= len(seeds)) if seeds else None,
+            success=(sum(judged) * 2 > len(judged)) if judged else None,
         ))
     return items
 
@@ -315,7 +318,7 @@ def render_html(report: Report, run: RunFolder) -> str:
             if g.detected is not None:
                 tags += f'<span class="tag {"ok" if g.detected else "bad"}">detected: {_e(g.hit_rank or "miss")}</span>'
             if g.success is not None:
-                tags += f'<span class="tag {"ok" if g.success else "bad"}">{"resolved" if g.success else "failed"}</span>'
+                tags += f'<span class="tag {"ok" if g.success else "bad"}">{"resolved" if g.success else "unresolved"}</span>'
             cards.append(f'<div class="card">{media}<h3>{_e(g.name)}</h3>{tags}<p>{_e(g.description)}</p></div>')
         parts.append(_section("gallery", "Scene gallery", f'<div class="gallery">{"".join(cards)}</div>'))
     else:

@@ -82,6 +82,8 @@ def success_summary(results: Sequence[SkillResult], tasks: Sequence[TaskProposal
     resolved_by_class: dict[str, Rate] = {}
     harm = {"new": 0, "safe": 0, "free": 0, "none": 0, "acted": 0}
     verdicts = verdicts or {}
+    from anomalygen.referee.verdict import from_old_outcome
+
     for r in results:
         task = by_id.get(r.task_id)
         overall.n += 1
@@ -91,6 +93,8 @@ def success_summary(results: Sequence[SkillResult], tasks: Sequence[TaskProposal
         for sub in r.subtasks:
             bump(by_method, str(sub.method), sub.success)
         v = verdicts.get((r.task_id, r.seed))
+        if v is None and r.outcome is not None:  # a run judged before verdict.json existed
+            v = from_old_outcome(r.task_id, r.seed, r.outcome)
         if v is not None:  # the referee's verdict against truth.json
             harm["new"] += int(bool(v.new_hazards))
             harm["safe"] += int(bool(v.interventions_on_safe))

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 
 from anomalygen.referee.truth import class_matches
-from anomalygen.schema import HazardManifest, HazardVerdict, SceneGraph, Verdict
+from anomalygen.schema import FixOutcome, HazardManifest, HazardVerdict, SceneGraph, Verdict
 
 MOVED_M = 0.05  # a near-miss object displaced further than this was acted on
 TURNED = 0.1  # a near-miss joint (rad or m) moved further than this was acted on
@@ -64,6 +64,24 @@ def verdict_on(manifest: HazardManifest, initial: SceneGraph, final: SceneGraph,
     return Verdict(task_id=task_id, seed=seed, status=status, resolved=resolved, hazards=hazards, new_hazards=new,
                    interventions_on_safe=on_safe, released=sorted(released or []), judged_from=judged_from,
                    settle_s=settle_s)
+
+
+def from_old_outcome(task_id: str, seed: int, outcome: FixOutcome) -> Verdict:
+    """An old run's ``SkillResult.outcome`` read as a verdict (judged on its final graph as saved). Its
+    ``resolved`` said True for a hazard-free scene; here such a run is no_action_needed or acted_on_safe,
+    and a run that created a hazard is unresolved, as for new runs."""
+    hazards = [HazardVerdict(hazard_class=h.hazard_class, object=h.object, resolved=h.resolved, detail=h.detail)
+               for h in outcome.hazards]
+    if hazards:
+        resolved = all(h.resolved for h in hazards) and not outcome.new_hazards
+        status = "resolved" if resolved else "unresolved"
+    else:
+        resolved = False
+        status = ("unresolved" if outcome.new_hazards else "acted_on_safe" if outcome.interventions_on_safe
+                  else "no_action_needed")
+    return Verdict(task_id=task_id, seed=seed, status=status, resolved=resolved, hazards=hazards,
+                   new_hazards=list(outcome.new_hazards), interventions_on_safe=list(outcome.interventions_on_safe),
+                   judged_from="graph")
 
 
 def _acted_on(name: str, initial: SceneGraph, final: SceneGraph) -> bool:
