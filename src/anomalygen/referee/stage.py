@@ -33,7 +33,8 @@ STAGE = "judge"
 VERDICT_FILE = "verdict.json"
 JUDGED_GRAPH = "judged_graph.json"  # the released, settled final state's scene graph the verdict read
 FINAL_GRAPH = "final_graph.json"  # what an old run's learn item left instead of its final state
-TABLE_COUNTS = ("runs", "robot_done", "judged", "resolved", "no_action_needed", "acted_on_safe", "new_hazards", "on_safe")
+TABLE_COUNTS = ("runs", "robot_done", "judged", "resolved", "hazard_free", "no_action_needed", "acted_on_safe",
+                "new_hazards", "on_safe")
 
 
 def verdict_path(run: RunFolder, task_id: str, seed: int) -> Path:
@@ -135,8 +136,9 @@ def _is_done_for(run: RunFolder):
 
 def verdict_table(run: RunFolder, tasks: list[TaskProposal]) -> dict[str, dict[str, float]]:
     """Per hazard class: learn runs; the referee's verdicts (``judged``: runs with a verdict; ``resolved``
-    on scenes with hazards; ``no_action_needed`` / ``acted_on_safe`` on hazard-free ones; runs that
-    created a new hazard or acted on a near-miss); and, beside it, the robot's own check (``robot_done``)."""
+    on scenes with hazards; ``hazard_free`` runs and of those ``no_action_needed`` / ``acted_on_safe``;
+    runs that created a new hazard or acted on a near-miss); and, beside it, the robot's own check
+    (``robot_done``)."""
     acc: dict[str, dict[str, int]] = defaultdict(lambda: dict.fromkeys(TABLE_COUNTS, 0))
     for t in tasks:
         for seed in _seeds(run, t.id):
@@ -149,6 +151,7 @@ def verdict_table(run: RunFolder, tasks: list[TaskProposal]) -> dict[str, dict[s
                 continue
             row["judged"] += 1
             row["resolved"] += int(v.resolved)
+            row["hazard_free"] += int(not v.hazards)
             row["no_action_needed"] += int(v.status == "no_action_needed")
             row["acted_on_safe"] += int(v.status == "acted_on_safe")
             row["new_hazards"] += int(bool(v.new_hazards))
@@ -167,8 +170,8 @@ def _print_table(table: dict[str, dict[str, float]]) -> None:
         t.add_column(col, justify="left" if col == "hazard class" else "right", overflow="fold")
 
     def cells(name: str, row: dict) -> list[str]:
-        with_hazards = row["judged"] - row["no_action_needed"] - row["acted_on_safe"]
-        free = row["no_action_needed"] + row["acted_on_safe"]
+        with_hazards = row["judged"] - row["hazard_free"]
+        free = row["hazard_free"]
         resolved = f"{row['resolved']}/{with_hazards} ({row['resolved'] / with_hazards:.0%})" if with_hazards else "-"
         return [name, str(row["runs"]), resolved, f"{row['no_action_needed']}/{row['acted_on_safe']}" if free else "-",
                 str(row["new_hazards"]), str(row["on_safe"]), f"{row['robot_done']}/{row['runs']}"]

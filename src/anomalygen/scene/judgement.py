@@ -18,13 +18,20 @@ from anomalygen.scene.instances import (
     HAZARD_NEAR_SIDE,
     INWARD,
     cavity_world,
+    container_room,
     instance_name,
     placed_instance,
     surface_of,
 )
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.selection import Selection
-from anomalygen.schema import ENCLOSING_LABELS, ObjectRole, ValidationCheck, ValidationReport
+from anomalygen.schema import (
+    ENCLOSING_LABELS,
+    LATCHING_PROPERTY,
+    ObjectRole,
+    ValidationCheck,
+    ValidationReport,
+)
 
 
 def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed], surfaces: list[Placed],
@@ -36,15 +43,11 @@ def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed]
     for pick in items.near_misses if surfaces else []:
         p = _chosen(sel, pick.category, rng)
         holder = surfaces[int(rng.integers(len(surfaces)))]
-        try:
-            if pick.edge_gap is not None:
-                lay.place_on_surface(p, holder, surface_of(holder), inward=mix.FAR_M, edge_gap=pick.edge_gap)
-                rule = f"{pick.edge_gap:.2f} m from the edge, just {pick.kind.split('_')[1]} {pick.hazard_class}'s rule"
-                p.intent = Intent("hazard" if pick.kind == "just_inside" else "borderline", pick.hazard_class, rule)
-            else:
-                lay.place_on_surface(p, holder, surface_of(holder), inward=mix.FAR_M)
-        except ItemFailed:
+        if not _on_surface_clear_of_edges(lay, p, holder, pick.edge_gap):
             continue
+        if pick.edge_gap is not None:
+            rule = f"{pick.edge_gap:.2f} m from the edge, just {pick.kind.split('_')[1]} {pick.hazard_class}'s rule"
+            p.intent = Intent("hazard" if pick.kind == "just_inside" else "borderline", pick.hazard_class, rule)
         placed[p.name] = p
     if items.state is not None and surfaces:
         _place_state_near_miss(sel, lay, placed, surfaces, items.state, rng)
@@ -57,6 +60,18 @@ def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed]
         if role == ObjectRole.HAZARD:
             p.intent = Intent("hazard", mix.SECOND_HAZARD_CLASS, "the judgement mix's second hazard")
         placed[p.name] = p
+
+
+def _on_surface_clear_of_edges(lay: Layout, p: Placed, holder: Placed, edge_gap: float | None = None) -> bool:
+    """Rest ``p`` on ``holder``'s top ``FAR_M`` from its edges (the robot-facing one ``edge_gap`` away
+    when given), else ``NEAR_FAR_M`` when the top is too crowded for that; False when it finds no room."""
+    for inward in (mix.FAR_M, mix.NEAR_FAR_M):
+        try:
+            lay.place_on_surface(p, holder, surface_of(holder), inward=inward, edge_gap=edge_gap)
+            return True
+        except ItemFailed:
+            continue
+    return False
 
 
 def _chosen(sel: Selection, category: str, rng) -> Placed:
@@ -79,9 +94,7 @@ def _place_state_near_miss(sel: Selection, lay: Layout, placed: dict[str, Placed
         far = j.range[1] if abs(j.range[1] - j.closed_value) >= abs(j.range[0] - j.closed_value) else j.range[0]
         p.joint_values[j.name] = float(j.closed_value + step * (1 if far >= j.closed_value else -1))
     holder = surfaces[int(rng.integers(len(surfaces)))]
-    try:
-        lay.place_on_surface(p, holder, surface_of(holder), inward=mix.FAR_M)
-    except ItemFailed:
+    if not _on_surface_clear_of_edges(lay, p, holder):
         sel.used.discard(p.name)
         return
     state = "ajar" if pick.ajar else "off"
@@ -97,8 +110,12 @@ def room_fixtures(kb, lay: Layout) -> list[Placed]:
 
 def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None) -> None:
     """The task's object where it is no hazard: shut inside its container, else well inside the
-    surface, else on the floor beside a piece of furniture, out of the walkway."""
+    surface, else on the floor beside a piece of furniture, out of the walkway. For a class whose
+    danger is a child reaching it, only a container that latches keeps it safe (a toddler opens a
+    cupboard or a box): such a container is added when the task's own does not latch."""
     hazard, container = sel.hazard, sel.container
+    if _guards_a_child(sel.hc) and (container is None or not _latches(sel.kb, container.catalogue)):
+        container = _latching_container(sel, hazard) or container
     hp = placed[hazard.name] = placed_instance(hazard)
     if container is not None and container is not hazard and container.asset.cavities:
         holder = placed.get(container.name)
@@ -116,6 +133,27 @@ def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], 
         lay.place_on_surface(hp, support, surface_of(support), inward=INWARD, near_side=HAZARD_NEAR_SIDE)
         return
     lay.place_beside(hp, room_fixtures(sel.kb, lay))
+
+
+def _guards_a_child(hc) -> bool:
+    return hc is not None and any(c.name == "child_reachable" and not c.negate for c in hc.preconditions)
+
+
+def _latches(kb, catalogue: str) -> bool:
+    return LATCHING_PROPERTY in kb.properties_of(catalogue)
+
+
+def _latching_container(sel: Selection, hazard) -> select.Chosen | None:
+    """A container of a kind that latches (the knowledge base's ``lockable`` objects) the object fits in."""
+    for name in sorted(n for n in sel.kb.objects if _latches(sel.kb, n)):
+        try:
+            cand = sel.choose(name, ObjectRole.CONTAINER)
+        except (ItemFailed, KeyError):
+            continue
+        if cand.asset.cavities and hazard.size <= container_room(cand.asset):
+            return cand
+        sel.forget(cand)
+    return None
 
 
 def check_hazard_free(report: ValidationReport, graph, hazard_class: str) -> ValidationReport:

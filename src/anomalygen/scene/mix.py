@@ -47,6 +47,7 @@ NEAR_MISS_KINDS = ("far", "just_outside", "just_inside")
 NEAR_MISS_KIND_P = (0.4, 0.4, 0.2)
 BORDER_M = 0.01  # m either side of a class's distance threshold (0.11 and 0.13 m for a 0.12 m rule)
 FAR_M = 0.25  # m from every edge for a near-miss well clear of the edge rule
+NEAR_FAR_M = 0.15  # m: the fallback on a crowded top, still 3 cm beyond the 0.12 m edge rule
 STATE_NEAR_MISS_SHARE = 0.5  # share of scenes given a state near-miss (when near_misses > 0)
 AJAR_RAD = math.radians(2.0)  # a door or lid left ajar by two degrees: shut in every class's sense
 AJAR_M = 0.005  # m: a drawer left out by half a centimetre
