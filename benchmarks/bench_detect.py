@@ -45,7 +45,7 @@ def bench_rules_speed(repeat: int = 3) -> dict:
 
 def bench_judge() -> dict:
     from anomalygen.embedding import encoder
-    from anomalygen.referee.calibrate import calibrate, load_pairs, similarities
+    from anomalygen.evaluate.judge_calibration import calibrate, load_pairs, similarities
 
     pairs = load_pairs()
     encoder()  # load once, outside the timing
@@ -62,8 +62,8 @@ def bench_run(root: Path, k: int = 3) -> dict:
     """Rule detection on every built scene of a run, then the referee's judging of it, in memory."""
     from anomalygen.config import load_settings
     from anomalygen.detect.stage import detect_scene, make_detector
-    from anomalygen.referee.detection_report import summarise
-    from anomalygen.referee.detections import judge_detection, make_judge
+    from anomalygen.evaluate.detection_report import summarise
+    from anomalygen.evaluate.judged_detections import judge_detection, make_judge
     from anomalygen.referee.truth import load_manifest
     from anomalygen.runfolder import RunFolder, try_read_model
     from anomalygen.schema import SceneGraph, SceneSpec

@@ -232,7 +232,6 @@ def learn(
 @app.command()
 def judge(
     run: RunOpt = Path("runs/default"),
-    k: Annotated[int | None, typer.Option("--k", help="hit@1..k of the detections (as detect ran).")] = None,
     only: OnlyOpt = None,
     workers: WorkersOpt = None,
     config: ConfigOpt = None,
@@ -242,9 +241,9 @@ def judge(
     executor: ExecutorOpt = None,
     address: AddressOpt = None,
 ):
-    """The referee, after the robot: judge detections and every run's settled final state against the
-    hidden truth (writes skills/<task>/seed<k>/verdict.json and detections_summary.json)."""
-    settings = _common(config, None, quiet, workers, executor, address, **{"detect.k": k})
+    """The referee, after the robot: judge every run's released, settled final state against the hidden
+    truth (writes skills/<task>/seed<k>/verdict.json)."""
+    settings = _common(config, None, quiet, workers, executor, address)
     folder = _open_run(run)
     _finish(_run_stage("judge", folder, settings, force=force, only=only), as_json)
 

@@ -52,7 +52,7 @@ def test_rules_find_the_hazard_in_a_built_scene_without_seeing_the_task(tmp_path
     # every built object is shown, clutter included
     assert {o["name"] for o in observation_json(graph)["objects"]} == {o.name for o in spec.objects}
     det = detect_scene(task.id, graph, settings)  # the detector is given the graph alone
-    from anomalygen.referee.detections import judge_detection, make_judge
+    from anomalygen.evaluate.judged_detections import judge_detection, make_judge
     from anomalygen.referee.truth import load_manifest
 
     det = judge_detection(det, task, spec, graph, load_manifest(tmp_path), make_judge(settings))

@@ -11,9 +11,9 @@ import pytest
 def test_llm_detector_runs_on_the_bundled_gguf(tmp_path, kb):
     from anomalygen.config import LLMConfig
     from anomalygen.detect.llm_detector import LLMDetector
+    from anomalygen.evaluate.text_judge import Judge
     from anomalygen.llm import get_client
     from anomalygen.referee.ground_truth import ground_truth
-    from anomalygen.referee.text_judge import Judge
 
     client = get_client(LLMConfig(backend="llamacpp", cache=False, max_tokens=160, repair_retries=1))
     graph = g.pill_on_floor()

@@ -11,9 +11,9 @@ from test_detect_stage import standard_run
 from anomalygen.config import load_settings
 from anomalygen.detect.hybrid import HybridDetector
 from anomalygen.detect.stage import run_stage as detect_stage
+from anomalygen.evaluate.detection_report import DetectionReport, summary_path
+from anomalygen.evaluate.judged_detections import judge_detections
 from anomalygen.llm import get_client
-from anomalygen.referee.detection_report import DetectionReport, summary_path
-from anomalygen.referee.stage import run_stage as judge_stage
 from anomalygen.runfolder import read_jsonl, read_model
 from anomalygen.schema import Detection
 from support.fixtures import llm_config_for
@@ -34,9 +34,9 @@ def reply(*hyps):
 
 
 def run_stage(run, settings, **kwargs):
-    """Detect, then the referee's judge stage (which scores the claims): what `anomalygen run` does."""
+    """Detect, then the evaluate side's judging of the claims: what `anomalygen run` does."""
     summary = detect_stage(run, settings, **kwargs)
-    judge_stage(run, settings, **kwargs)
+    judge_detections(run, settings)
     return summary
 
 

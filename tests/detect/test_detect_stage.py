@@ -1,5 +1,5 @@
 """The detect stage on a run folder of hand-built scenes: files, collation, resume, CLI; its detections
-judged afterwards by the referee's judge stage (hit@k, detections_summary.json)."""
+judged afterwards on the evaluate side (hit@k, detections_summary.json)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ import pytest
 from anomalygen.config import load_settings
 from anomalygen.detect.stage import run_stage
 from anomalygen.errors import UserError
-from anomalygen.referee.detection_report import DetectionReport, summary_path
-from anomalygen.referee.stage import run_stage as judge_stage
+from anomalygen.evaluate.detection_report import DetectionReport, summary_path
+from anomalygen.evaluate.judged_detections import judge_detections
 from anomalygen.runfolder import RunFolder, read_jsonl, read_model, write_jsonl, write_model
 from anomalygen.schema import Detection, SceneSpec
 
@@ -43,7 +43,7 @@ def settings(**over):
     return load_settings(None, {"quiet": True, "workers": 1, **over})
 
 
-def test_rules_stage_writes_detections_and_the_judge_stage_their_summary(tmp_path):
+def test_rules_stage_writes_detections_and_evaluate_judges_them(tmp_path):
     run = standard_run(tmp_path)
     summary = run_stage(run, settings())
     assert (summary.done, summary.failed) == (3, 0)
@@ -52,8 +52,7 @@ def test_rules_stage_writes_detections_and_the_judge_stage_their_summary(tmp_pat
     # the detect stage writes claims only: no judgement of them, no summary against the task
     assert all(not d.judged and d.hit_rank is None and d.judgements == [] for d in dets)
     assert not summary_path(run).exists()
-    judged = judge_stage(run, settings())
-    assert (judged.done, judged.failed) == (3, 0)
+    judge_detections(run, settings())
     dets = read_jsonl(run.detections_path, Detection)
     assert all(d.judged and d.hit_rank == 1 and d.detector == "rules" for d in dets)
     assert all((run.detections_dir / f"{d.task_id}.json").is_file() for d in dets)
@@ -76,7 +75,7 @@ def test_misses_are_listed_with_reasons_and_unbuilt_scenes_reported(tmp_path):
     assert summary.done == 2 and summary.failed == 0  # the unbuilt scene is build's failure, not ours
     with pytest.raises(UserError, match="no built scene for: t-pill"):
         run_stage(run, settings(), only=["t-pill"])
-    judge_stage(run, settings())
+    judge_detections(run, settings())
     report = read_model(summary_path(run), DetectionReport)
     assert report.missing_scenes == ["t-pill"]
     assert report.overall.rate[1] == 0.5
@@ -94,14 +93,12 @@ def test_resume_skips_done_scenes_and_force_redoes_them(tmp_path):
     assert len(read_jsonl(run.detections_path, Detection)) == 3
     forced = run_stage(run, settings(), force=True, only=["t-pill"])
     assert (forced.done, forced.skipped) == (1, 0)
-    # judging notices the re-detected scene and redoes only that one
-    assert judge_stage(run, settings()).done == 3
-    assert (judge_stage(run, settings()).done, judge_stage(run, settings()).skipped) == (0, 3)
+    # judging notices the re-detected scene: judged again, the others kept
+    judge_detections(run, settings())
     run_stage(run, settings(), force=True, only=["t-pill"])
-    again = judge_stage(run, settings())
-    assert (again.done, again.skipped) == (1, 2)
-    with pytest.raises(UserError, match="unknown task id"):
-        judge_stage(run, settings(), only=["t-nope"])
+    assert [d.judged for d in read_jsonl(run.detections_path, Detection)] == [True, False, True]
+    judge_detections(run, settings())
+    assert all(d.judged for d in read_jsonl(run.detections_path, Detection))
 
 
 def test_llm_detector_without_llm_is_a_clear_user_error(tmp_path):
@@ -116,7 +113,6 @@ def test_cli_detect(tmp_path, capsys):
     main(["detect", "--run", str(run.root), "--detector", "rules", "--k", "2", "--json"])
     out = json.loads(capsys.readouterr().out)
     assert out["done"] == 3 and out["failed"] == 0
-    main(["judge", "--run", str(run.root), "--k", "2", "--json"])
-    assert json.loads(capsys.readouterr().out)["done"] == 3
+    judge_detections(run, settings(**{"detect.k": 2}))
     report = read_model(summary_path(run), DetectionReport)
     assert report.k == 2 and report.overall.rate[1] == 1.0

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 from anomalygen.config import Settings
 from anomalygen.evaluate.baselines import PAPER_ABLATION
+from anomalygen.evaluate.detection_report import summarise
 from anomalygen.evaluate.report import Report, ablation_rows, detection_rows, render_markdown, run_stage
 from anomalygen.evaluate.stage import evaluate_run
-from anomalygen.referee.detection_report import summarise
 from anomalygen.runfolder import read_jsonl, write_jsonl
 from anomalygen.schema import Detection, Engine
 

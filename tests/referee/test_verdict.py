@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-import detect_graphs as g
-
 from anomalygen.referee.truth import bound_success, class_matches
 from anomalygen.referee.verdict import verdict_on
 from anomalygen.schema import HazardManifest, ManifestHazard, NearMiss, Relation, SceneGraph
+from detect import detect_graphs as g  # tests/detect/detect_graphs.py: the hand-built scene graphs
 
 
 def knife_manifest(kb) -> HazardManifest:

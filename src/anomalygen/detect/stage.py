@@ -5,7 +5,8 @@ configured detector and write ``detections/<task_id>.json``. A detector failure 
 produced a valid reply) is recorded in that scene's ``Detection.error`` and counts as a miss; it never
 ends the batch. After the items: collate ``detections.jsonl`` atomically in task order and print one
 line of what was claimed. Judging the claims against the hidden task and truth.json (hit@k, recall,
-precision, ``detections_summary.json``) is the referee's judge stage (``anomalygen judge``).
+precision, ``detections_summary.json``) happens on the evaluate side, after the robot
+(``anomalygen evaluate``, ``evaluate/judged_detections.py``).
 """
 
 from __future__ import annotations
@@ -63,7 +64,7 @@ def detect_scene(task_id: str, graph: SceneGraph, settings: Settings, *, detecto
     """Detect on one scene graph (pure apart from LLM calls): what the item function writes.
 
     The detector sees the graph only; how its claims fare against the answer key is the referee's
-    business, afterwards (``anomalygen judge``)."""
+    business, afterwards (``anomalygen evaluate``)."""
     from anomalygen.llm import LLMItemError
 
     detector = detector or make_detector(settings)
@@ -133,7 +134,7 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
 
 
 def claims_line(detections: list[Detection], detector: str) -> str:
-    """What the detector claimed, in one line (how the claims fare is ``anomalygen judge``'s to say)."""
+    """What the detector claimed, in one line (how the claims fare is for ``anomalygen evaluate`` to say)."""
     top = Counter(d.hypotheses[0].hazard_class or "free text" for d in detections if d.hypotheses)
     failed = sum(1 for d in detections if d.error)
     quiet = sum(1 for d in detections if not d.hypotheses and not d.error)

@@ -49,7 +49,7 @@ class DetectionSummary(Strict):
 
     @property
     def detector_label(self) -> str:
-        from anomalygen.referee.detection_report import detector_label
+        from anomalygen.evaluate.detection_report import detector_label
 
         return detector_label(self.detectors)
     scores: DetectionScores | None = Field(None, description="per-hazard scores against truth.json")

@@ -108,13 +108,20 @@ def measured_ablation(run_name: str, rows: list[DiversityRow], group_of: dict[st
 
 
 def run_stage(run: RunFolder, settings: Settings) -> StageSummary:
+    from anomalygen.evaluate.judged_detections import judge_detections
+
     started, record = time.perf_counter(), StageRecord(started=now_iso())
+    detections = judge_detections(run, settings)  # scored here, after the robot: detect never reads the task
     evaluation = evaluate_run(run, settings)
     write_model(evaluation_path(run), evaluation)
     if not settings.quiet:
         from rich.console import Console
 
         Console(width=max(Console().width, 120)).print(rich_table(evaluation.diversity))
+        if detections is not None:
+            from anomalygen.evaluate.detection_report import print_report
+
+            print_report(detections)
         if evaluation.not_run:
             Console(stderr=True).print(f"not run yet: {', '.join(evaluation.not_run)}", highlight=False)
     summary = StageSummary("evaluate", done=1, wall_s=time.perf_counter() - started)

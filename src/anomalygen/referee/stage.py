@@ -1,18 +1,14 @@
 """Stage "judge": after the robot's items have finished, the referee judges what they left behind.
 
-Per task (one runner item), with the answer key at hand (the task, ``truth.json``):
+Per task (one runner item), with the answer key at hand (the scene's ``truth.json``): every learn run
+of the scene (``skills/<task>/seed<k>/``) has its final simulator state (``final_state.npz``) released
+and settled and judged against the truth into ``verdict.json``, with the scene graph it was judged on
+in ``judged_graph.json``. Runs from before the state was saved are judged on their
+``final_graph.json`` as it was (``judged_from = "graph"``).
 
-- the scene's detection, if any: the text judge's hits against the task (``hit_rank``, judgements)
-  and ``judged`` set, written back to ``detections/<task>.json``;
-- every learn run of the scene (``skills/<task>/seed<k>/``): its final simulator state
-  (``final_state.npz``) released and settled, judged against the truth into ``verdict.json``, with
-  the scene graph it was judged on in ``judged_graph.json``. Runs from before the state was saved are
-  judged on their ``final_graph.json`` as it was (``judged_from = "graph"``).
-
-An item is done when its detection is judged and every run has a verdict at least as new as its
-result, so re-running learn (or detect) redoes the judging. After the items: ``detections.jsonl``
-collated, ``detections_summary.json`` (hit@k and the per-hazard scores against truth.json), and the
-fixes table by hazard class — the referee's verdict, with the robot's own check beside it.
+An item is done when every run has a verdict at least as new as its result, so re-running learn
+redoes the judging. After the items: the fixes table by hazard class — the referee's verdict, with
+the robot's own check beside it. (Detections are scored against the truth on the evaluate side.)
 """
 
 from __future__ import annotations
@@ -22,9 +18,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from anomalygen.errors import UserError
-from anomalygen.runfolder import RunFolder, try_read_model, write_jsonl, write_model
+from anomalygen.runfolder import RunFolder, try_read_model, write_model
 from anomalygen.runner import StageContext, StageSummary, run_items
-from anomalygen.schema import Detection, SceneGraph, SceneSpec, SkillResult, TaskProposal, Verdict
+from anomalygen.schema import SceneGraph, SceneSpec, SkillResult, TaskProposal, Verdict
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
@@ -84,30 +80,16 @@ def judge_run(run: RunFolder, task_id: str, seed: int, spec: SceneSpec, manifest
 
 
 def judge_item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str, Any]:
-    from anomalygen.detect.stage import detection_path
     from anomalygen.knowledge import load_kb
-    from anomalygen.referee.detections import judge_detection, make_judge
     from anomalygen.referee.truth import load_manifest
     from anomalygen.scene.graph import load_scene
 
-    run, settings = ctx.run, ctx.settings
+    run = ctx.run
     scene_dir = run.scene_dir(task_id)
-    task = TaskProposal.model_validate(payload["task"])
     spec = try_read_model(scene_dir / "scene.json", SceneSpec)
     manifest = load_manifest(scene_dir)
-    out: dict[str, Any] = {"hazard_class": task.hazard_class, "verdicts": {}}
-    det = try_read_model(detection_path(run, task_id), Detection)
-    if det is not None:
-        judge = make_judge(settings)
-        if judge.llm is not None:
-            judge.llm.reset_usage()
-        graph = try_read_model(scene_dir / "scene_graph.json", SceneGraph)
-        det = judge_detection(det, task, spec, graph, manifest, judge)
-        write_model(detection_path(run, task_id), det)
-        out["hit_rank"] = det.hit_rank
-        if judge.llm is not None:
-            out["usage"] = judge.llm.reset_usage().model_dump()
     seeds = _seeds(run, task_id)
+    out: dict[str, Any] = {"verdicts": {}}
     if manifest is None or spec is None or not seeds:
         return out
     kb = load_kb()
@@ -121,12 +103,7 @@ def judge_item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict
 
 
 def _is_done_for(run: RunFolder):
-    from anomalygen.detect.stage import detection_path
-
     def is_done(task_id: str) -> bool:
-        det = try_read_model(detection_path(run, task_id), Detection)
-        if det is not None and not det.judged:
-            return False
         if not (run.scene_dir(task_id) / "truth.json").is_file():
             return True
         return all(_fresh(verdict_path(run, task_id, s), run.skill_dir(task_id, s) / "result.json")
@@ -183,48 +160,18 @@ def _print_table(table: dict[str, dict[str, float]]) -> None:
     Console(stderr=True).print(t)
 
 
-def _summarise_detections(run: RunFolder, tasks: list[TaskProposal], settings: Settings):
-    """Collate the judged detections and write detections_summary.json (None when nothing was detected)."""
-    from anomalygen.detect.stage import detection_path
-    from anomalygen.referee.detection_report import summarise, summary_path
-    from anomalygen.referee.score import score_detections
-    from anomalygen.referee.truth import load_manifest
-
-    detections = [d for t in tasks if (d := try_read_model(detection_path(run, t.id), Detection)) is not None]
-    if not detections:
-        return None
-    write_jsonl(run.detections_path, detections)
-    judged = [d for d in detections if d.judged]
-    report = summarise(judged, tasks, settings.detect.k)
-    manifests = {t.id: m for t in tasks if (m := load_manifest(run.scene_dir(t.id))) is not None}
-    report.scores = score_detections(judged, manifests, settings.detect.k) if manifests else None
-    write_model(summary_path(run), report)
-    return report
-
-
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
-    from anomalygen.detect.stage import record_llm_usage
-
     tasks = run.load_tasks()
     if only:
         unknown = sorted(set(only) - {t.id for t in tasks})
         if unknown:
             raise UserError(f"unknown task id(s): {', '.join(unknown)}")
     chosen = [t for t in tasks if (not only or t.id in only) and (run.scene_dir(t.id) / "scene.json").is_file()]
-    items = [(t.id, {"task": t.model_dump(mode="json")}) for t in chosen]
+    items = [(t.id, {}) for t in chosen]
     summary = run_items(run, STAGE, items, judge_item, settings=settings, is_done=_is_done_for(run), force=force,
                         description="judge")
-    record_llm_usage(run, summary)
-    report = _summarise_detections(run, tasks, settings)
     table = verdict_table(run, chosen)
     summary.results["by_class"] = table
-    if report is not None:
-        summary.results["detection"] = report.model_dump(mode="json")
-    if not settings.quiet:
-        from anomalygen.referee.detection_report import print_report
-
-        if report is not None:
-            print_report(report)
-        if table:
-            _print_table(table)
+    if not settings.quiet and table:
+        _print_table(table)
     return summary

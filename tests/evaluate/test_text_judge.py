@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import json
 
-import detect_graphs as g
 import numpy as np
 import pytest
 
-from anomalygen.referee.calibrate import calibrate, calibration_path, load_pairs
+from anomalygen.evaluate.judge_calibration import calibrate, calibration_path, load_pairs
+from anomalygen.evaluate.text_judge import Judge, best_threshold, calibrated_threshold, first_hit
 from anomalygen.referee.ground_truth import ground_truth
-from anomalygen.referee.text_judge import Judge, best_threshold, calibrated_threshold, first_hit
 from anomalygen.schema import Hypothesis, SceneSpec
+from detect import detect_graphs as g  # tests/detect/detect_graphs.py: the hand-built scene graphs
 
 
 def hyp(rank, obj, cls, problem="p", solution="s"):

@@ -31,7 +31,7 @@ _FALLBACK_THRESHOLD = 0.6
 
 @functools.cache
 def calibrated_threshold() -> float:
-    """The SBERT threshold chosen by ``anomalygen.referee.calibrate`` and stored with the data."""
+    """The SBERT threshold chosen by ``anomalygen.evaluate.judge_calibration`` and stored with the data."""
     try:
         ref = resources.files("anomalygen.data").joinpath("judge/threshold.json")
         return float(json.loads(ref.read_text(encoding="utf-8"))["threshold"])
