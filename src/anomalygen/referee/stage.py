@@ -140,11 +140,11 @@ def _print_table(table: dict[str, dict[str, float]]) -> None:
     from rich.console import Console
     from rich.table import Table
 
-    t = Table(title="fixes by hazard class: the referee's verdict (robot's own check beside it)")
-    columns = ("hazard class", "runs", "resolved", "hazard-free: no action / acted", "new hazards",
-               "acted on safe", "robot's own check")
+    t = Table(title="the referee's verdict by hazard class (free: hazard-free scenes; robot's own check last)")
+    columns = ("hazard class", "runs", "resolved", "free: idle/acted", "new haz.", "on safe", "robot's own")
     for col in columns:
-        t.add_column(col, justify="left" if col == "hazard class" else "right", overflow="fold")
+        first = col == "hazard class"
+        t.add_column(col, justify="left" if first else "right", no_wrap=first, overflow="fold")
 
     def cells(name: str, row: dict) -> list[str]:
         with_hazards = row["judged"] - row["hazard_free"]

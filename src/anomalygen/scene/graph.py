@@ -40,6 +40,9 @@ NEAR_DIST = 0.15  # m: bounding-box gap below which two objects are "near"
 # CLOSED_TOL, which asks whether the robot finished closing it.
 ENCLOSED_TOL = 0.1
 CAVITY_TOL = 0.01  # m: an object's centre this far outside a cavity's box still counts as inside it
+# m: below a cavity's floor face, more: generators shrink a compartment's declared box by its wall
+# thickness, so a flat thing lying on a cupboard shelf (a USB stick, 7 mm) has its centre 1-2 cm under it
+CAVITY_FLOOR_TOL = 0.05
 UNDER_GAP = 0.02  # m: an object's top at least this far below another's top to lie under it
 
 
@@ -270,7 +273,9 @@ def _containment(idx: _Index, data, center: np.ndarray, held: set[int]) -> np.nd
     mats = data.xmat[idx.cav_body].reshape(k, 3, 3)
     origin = pos + np.einsum("kij,kj->ki", mats, idx.cav_center)
     local = np.einsum("kji,knj->kni", mats, center[None, :, :] - origin[:, None, :])  # R^T (c - o)
-    within = np.all(np.abs(local) <= idx.cav_half[:, None, :] + CAVITY_TOL, axis=2)
+    half = idx.cav_half[:, None, :]
+    within = np.all(np.abs(local[..., :2]) <= half[..., :2] + CAVITY_TOL, axis=2)
+    within &= (local[..., 2] <= half[..., 2] + CAVITY_TOL) & (local[..., 2] >= -half[..., 2] - CAVITY_FLOOR_TOL)
     within[np.arange(k), idx.cav_owner] = False
     if held:
         within[:, sorted(held)] = False
@@ -319,6 +324,7 @@ def scene_graph(model: mujoco.MjModel, data: mujoco.MjData, spec: SceneSpec) -> 
     latched = np.zeros(n, dtype=bool)
     for i in range(n):
         ks = np.flatnonzero(within[:, i]) if len(within) else np.zeros(0, int)
+        ks = np.array([k for k in ks if i not in supports[int(idx.cav_owner[k])]], dtype=int)  # it bears the container
         ks = ks[np.argsort(idx.cav_volume[ks], kind="stable")]
         owners = list(dict.fromkeys(int(idx.cav_owner[k]) for k in ks))
         containers.append(owners)
