@@ -149,7 +149,9 @@ def _print_table(table: dict[str, dict[str, float]]) -> None:
     def cells(name: str, row: dict) -> list[str]:
         with_hazards = row["judged"] - row["hazard_free"]
         free = row["hazard_free"]
-        resolved = f"{row['resolved']}/{with_hazards} ({row['resolved'] / with_hazards:.0%})" if with_hazards else "-"
+        resolved = f"{row['resolved']}/{with_hazards}" if with_hazards else "-"
+        if name == "all" and with_hazards:
+            resolved += f" {row['resolved'] / with_hazards:.0%}"
         return [name, str(row["runs"]), resolved, f"{row['no_action_needed']}/{row['acted_on_safe']}" if free else "-",
                 str(row["new_hazards"]), str(row["on_safe"]), f"{row['robot_done']}/{row['runs']}"]
 
