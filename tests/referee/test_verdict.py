@@ -84,7 +84,7 @@ def test_a_hazard_free_scene_is_never_resolved_left_alone_is_no_action_needed(kb
     assert (v.status, v.resolved, v.hazards, v.new_hazards) == ("no_action_needed", False, [], [])
 
 
-def test_a_hazard_free_scene_touched_is_acted_on_safe_and_harmed_is_unresolved(kb):
+def test_a_hazard_free_scene_touched_or_harmed_is_acted_on_safe_never_resolved(kb):
     start = _without_knife(g.knife_on_counter_edge())
     nudged = moved(start, "mug_0", position=[0.2, 1.7, 0.925])
     v = verdict_on(_hazard_free(kb), start, nudged, kb, task_id="t")
@@ -93,7 +93,7 @@ def test_a_hazard_free_scene_touched_is_acted_on_safe_and_harmed_is_unresolved(k
                     child_reachable=True)
     dropped = dropped.model_copy(update={"relations": [r for r in start.relations if r.subject != "kitchen_knife_0"]})
     v = verdict_on(_hazard_free(kb), start, dropped, kb, task_id="t")
-    assert v.status == "unresolved" and not v.resolved
+    assert v.status == "acted_on_safe" and not v.resolved
     assert "keep_sharp_away_from_children on kitchen_knife_0" in v.new_hazards
 
 

@@ -1,12 +1,13 @@
-"""Stage 3 entry point: detect the hazard in every built scene and collate the detections.
+"""Stage 3 entry point: detect the hazards in every built scene and collate the detections.
 
 Per scene (one runner item): read ``scene_graph.json`` (the only input a detector sees), run the
 configured detector and write ``detections/<task_id>.json``. A detector failure (an LLM that never
-produced a valid reply) is recorded in that scene's ``Detection.error`` and counts as a miss; it never
-ends the batch. After the items: collate ``detections.jsonl`` atomically in task order and print one
-line of what was claimed. Judging the claims against the hidden task and truth.json (hit@k, recall,
-precision, ``detections_summary.json``) happens on the evaluate side, after the robot
-(``anomalygen evaluate``, ``evaluate/judged_detections.py``).
+produced a valid reply) is recorded in that scene's ``Detection.error`` and counts as a miss; it
+never ends the batch. After the items: collate ``detections.jsonl`` atomically in task order and
+print what was claimed.
+
+Nothing here reads the task or the scene's truth: detections are scored against the truth on the
+evaluate side (``anomalygen evaluate`` writes ``detections_summary.json``).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 from anomalygen.errors import ItemFailed, UserError
 from anomalygen.runfolder import RunFolder, try_read_model, write_jsonl, write_model
-from anomalygen.runner import StageContext, StageSummary, run_items
+from anomalygen.runner import StageContext, StageSummary, check_only, config_section, run_items
 from anomalygen.schema import Detection, SceneGraph
 
 if TYPE_CHECKING:
@@ -61,10 +62,8 @@ def _detector_name(detector, settings: Settings) -> str:
 
 
 def detect_scene(task_id: str, graph: SceneGraph, settings: Settings, *, detector=None) -> Detection:
-    """Detect on one scene graph (pure apart from LLM calls): what the item function writes.
-
-    The detector sees the graph only; how its claims fare against the answer key is the referee's
-    business, afterwards (``anomalygen evaluate``)."""
+    """Detect on one scene graph (pure apart from LLM calls): what the item function writes. The
+    task id only names the record; the detector is given the graph alone."""
     from anomalygen.llm import LLMItemError
 
     detector = detector or make_detector(settings)
@@ -79,10 +78,9 @@ def detect_scene(task_id: str, graph: SceneGraph, settings: Settings, *, detecto
 
 def _item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str, Any]:
     run, settings = ctx.run, ctx.settings
-    scene_dir = run.scene_dir(task_id)
-    graph = try_read_model(scene_dir / "scene_graph.json", SceneGraph)
+    graph = try_read_model(_graph_path(run, task_id), SceneGraph)
     if graph is None:
-        raise ItemFailed(f"no valid scene_graph.json in {scene_dir} (build the scene first)")
+        raise ItemFailed(f"no valid scene_graph.json in {run.scene_dir(task_id)} (build the scene first)")
     detector = make_detector(settings)
     client = getattr(detector, "client", None)
     if client is not None:
@@ -90,7 +88,12 @@ def _item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str,
     det = detect_scene(task_id, graph, settings, detector=detector)
     write_model(detection_path(run, task_id), det)
     usage = client.reset_usage().model_dump() if client is not None else None
-    return {"error": det.error, "fallback": getattr(detector, "fell_back", None), "usage": usage}
+    return {"claims": len(det.hypotheses), "error": det.error, "fallback": getattr(detector, "fell_back", None),
+            "usage": usage}
+
+
+def _graph_path(run: RunFolder, task_id: str):
+    return run.scene_dir(task_id) / "scene_graph.json"
 
 
 def _is_done_for(run: RunFolder, settings: Settings):
@@ -103,22 +106,21 @@ def _is_done_for(run: RunFolder, settings: Settings):
 
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
     tasks = run.load_tasks()
-    if only:
-        unknown = sorted(set(only) - {t.id for t in tasks})
-        if unknown:
-            raise UserError(f"unknown task id(s): {', '.join(unknown)}")
+    check_only(only, [t.id for t in tasks])
     make_detector(settings)  # fail fast (no LLM for llm/hybrid) before any item runs
-    chosen = [t for t in tasks if not only or t.id in only]
+    chosen = [t.id for t in tasks if not only or t.id in only]
     # A task whose scene was never built (or failed to build) is the build stage's failure, already
-    # recorded there; detection lists it in the report instead of failing it a second time.
-    built = [t for t in chosen if (run.scene_dir(t.id) / "scene_graph.json").is_file()]
+    # recorded there; evaluate lists it as missing instead of failing it a second time here.
+    built = [tid for tid in chosen if _graph_path(run, tid).is_file()]
     if only and len(built) < len(chosen):
-        missing = sorted({t.id for t in chosen} - {t.id for t in built})
+        missing = sorted(set(chosen) - set(built))
         raise UserError(f"no built scene for: {', '.join(missing)} (run 'anomalygen build' first)")
-    items = [(t.id, {}) for t in built]  # the detector gets the scene graph, never the task
-    summary = run_items(run, STAGE, items, _item, settings=settings, is_done=_is_done_for(run, settings), force=force,
-                        description=f"detect ({settings.detect.detector})")
-    record_llm_usage(run, summary)
+    summary = run_items(run, STAGE, [(tid, {}) for tid in built], _item, settings=settings,
+                        is_done=_is_done_for(run, settings), force=force,
+                        description=f"detect ({settings.detect.detector})",
+                        inputs=lambda tid: [_graph_path(run, tid)],
+                        config=config_section(settings, "detect", llm=settings.detect.detector != "rules"))
+    _record_llm_usage(run, summary)
 
     detections = [d for t in tasks if (d := try_read_model(detection_path(run, t.id), Detection)) is not None]
     write_jsonl(run.detections_path, detections)
@@ -127,23 +129,17 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
         from rich.console import Console
 
         console = Console(stderr=True)
-        console.print(claims_line(detections, settings.detect.detector), highlight=False)
+        claims = Counter(len(d.hypotheses) for d in detections)
+        console.print(f"detections ({settings.detect.detector}): {len(detections)} scenes, "
+                      f"{sum(n * c for n, c in claims.items())} claims, {claims.get(0, 0)} scenes with none, "
+                      f"{sum(1 for d in detections if d.error)} failed; scored against the truth by "
+                      "'anomalygen evaluate' (detections_summary.json)", highlight=False)
         if fallbacks:
             console.print(f"[yellow]{fallbacks} scene(s): LLM ranking failed, rule order kept[/yellow]")
     return summary
 
 
-def claims_line(detections: list[Detection], detector: str) -> str:
-    """What the detector claimed, in one line (how the claims fare is for ``anomalygen evaluate`` to say)."""
-    top = Counter(d.hypotheses[0].hazard_class or "free text" for d in detections if d.hypotheses)
-    failed = sum(1 for d in detections if d.error)
-    quiet = sum(1 for d in detections if not d.hypotheses and not d.error)
-    common = ", ".join(f"{c} x{n}" for c, n in top.most_common(5))
-    return (f"detect ({detector}): {len(detections)} scenes, {sum(len(d.hypotheses) for d in detections)} "
-            f"hypotheses, {quiet} with none, {failed} failed; most common top-1 class: {common or 'none'}")
-
-
-def record_llm_usage(run: RunFolder, summary: StageSummary) -> None:
+def _record_llm_usage(run: RunFolder, summary: StageSummary) -> None:
     from anomalygen.schema import LLMUsage
 
     total = LLMUsage()

@@ -2,10 +2,9 @@
 
 Every figure is counted against the builder's hidden truth (``truth.json``), hazard by hazard, over
 every class: a hazard is *detected* when a claim of the scene's detection names it, *planned* when the
-scene's plan acts on its object, *resolved* when the referee's verdict (``verdict.json``) found it fixed
-at the end of a run, with no hazard class still firing on its object (over the runs of its scene).
-Harm is counted per run: runs that created a new hazard (such a run is not resolved, even when this
-hazard is), and runs that acted on a near-miss (an object that was already safe).
+scene's plan acts on its object, *resolved* when the referee found it fixed at the end of a run (over
+the runs of its scene). Harm is counted per run: runs that created a new hazard, and runs that acted
+on a near-miss (an object that was already safe).
 """
 
 from __future__ import annotations
@@ -23,8 +22,7 @@ class ClassRow(Strict):
     detected: int = 0
     planned: int = 0
     runs: int = Field(0, description="(hazard, seed) executions judged")
-    resolved: int = Field(0, description="of those, the hazard was fixed at the end (no class fires on its object) "
-                          "and the run created no new hazard")
+    resolved: int = Field(0, description="of those, the hazard was fixed at the end")
 
 
 class HazardTable(Strict):
@@ -35,15 +33,12 @@ class HazardTable(Strict):
     runs: int = Field(0, description="executions (scene, seed) judged by the referee")
     runs_with_new_hazards: int = 0
     runs_acting_on_safe: int = 0
-    hazard_free_runs: int = Field(0, description="runs on hazard-free scenes (never counted as resolved)")
-    hazard_free_left_alone: int = Field(0, description="of those, verdict 'no_action_needed'")
 
 
 def hazard_table(run: RunFolder, task_ids: list[str], seeds: int) -> HazardTable:
     """The table over ``task_ids`` (every scene with a truth.json), ``seeds`` runs per scene."""
-    from anomalygen.referee.score import claim_matches
-    from anomalygen.referee.stage import load_verdict
-    from anomalygen.referee.truth import load_manifest
+    from anomalygen.evaluate.detection_scores import finds, load_manifest
+    from anomalygen.evaluate.verdicts import verdict_of
 
     rows: dict[str, ClassRow] = defaultdict(ClassRow)
     table = HazardTable()
@@ -56,25 +51,22 @@ def hazard_table(run: RunFolder, task_ids: list[str], seeds: int) -> HazardTable
         det = try_read_model(run.detections_dir / f"{tid}.json", Detection)
         plan = try_read_model(run.plan_path(tid), Plan)
         acted = {str(st.params.get("object")) for st in plan.subtasks} if plan is not None else set()
-        verdicts = [v for s in range(seeds) if (v := load_verdict(run, tid, s)) is not None]
-        for v in verdicts:
+        results = [v for s in range(seeds) if (v := verdict_of(run, tid, s)) is not None]
+        for r in results:
             table.runs += 1
-            table.runs_with_new_hazards += int(bool(v.new_hazards))
-            table.runs_acting_on_safe += int(bool(v.interventions_on_safe))
-            if not manifest.hazards:
-                table.hazard_free_runs += 1
-                table.hazard_free_left_alone += int(v.status == "no_action_needed")
+            table.runs_with_new_hazards += int(bool(r.new_hazards))
+            table.runs_acting_on_safe += int(bool(r.interventions_on_safe))
         for h in manifest.hazards:
             row = rows[h.hazard_class]
             row.hazards += 1
             hyps = det.hypotheses if det is not None else []
-            row.detected += int(any(claim_matches(x, h.object, h.hazard_class, h.category) for x in hyps))
+            row.detected += int(finds(hyps, h))
             row.planned += int(h.object in acted)
-            for v in verdicts:
-                outcome = next((o for o in v.hazards if o.object == h.object), None)
+            for r in results:
+                outcome = next((o for o in r.hazards if o.object == h.object), None)
                 if outcome is not None:
                     row.runs += 1
-                    row.resolved += int(outcome.resolved and not v.new_hazards)
+                    row.resolved += int(outcome.resolved)
     table.by_class = dict(sorted(rows.items()))
     for row in table.by_class.values():
         for key in ("hazards", "detected", "planned", "runs", "resolved"):
@@ -93,8 +85,7 @@ def markdown(table: HazardTable, title: str = "") -> str:
         lines.append(f"| {name} | {r.hazards} | {pct(r.detected, r.hazards)} | {pct(r.planned, r.hazards)} | "
                      f"{pct(r.resolved, r.runs)} of {r.runs} |")
     lines.append("")
-    lines.append(f"{table.scenes} scenes ({table.hazard_free_scenes} hazard-free), {table.runs} runs judged by the "
-                 f"referee: {pct(table.runs_with_new_hazards, table.runs)} created a new hazard, "
-                 f"{pct(table.runs_acting_on_safe, table.runs)} acted on an already-safe object; on hazard-free "
-                 f"scenes {pct(table.hazard_free_left_alone, table.hazard_free_runs)} of runs left the scene alone.")
+    lines.append(f"{table.scenes} scenes ({table.hazard_free_scenes} hazard-free), {table.runs} runs: "
+                 f"{pct(table.runs_with_new_hazards, table.runs)} created a new hazard, "
+                 f"{pct(table.runs_acting_on_safe, table.runs)} acted on an already-safe object.")
     return "\n".join(lines).strip() + "\n"

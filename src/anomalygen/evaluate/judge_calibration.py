@@ -1,4 +1,4 @@
-"""Calibrate the judge's Sentence-BERT threshold on the hand-labelled pairs, and report how good it is.
+"""Calibrate the text judge's Sentence-BERT threshold on the hand-labelled pairs, and report how good it is.
 
 ``python -m anomalygen.evaluate.judge_calibration`` embeds every (hypothesis, task) pair of
 ``data/judge/calibration.jsonl``, picks the threshold with the best F1, prints precision and recall

@@ -12,11 +12,12 @@ really gone is the judge stage's verdict (``anomalygen judge``), which this stag
 from __future__ import annotations
 
 from collections import defaultdict
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from anomalygen.errors import ItemFailed
 from anomalygen.runfolder import RunFolder, try_read_model, write_model
-from anomalygen.runner import StageContext, StageSummary, run_items
+from anomalygen.runner import StageContext, StageSummary, check_only, config_section, run_items
 from anomalygen.schema import Plan, SkillResult
 
 if TYPE_CHECKING:
@@ -58,6 +59,12 @@ def learn_item(item_id: str, payload: dict, ctx: StageContext) -> dict:
     return {"success": result.success}
 
 
+def _inputs(run: RunFolder, task_id: str) -> list[Path]:
+    """What an execution is made from: its plan and the built scene (a re-plan or rebuild redoes it)."""
+    scene = run.scene_dir(task_id)
+    return [run.plan_path(task_id), scene / "scene.json", scene / "scene.xml", scene / "scene_graph.json"]
+
+
 def success_table(run: RunFolder, items: list[tuple[str, dict]], classes: dict[str, str]) -> dict[str, dict[str, float]]:
     """Per hazard class of the task (``classes``: task id -> class; the grouping is done here, after
     the items, which never see it): executions and the robot's own check (``success``: its plan's final
@@ -78,12 +85,11 @@ TABLE_COUNTS = ("n", "success")
 
 def _print_table(table: dict[str, dict[str, float]]) -> None:
     from rich.console import Console
-    from rich.table import Table
 
-    t = Table(title="robot's own check by hazard class (the referee's verdict: anomalygen judge)")
-    columns = ("hazard class", "runs", "robot's own check: plan done")
-    for col in columns:
-        t.add_column(col, justify="left" if col == "hazard class" else "right", overflow="fold")
+    from anomalygen.tables import name_table
+
+    t = name_table("robot's own check by hazard class (the referee's verdict: anomalygen judge)", "hazard class",
+                   ("runs", "robot's own check: plan done"), [*table, "all"])
 
     def cells(name: str, row: dict) -> list[str]:
         n = row["n"]
@@ -99,7 +105,9 @@ def _print_table(table: dict[str, dict[str, float]]) -> None:
 
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
     items: list[tuple[str, dict]] = []
-    for t in run.load_tasks():
+    tasks = run.load_tasks()
+    check_only(only, [t.id for t in tasks])
+    for t in tasks:
         if only and t.id not in only:
             continue
         if not run.plan_path(t.id).is_file() or not (run.scene_dir(t.id) / "scene.json").is_file():
@@ -111,8 +119,10 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
         task_id, seed = _split(item_id)
         return try_read_model(run.skill_dir(task_id, seed) / "result.json", SkillResult) is not None
 
-    summary = run_items(run, STAGE, items, learn_item, settings=settings, is_done=done, force=force)
-    table = success_table(run, items, {t.id: t.hazard_class for t in run.load_tasks()})
+    summary = run_items(run, STAGE, items, learn_item, settings=settings, is_done=done, force=force,
+                        inputs=lambda item_id: _inputs(run, _split(item_id)[0]),
+                        config=config_section(settings, "learn", exclude=("seeds",)))
+    table = success_table(run, items, {t.id: t.hazard_class for t in tasks})
     summary.results["by_class"] = table
     if not settings.quiet and table:
         _print_table(table)

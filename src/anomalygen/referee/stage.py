@@ -6,8 +6,8 @@ and settled and judged against the truth into ``verdict.json``, with the scene g
 in ``judged_graph.json``. Runs from before the state was saved are judged on their
 ``final_graph.json`` as it was (``judged_from = "graph"``).
 
-An item is done when every run has a verdict at least as new as its result, so re-running learn
-redoes the judging. After the items: the fixes table by hazard class — the referee's verdict, with
+An item is done when every run has a verdict and its fingerprint (the scene, its truth, each run's
+result and final state) is unchanged, so re-running learn or rebuilding the scene redoes the judging. After the items: the fixes table by hazard class — the referee's verdict, with
 the robot's own check beside it. (Detections are scored against the truth on the evaluate side.)
 """
 
@@ -17,9 +17,8 @@ from collections import defaultdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from anomalygen.errors import UserError
 from anomalygen.runfolder import RunFolder, try_read_model, write_model
-from anomalygen.runner import StageContext, StageSummary, run_items
+from anomalygen.runner import StageContext, StageSummary, check_only, run_items
 from anomalygen.schema import SceneGraph, SceneSpec, SkillResult, TaskProposal, Verdict
 
 if TYPE_CHECKING:
@@ -52,8 +51,14 @@ def _seeds(run: RunFolder, task_id: str) -> list[int]:
                   if p.parent.name.removeprefix("seed").isdigit())
 
 
-def _fresh(out: Path, source: Path) -> bool:
-    return out.is_file() and out.stat().st_mtime >= source.stat().st_mtime
+def _inputs(run: RunFolder, task_id: str) -> list[Path]:
+    """What a task's verdicts are made from: the scene, its truth, and every run's result and end state."""
+    from anomalygen.scene.state import FINAL_STATE
+
+    scene = run.scene_dir(task_id)
+    runs = [run.skill_dir(task_id, s) / name for s in _seeds(run, task_id)
+            for name in ("result.json", FINAL_STATE, FINAL_GRAPH)]
+    return [scene / "scene.json", scene / "scene.xml", scene / "truth.json", *runs]
 
 
 def judge_run(run: RunFolder, task_id: str, seed: int, spec: SceneSpec, manifest, kb, scene=None) -> Verdict | None:
@@ -106,8 +111,7 @@ def _is_done_for(run: RunFolder):
     def is_done(task_id: str) -> bool:
         if not (run.scene_dir(task_id) / "truth.json").is_file():
             return True
-        return all(_fresh(verdict_path(run, task_id, s), run.skill_dir(task_id, s) / "result.json")
-                   for s in _seeds(run, task_id))
+        return all(verdict_path(run, task_id, s).is_file() for s in _seeds(run, task_id))
     return is_done
 
 
@@ -164,14 +168,11 @@ def _print_table(table: dict[str, dict[str, float]]) -> None:
 
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
     tasks = run.load_tasks()
-    if only:
-        unknown = sorted(set(only) - {t.id for t in tasks})
-        if unknown:
-            raise UserError(f"unknown task id(s): {', '.join(unknown)}")
+    check_only(only, [t.id for t in tasks])
     chosen = [t for t in tasks if (not only or t.id in only) and (run.scene_dir(t.id) / "scene.json").is_file()]
     items = [(t.id, {}) for t in chosen]
     summary = run_items(run, STAGE, items, judge_item, settings=settings, is_done=_is_done_for(run), force=force,
-                        description="judge")
+                        description="judge", inputs=lambda task_id: _inputs(run, task_id))
     table = verdict_table(run, chosen)
     summary.results["by_class"] = table
     if not settings.quiet and table:

@@ -10,7 +10,8 @@ edge onto the floor is no longer at the edge, and is within a child's reach). Th
 against the run: a hazard present at the end that was not there at the start (a glass knocked to
 the floor, a door left open) makes the run unresolved, and acting on a near-miss (moving a knife
 that was already shut in a drawer) is reported. A scene that held no hazard is never "resolved":
-the run either left it alone (``no_action_needed``) or acted on something safe (``acted_on_safe``).
+the run either left it alone (``no_action_needed``) or acted on it (``acted_on_safe``: it moved a
+near-miss or made a hazard; ``new_hazards`` says which).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from __future__ import annotations
 import math
 
 from anomalygen.referee.truth import class_matches
-from anomalygen.schema import FixOutcome, HazardManifest, HazardVerdict, SceneGraph, Verdict
+from anomalygen.schema import HazardManifest, HazardVerdict, SceneGraph, Verdict
 
 MOVED_M = 0.05  # a near-miss object displaced further than this was acted on
 TURNED = 0.1  # a near-miss joint (rad or m) moved further than this was acted on
@@ -58,30 +59,12 @@ def verdict_on(manifest: HazardManifest, initial: SceneGraph, final: SceneGraph,
     if manifest.hazards:
         resolved = all(h.resolved for h in hazards) and not new
         status = "resolved" if resolved else "unresolved"
-    else:
+    else:  # nothing to fix: left alone, or acted on (moved a near-miss, or made a hazard)
         resolved = False
-        status = "unresolved" if new else "acted_on_safe" if on_safe else "no_action_needed"
+        status = "acted_on_safe" if new or on_safe else "no_action_needed"
     return Verdict(task_id=task_id, seed=seed, status=status, resolved=resolved, hazards=hazards, new_hazards=new,
                    interventions_on_safe=on_safe, released=sorted(released or []), judged_from=judged_from,
                    settle_s=settle_s)
-
-
-def from_old_outcome(task_id: str, seed: int, outcome: FixOutcome) -> Verdict:
-    """An old run's ``SkillResult.outcome`` read as a verdict (judged on its final graph as saved). Its
-    ``resolved`` said True for a hazard-free scene; here such a run is no_action_needed or acted_on_safe,
-    and a run that created a hazard is unresolved, as for new runs."""
-    hazards = [HazardVerdict(hazard_class=h.hazard_class, object=h.object, resolved=h.resolved, detail=h.detail)
-               for h in outcome.hazards]
-    if hazards:
-        resolved = all(h.resolved for h in hazards) and not outcome.new_hazards
-        status = "resolved" if resolved else "unresolved"
-    else:
-        resolved = False
-        status = ("unresolved" if outcome.new_hazards else "acted_on_safe" if outcome.interventions_on_safe
-                  else "no_action_needed")
-    return Verdict(task_id=task_id, seed=seed, status=status, resolved=resolved, hazards=hazards,
-                   new_hazards=list(outcome.new_hazards), interventions_on_safe=list(outcome.interventions_on_safe),
-                   judged_from="graph")
 
 
 def _acted_on(name: str, initial: SceneGraph, final: SceneGraph) -> bool:

@@ -36,7 +36,7 @@ class Verdict(Artefact):
 
     ``status``: a scene with hazards is ``resolved`` (every hazard resolved and no new hazard) or
     ``unresolved``; a hazard-free scene is never resolved: ``no_action_needed`` when the robot left it
-    as it was, ``acted_on_safe`` when it moved a near-miss, ``unresolved`` when it created a hazard.
+    as it was, ``acted_on_safe`` when it moved a near-miss or created a hazard (``new_hazards``).
     """
 
     task_id: str
