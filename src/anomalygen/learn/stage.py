@@ -84,9 +84,7 @@ TABLE_COUNTS = ("n", "success")
 
 
 def _print_table(table: dict[str, dict[str, float]]) -> None:
-    from rich.console import Console
-
-    from anomalygen.tables import name_table
+    from anomalygen.tables import name_table, print_with_total
 
     t = name_table("robot's own check by hazard class (the referee's verdict: anomalygen judge)", "hazard class",
                    ("runs", "robot's own check: plan done"), [*table, "all"])
@@ -96,11 +94,7 @@ def _print_table(table: dict[str, dict[str, float]]) -> None:
         done = f"{row['success']} ({row['success'] / n:.0%})" if n else "-"
         return [name, str(n), done]
 
-    for hc, row in table.items():
-        t.add_row(*cells(hc, row))
-    total = {k: sum(r[k] for r in table.values()) for k in TABLE_COUNTS}
-    t.add_row(*cells("all", total))
-    Console(stderr=True).print(t)
+    print_with_total(t, table, TABLE_COUNTS, cells)
 
 
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:

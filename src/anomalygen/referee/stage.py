@@ -141,14 +141,11 @@ def verdict_table(run: RunFolder, tasks: list[TaskProposal]) -> dict[str, dict[s
 
 
 def _print_table(table: dict[str, dict[str, float]]) -> None:
-    from rich.console import Console
-    from rich.table import Table
+    from anomalygen.tables import name_table, print_with_total
 
-    t = Table(title="the referee's verdict by hazard class (free: hazard-free scenes; robot's own check last)")
-    columns = ("hazard class", "runs", "resolved", "free: idle/acted", "new haz.", "on safe", "robot's own")
-    for col in columns:
-        first = col == "hazard class"
-        t.add_column(col, justify="left" if first else "right", no_wrap=first, overflow="fold")
+    t = name_table("the referee's verdict by hazard class (free: hazard-free scenes; robot's own check last)",
+                   "hazard class", ("runs", "resolved", "free: idle/acted", "new haz.", "on safe", "robot's own"),
+                   [*table, "all"])
 
     def cells(name: str, row: dict) -> list[str]:
         with_hazards = row["judged"] - row["hazard_free"]
@@ -159,11 +156,7 @@ def _print_table(table: dict[str, dict[str, float]]) -> None:
         return [name, str(row["runs"]), resolved, f"{row['no_action_needed']}/{row['acted_on_safe']}" if free else "-",
                 str(row["new_hazards"]), str(row["on_safe"]), f"{row['robot_done']}/{row['runs']}"]
 
-    for hc, row in table.items():
-        t.add_row(*cells(hc, row))
-    total = {k: sum(r[k] for r in table.values()) for k in TABLE_COUNTS}
-    t.add_row(*cells("all", total))
-    Console(stderr=True).print(t)
+    print_with_total(t, table, TABLE_COUNTS, cells)
 
 
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
