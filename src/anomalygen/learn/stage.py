@@ -86,8 +86,8 @@ TABLE_COUNTS = ("n", "success")
 def _print_table(table: dict[str, dict[str, float]]) -> None:
     from anomalygen.tables import name_table, print_with_total
 
-    t = name_table("robot's own check by hazard class (the referee's verdict: anomalygen judge)", "hazard class",
-                   ("runs", "robot's own check: plan done"), [*table, "all"])
+    t = name_table("the robot's own check (its plan's final condition held) by hazard class; the referee's "
+                   "verdict: anomalygen judge", "hazard class", ("runs", "own check"), [*table, "all"])
 
     def cells(name: str, row: dict) -> list[str]:
         n = row["n"]

@@ -143,16 +143,14 @@ def verdict_table(run: RunFolder, tasks: list[TaskProposal]) -> dict[str, dict[s
 def _print_table(table: dict[str, dict[str, float]]) -> None:
     from anomalygen.tables import name_table, print_with_total
 
-    t = name_table("the referee's verdict by hazard class (free: hazard-free scenes; robot's own check last)",
-                   "hazard class", ("runs", "resolved", "free: idle/acted", "new haz.", "on safe", "robot's own"),
-                   [*table, "all"])
+    t = name_table("the referee's verdict by hazard class; free: hazard-free runs left alone/acted on; new: runs "
+                   "that made a hazard; own: the robot's own check", "hazard class",
+                   ("runs", "resolved", "free", "new", "on safe", "own"), [*table, "all"])
 
     def cells(name: str, row: dict) -> list[str]:
         with_hazards = row["judged"] - row["hazard_free"]
         free = row["hazard_free"]
         resolved = f"{row['resolved']}/{with_hazards}" if with_hazards else "-"
-        if name == "all" and with_hazards:
-            resolved += f" {row['resolved'] / with_hazards:.0%}"
         return [name, str(row["runs"]), resolved, f"{row['no_action_needed']}/{row['acted_on_safe']}" if free else "-",
                 str(row["new_hazards"]), str(row["on_safe"]), f"{row['robot_done']}/{row['runs']}"]
 
