@@ -3,7 +3,7 @@
 The builder writes each scene's hidden ``truth.json`` through :mod:`anomalygen.referee.truth`; after
 the robot's items have finished, the judge stage (:mod:`anomalygen.referee.stage`, ``anomalygen
 judge``) scores the detections and judges every run's settled final state. Nothing on the robot's
-side (detect, plan, learn, control, rl, robot, skills) imports this package; ``tests/test_layout.py``
+side (detect, plan, learn, robot, skills) imports this package; ``tests/test_layout.py``
 enforces it.
 
 Public entry points:
