@@ -98,7 +98,7 @@ def test_the_scan_catches_a_literal_copy(tmp_path, monkeypatch):
 
 def test_every_closure_the_planner_and_skills_use_is_enclosing_in_the_table_and_the_graph():
     from anomalygen.plan import planner
-    from anomalygen.scene.graph import _is_closed_enclosure
+    from anomalygen.scene.graph import cavity_closers, cavity_shut
     from anomalygen.skills.scripted import access, joints
 
     used = {*planner.CLOSURES, *planner.LID_PARTS.split("|"), *access.CLOSURES_ALL, *access.LIDS,
@@ -106,10 +106,18 @@ def test_every_closure_the_planner_and_skills_use_is_enclosing_in_the_table_and_
     assert part_labels.FLAP in used
     for label in used:
         assert part_labels.encloses(label) and part_labels.is_closure(label), label
-        shut = JointState(name=f"{label}_0", label=label, value=0.0, range=(0.0, 1.5), closed_value=0.0)
-        assert shut.encloses and _is_closed_enclosure([shut]), label
-        ajar = shut.model_copy(update={"value": 0.5})
-        assert not _is_closed_enclosure([ajar]), label
+        # the graph: a cavity that names this part (and a second leaf no cavity names) is shut by both
+        leaves = [JointState(name=f"{label}_{i}", label=label, value=0.0, range=(0.0, 1.5), closed_value=0.0)
+                  for i in range(2)]
+        (closers,) = cavity_closers(leaves, [leaves[0].name])
+        assert {js.name for js in closers} == {js.name for js in leaves}, label
+        assert cavity_shut([(js, 0.0) for js in closers]), label
+        assert not cavity_shut([(js, 0.5 if js is leaves[1] else 0.0) for js in closers]), label
+    # a part that does not enclose (an oven rack's slide, a window) leaves a cavity to the enclosing ones
+    rack = JointState(name="rack", label="rack", value=0.0, range=(0.0, 0.3), closed_value=0.0)
+    flap = JointState(name="flap_0", label=part_labels.FLAP, value=0.0, range=(0.0, 1.5), closed_value=0.0)
+    assert [[js.name for js in c] for c in cavity_closers([rack, flap], ["rack", None])] == [["flap_0"], ["flap_0"]]
+    assert cavity_closers([rack], ["rack"]) == [[]] and not cavity_shut([])
     # and the table's views are the same sets
     assert set(part_labels.ENCLOSING_LABELS) == used
     assert set(part_labels.LID_LABELS) == {part_labels.LID, part_labels.FLAP}

@@ -3,9 +3,9 @@
 Every artefact is a file in the run folder, so each class is strict (unknown fields are errors, not
 silently dropped) and carries a ``schema_version`` so old runs can be detected rather than misread.
 Stages depend on these classes, never on each other's internals. One module per stage owns its
-artefacts (``tasks``, ``scenes``, ``detection``, ``skills``, ``run``) over the shared ``base`` and
-``vocabulary``; import every name from ``anomalygen.schema``. ``part_labels`` is the one table of
-joint labels (what shuts, encloses, switches) that every stage decides by.
+artefacts (``tasks``, ``scenes``, ``detection``, ``skills``, ``verdicts``, ``run``) over the shared
+``base`` and ``vocabulary``; import every name from ``anomalygen.schema``. ``part_labels`` is the one
+table of joint labels (what shuts, encloses, switches) that every stage decides by.
 """
 
 from __future__ import annotations
@@ -56,18 +56,21 @@ from anomalygen.schema.run import (
 )
 from anomalygen.schema.scenes import (
     CHILD_REACH,
+    LATCHING_PROPERTY,
     AssetRef,
     GraphObject,
     HazardManifest,
     JointState,
     ManifestHazard,
     NearMiss,
+    PlacedCavity,
     PlacedObject,
     Relation,
     SceneGraph,
     SceneSpec,
     ValidationCheck,
     ValidationReport,
+    within_child_reach,
 )
 from anomalygen.schema.skills import (
     FixOutcome,
@@ -88,6 +91,7 @@ from anomalygen.schema.tasks import (
     Scenario,
     TaskProposal,
 )
+from anomalygen.schema.verdicts import HazardVerdict, Verdict, VerdictStatus
 from anomalygen.schema.vocabulary import (
     AssetSource,
     BrainstormMode,
@@ -116,6 +120,7 @@ ARTEFACTS: dict[str, type[BaseModel]] = {
         RewardSpec,
         SuccessSpec,
         SkillResult,
+        Verdict,
         RunManifest,
         ItemError,
     )
@@ -165,7 +170,10 @@ __all__ = [
     "TAP",
     "FAUCET",
     "CHILD_REACH",
+    "LATCHING_PROPERTY",
+    "within_child_reach",
     "JointState",
+    "PlacedCavity",
     "PlacedObject",
     "ValidationCheck",
     "ValidationReport",
@@ -188,6 +196,9 @@ __all__ = [
     "HazardOutcome",
     "FixOutcome",
     "SkillResult",
+    "HazardVerdict",
+    "Verdict",
+    "VerdictStatus",
     "StageRecord",
     "LLMUsage",
     "RunManifest",
