@@ -13,7 +13,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from anomalygen.schema import CHILD_REACH, DOOR, DRAWER, GraphObject, JointState, Relation, SceneGraph
+from anomalygen.schema import (
+    CHILD_REACH,
+    DOOR,
+    DRAWER,
+    GraphObject,
+    JointState,
+    Relation,
+    SceneGraph,
+    part_labels,
+)
 
 #: Top-surface heights (m) per placement, inside the knowledge base's SUPPORT_HEIGHTS ranges.
 SURFACE_TOP = {"table": 0.75, "table_edge": 0.75, "counter": 0.9, "counter_edge": 0.9, "shelf": 1.4, "low_table": 0.42}
@@ -78,7 +87,7 @@ def _hazard_objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObject]
     name = f"{obj.lower()}_0"
     props = _props(kb, obj)
     if hc.hazard_variable == "$target" and hc.articulation is not None:
-        label = kb.articulation_part(hc, obj) or hc.articulation.part.split("|")[0]
+        label = kb.articulation_part(hc, obj) or part_labels.alternatives(hc.articulation.part)[0]
         frac = 0.8 if hc.articulation.initial_state in ("open", "on") else 0.0
         objs = [_obj(name, obj, props, pos=(1.0, -0.8, 0.5), size=(0.6, 0.6, 1.0), height=0.0, on_floor=True,
                      joints=[_joint(f"{name}_{label}", label, frac)])]

@@ -247,7 +247,7 @@ def set_articulations(chosen: Chosen, uses: list[tuple[str, str]], rng: np.rando
             # 'door|drawer': opening one kind is enough for the hazard; prefer the first alternative found
             canonical = part_labels.canonical
             first = next(
-                canonical(x) for x in label.split("|") if any(canonical(j.label) == canonical(x) for j in joints)
+                canonical(x) for x in part_labels.alternatives(label) if any(canonical(j.label) == canonical(x) for j in joints)
             )
             joints = [j for j in joints if canonical(j.label) == first]
         for joint in joints:

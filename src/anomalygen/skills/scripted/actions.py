@@ -116,7 +116,7 @@ class PushPull(Skill):
         prm, obj = dict(subtask.params), _object(episode, subtask)
         if prm.get("access"):
             if subtask.primitive == "pull":
-                return access.open_for_access(episode, obj, str(prm.get("part", LID)).split("|"), prm.get("contents"))
+                return access.open_for_access(episode, obj, part_labels.alternatives(str(prm.get("part", LID))), prm.get("contents"))
             return access.close_opened(episode, obj, every=bool(prm.get("contents")))
         return drive_joints(episode, subtask, obj, subtask.primitive or "", prm)
 

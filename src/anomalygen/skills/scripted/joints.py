@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from anomalygen.schema import ENCLOSING_LABELS, SubTask
+from anomalygen.schema import ENCLOSING_LABELS, SubTask, part_labels
 from anomalygen.skills.registry import SkillOutcome
 from anomalygen.skills.scripted.parts import actuate_part
 
@@ -41,7 +41,7 @@ def drive_joints(ep: Episode, st: SubTask, obj: str, prim: str, prm: dict) -> Sk
         if o.name != obj:
             continue
         for js in o.joint_states:
-            if label is not None and js.label not in label.split("|") and js.name != prm.get("joint"):
+            if label is not None and js.label not in part_labels.alternatives(label) and js.name != prm.get("joint"):
                 continue
             lo, hi = js.range
             closed = js.closed_value
