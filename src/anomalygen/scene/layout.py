@@ -30,6 +30,10 @@ EDGE_BAND = (0.015, 0.07)  # metres from the edge for *_edge placements (KB thre
 WALKWAY_CLEAR = 0.42  # > the KB's 0.3 m walkway clearance, with margin
 TUCK_GAP = (0.03, 0.12)  # metres from a fixture's side for an item tucked out of the walkway (KB: 0.3)
 TRIES = 60
+# Clearance kept round the robot at its start pose (its shape is the agent's: BASE_RADIUS, HOME_ARM_BOXES)
+BASE_CLEAR_TOP = 0.35  # m: a box whose bottom is lower than this (the base's 0.30 m top, plus 5 cm) can hit the base
+BASE_CLEAR_SIDE = 0.08  # m kept between such a box and the base disc
+ARM_CLEAR = 0.03  # m kept between any box and the arm's boxes at the home pose
 
 
 @dataclass
@@ -141,25 +145,18 @@ class Layout:
 
     def _hits_base(self, box) -> bool:
         """Does a world AABB intrude on the robot: its base disc, or the arm's box at the home pose?"""
-        if box[0][2] < 0.35:
+        if box[0][2] < BASE_CLEAR_TOP:
             closest = np.clip(self.base[:2], box[0][:2], box[1][:2])
-            if float(np.linalg.norm(closest - self.base[:2])) < Agent.BASE_RADIUS + 0.08:
+            if float(np.linalg.norm(closest - self.base[:2])) < Agent.BASE_RADIUS + BASE_CLEAR_SIDE:
                 return True
-        return any(overlaps(box, arm, margin=0.03) for arm in self.arm_boxes())
+        return any(overlaps(box, arm, margin=ARM_CLEAR) for arm in self.arm_boxes())
 
     def arm_boxes(self) -> list[tuple[np.ndarray, np.ndarray]]:
-        """World AABBs of the arm at its home pose: the column above the base and the forearm with
-        the cup, which hangs 0.3 m forward with its lowest point at ~1.01 m (above counters)."""
+        """World AABBs of the arm at its home pose (``Agent.HOME_ARM_BOXES``, turned with the base)."""
         c, s = math.cos(self.base[2]), math.sin(self.base[2])
         out = []
-        for (x0, x1), (z0, z1) in (((-0.2, 0.12), (0.3, 1.35)), ((0.12, 0.42), (0.98, 1.35))):
-            xy = np.array(
-                [
-                    [self.base[0] + c * x - s * y, self.base[1] + s * x + c * y]
-                    for x in (x0, x1)
-                    for y in (-0.15, 0.15)
-                ]
-            )
+        for (x0, x1), (y0, y1), (z0, z1) in Agent.HOME_ARM_BOXES:
+            xy = np.array([[self.base[0] + c * x - s * y, self.base[1] + s * x + c * y] for x in (x0, x1) for y in (y0, y1)])
             out.append((np.r_[xy.min(0), z0], np.r_[xy.max(0), z1]))
         return out
 
