@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from anomalygen.robot.agent import Agent
+from anomalygen.robot.motion import CHECKS_PER_IDLE_S
 from support.testbed import scene_with_obstacle
 
 DOWN = np.array([0.0, 0.0, -1.0])
@@ -111,7 +112,7 @@ def test_goes_around_an_obstacle_on_the_straight_route():
     drv = _driver(m, d)
     mon = Monitor(m, d)
     drv.on_step = mon
-    res = move_arm_planned(drv, target, quat, seed=0, time_limit=3.0)
+    res = move_arm_planned(drv, target, quat, seed=0, max_checks=3 * CHECKS_PER_IDLE_S)
     assert res.ok, res
     print(res, mon.deepest, mon.drift)
     assert np.linalg.norm(drv.site - target) < 0.015
@@ -150,7 +151,7 @@ def test_held_object_is_carried_and_checked():
     mon = Monitor(m, d)
     drv.on_step = mon
     target = d.body("bin_0").xpos + np.array([0.0, 0.0, 0.4])
-    res = move_arm_planned(drv, target, quat_z_to(DOWN), seed=0, time_limit=3.0)
+    res = move_arm_planned(drv, target, quat_z_to(DOWN), seed=0, max_checks=3 * CHECKS_PER_IDLE_S)
     assert res.ok, res
     print(res, mon.deepest, mon.drift)
     assert np.linalg.norm(drv.site - target) < 0.015
