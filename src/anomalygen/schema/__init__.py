@@ -3,7 +3,7 @@
 Every artefact is a file in the run folder, so each class is strict (unknown fields are errors, not
 silently dropped) and carries a ``schema_version`` so old runs can be detected rather than misread.
 Stages depend on these classes, never on each other's internals. One module per stage owns its
-artefacts (``tasks``, ``scenes``, ``detection``, ``skills``, ``run``) over the shared ``base`` and
+artefacts (``tasks``, ``scenes``, ``detection``, ``skills``, ``verdicts``, ``run``) over the shared ``base`` and
 ``vocabulary``; import every name from ``anomalygen.schema``.
 """
 
@@ -36,6 +36,7 @@ from anomalygen.schema.scenes import (
     CLOSED_TOL,
     CLOSURE_LABELS,
     ENCLOSING_LABELS,
+    LATCHING_PROPERTY,
     SWINGING_CLOSURES,
     AssetRef,
     GraphObject,
@@ -43,12 +44,14 @@ from anomalygen.schema.scenes import (
     JointState,
     ManifestHazard,
     NearMiss,
+    PlacedCavity,
     PlacedObject,
     Relation,
     SceneGraph,
     SceneSpec,
     ValidationCheck,
     ValidationReport,
+    within_child_reach,
 )
 from anomalygen.schema.skills import (
     FixOutcome,
@@ -69,6 +72,7 @@ from anomalygen.schema.tasks import (
     Scenario,
     TaskProposal,
 )
+from anomalygen.schema.verdicts import HazardVerdict, Verdict, VerdictStatus
 from anomalygen.schema.vocabulary import (
     AssetSource,
     BrainstormMode,
@@ -97,6 +101,7 @@ ARTEFACTS: dict[str, type[BaseModel]] = {
         RewardSpec,
         SuccessSpec,
         SkillResult,
+        Verdict,
         RunManifest,
         ItemError,
     )
@@ -130,7 +135,10 @@ __all__ = [
     "SWINGING_CLOSURES",
     "CLOSED_TOL",
     "CHILD_REACH",
+    "LATCHING_PROPERTY",
+    "within_child_reach",
     "JointState",
+    "PlacedCavity",
     "PlacedObject",
     "ValidationCheck",
     "ValidationReport",
@@ -153,6 +161,9 @@ __all__ = [
     "HazardOutcome",
     "FixOutcome",
     "SkillResult",
+    "HazardVerdict",
+    "Verdict",
+    "VerdictStatus",
     "StageRecord",
     "LLMUsage",
     "RunManifest",
