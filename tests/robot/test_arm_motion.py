@@ -238,3 +238,19 @@ def test_ik_goal_repeats_for_a_seed():
         q, _ = _ik_goal(m, d, chk, target, quat_z_to(DOWN), np.random.default_rng(3), 5)
         goals.append(q)
     assert goals[0] is not None and np.array_equal(goals[0], goals[1])
+
+
+def test_a_planned_move_runs_the_same_control_steps_on_a_much_slower_machine():
+    """What the robot does, not only the path: the same planned move in two fresh processes, one with
+    every collision check slowed by 4 ms, runs the same control steps to the same final state."""
+    from anomalygen.procs import child_pool
+    from support.planning import planned_arm_move
+
+    runs = []
+    for delay in (0.0, 0.004):
+        with child_pool(1) as pool:
+            runs.append(pool.submit(planned_arm_move, delay).result())
+    (ok, steps, way, q), (ok_slow, steps_slow, way_slow, q_slow) = runs
+    assert ok and ok_slow and steps > 0
+    assert (steps, way) == (steps_slow, way_slow)
+    assert np.array_equal(q, q_slow)

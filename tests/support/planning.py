@@ -66,3 +66,27 @@ def plan_obstacle_query(delay_s: float, max_checks: int) -> tuple[list[np.ndarra
     t0 = time.perf_counter()
     path = plan_path(m, d, Agent.ARM_JOINTS, g, max_checks=max_checks, seed=0, checker=checker)
     return path, checker.checks, time.perf_counter() - t0
+
+
+def planned_arm_move(delay_s: float) -> tuple[bool, int, int, np.ndarray]:
+    """``move_arm_planned`` from home to 15 cm above the table's box past :func:`obstacle_query`'s
+    obstacle, executed with physics, with every collision check slowed by ``delay_s``:
+    (ok, control steps, waypoints, final qpos). Run it in a fresh process (``procs.child_pool``)."""
+    from anomalygen.robot import motion
+    from anomalygen.robot.arm_motion import move_arm_planned
+    from anomalygen.robot.driver import Driver
+    from anomalygen.robot.ik import quat_z_to
+
+    contacts = motion.CollisionChecker.contacts
+
+    def slow(self, q):
+        time.sleep(delay_s)
+        return contacts(self, q)
+
+    motion.CollisionChecker.contacts = slow  # this process only: the caller runs it in a child
+    m, d, _ = obstacle_query()
+    drv = Driver(m, d)
+    drv.settle(5)
+    target = d.body("box_0").xpos + np.array([0.0, 0.0, 0.15])
+    res = move_arm_planned(drv, target, quat_z_to(np.array([0.0, 0.0, -1.0])), seed=0)
+    return res.ok, res.steps, res.path_len, d.qpos.copy()

@@ -128,8 +128,8 @@ def wall_cap_s(max_checks: int) -> float:
 def check_budget(count, max_checks: int, wall_s: float):
     """OMPL termination condition: ``count()`` (validity checks so far) reached ``max_checks``, or
     ``wall_s`` seconds passed. The planner evaluates it itself between iterations (no polling thread),
-    so the check budget ends a query at the same iteration on any machine (the last edge checked may
-    take it a few checks past ``max_checks``)."""
+    so the check budget ends a query at the same iteration on any machine (the edge being checked when
+    the count passes ``max_checks`` is finished first: up to some tens of checks more)."""
     from ompl import base as ob
 
     spent = ob.PlannerTerminationCondition(lambda: count() >= max_checks)
