@@ -29,9 +29,10 @@ _SEEDED = False
 log = logging.getLogger(__name__)
 
 #: Validity checks BIT* makes per second of one idle core on built household scenes: measured on the
-#: development machine (an AMD EPYC vCPU) by thread CPU time over unsolvable arm queries in six built
-#: scenes, 2,400-5,800 per CPU second (docs/learn.md); the upper part of that range, so that a budget
-#: converted from seconds gives at least what the old wall-clock limit allowed on an idle core.
+#: development machine (an AMD EPYC vCPU) by thread CPU time over unsolvable arm queries in ten built
+#: scenes, 2,400-7,300 per CPU second (docs/learn.md); so a budget converted from seconds gives about
+#: what the old wall-clock limit allowed on an idle core (twice that in the heaviest scenes, 0.7x in the
+#: lightest).
 CHECKS_PER_IDLE_S = 5000
 #: A query's default budget, in validity checks: what the old 2 s limit allowed on an idle core.
 PLAN_MAX_CHECKS = 2 * CHECKS_PER_IDLE_S
