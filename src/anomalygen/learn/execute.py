@@ -223,13 +223,11 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
                   recheck_fixes: int = 0) -> SkillResult:
     from anomalygen.control.driver import Driver
     from anomalygen.rng import item_rng
-    from anomalygen.scene.graph import load_scene, scene_graph
+    from anomalygen.perception import load_perceived_scene
+    from anomalygen.scene.graph import scene_graph
 
     t0 = time.perf_counter()
-    from anomalygen.perception import perceived_spec
-
-    model, data, spec = load_scene(scene_dir)
-    spec = perceived_spec(spec)  # the robot acts on what it perceives: no bindings, no roles
+    model, data, spec = load_perceived_scene(scene_dir)  # what it perceives: no bindings, roles or task
     timings = {"load_s": round(time.perf_counter() - t0, 3)}
     rec = None
     if video_path is not None:
