@@ -222,8 +222,8 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
                   retries: int = 1, reward_mode: str = "spec", final_graph_path=None, n_envs: int = 1,
                   recheck_fixes: int = 0) -> SkillResult:
     from anomalygen.control.driver import Driver
-    from anomalygen.rng import item_rng
     from anomalygen.perception import load_perceived_scene
+    from anomalygen.rng import item_rng
     from anomalygen.scene.graph import scene_graph
 
     t0 = time.perf_counter()
