@@ -35,6 +35,7 @@ from anomalygen.rng import item_rng, stable_hash
 from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
 from anomalygen.scene import robot, robot_model, select
 from anomalygen.scene.compose import compose_scene, hold_gravity_hinges, latch_switched_on, set_joints
+from anomalygen.scene.instances import renumber_by_position
 from anomalygen.scene.judgement import check_hazard_free
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.placement import place
@@ -78,7 +79,8 @@ def _plan(task: TaskProposal, settings: Settings, rng, hints=None,
     sel.hazard_free = hazard_free
     set_initial_joints(sel)
     lay, placed, support = place(sel, settings)
-    return lay, ({} if hazard_free else bind_roles(sel, support)), placed
+    placed, bindings = renumber_by_position(lay, placed, {} if hazard_free else bind_roles(sel, support))
+    return lay, bindings, placed
 
 
 # ============================================================================ attempt

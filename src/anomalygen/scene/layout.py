@@ -1,12 +1,13 @@
 """Placement: proposals in a unit cube, then a solver for support, non-overlap and reach.
 
 As in the paper, task-relevant objects are proposed at (x, y, z) inside the cube (0..1)^3 and
-unrelated clutter outside it. The cube is mapped onto the floor area in front of the robot
+unrelated clutter outside it. The cube is mapped onto the floor area in front of the robot's home
 (``REGION_ORIGIN`` .. + ``REGION_SIZE``). The solver then snaps each proposal onto its support (the
 floor, a support's top surface, a container's cavity, an edge band for ``*_edge`` placements),
 rejects proposals whose footprints overlap already placed objects (oriented boxes in the plane plus a
-height test), and moves the robot base so the hazard is within the arm's reach. MuJoCo contacts
-re-check the result after compiling (build.py), so this solver only has to be conservative.
+height test), checks that some free base pose has the hazard within the arm's reach, and draws the
+robot's start pose on free floor. MuJoCo contacts re-check the result after compiling (build.py), so
+this solver only has to be conservative.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ WALKWAY_CLEAR = 0.42  # > the KB's 0.3 m walkway clearance, with margin
 TUCK_GAP = (0.03, 0.12)  # metres from a fixture's side for an item tucked out of the walkway (KB: 0.3)
 ARM_REACH = 0.95  # horizontal reach from the base centre to an object, with the arm's offset
 TRIES = 60
+START_TRIES = 200  # draws of a free start pose before the robot starts at its home
 
 
 @dataclass
@@ -365,12 +367,34 @@ class Layout:
         self.base = np.array([xy[0], xy[1], math.atan2(aim[1] - xy[1], aim[0] - xy[0])])
 
     def _base_ok(self, xy: np.ndarray, aim: np.ndarray) -> bool:
+        return self._pose_free(xy, math.atan2(aim[1] - xy[1], aim[0] - xy[0]))
+
+    def _pose_free(self, xy: np.ndarray, yaw: float, *, swing: bool = False) -> bool:
+        """Would the robot at (xy, yaw) clear every placed footprint (``swing``: and the room kept
+        in front of shut doors and drawers)?"""
         old = self.base.copy()
-        self.base = np.array([xy[0], xy[1], math.atan2(aim[1] - xy[1], aim[0] - xy[0])])
+        self.base = np.array([xy[0], xy[1], yaw])
         try:
-            return not any(self._hits_base(o.footprint()) for o in self.items)
+            return not any(self._hits_base(o.footprint(swing=swing)) for o in self.items)
         finally:
             self.base = old
+
+    def draw_start_pose(self) -> np.ndarray:
+        """Where the robot starts (x, y, yaw): a random free spot on the floor, any heading, drawn
+        from the scene's generator once everything is placed.
+
+        Why: the base used to start 0.35-0.85 m from the hazard and facing it, which told the robot
+        what to look at. The draw aims at no object, so it cannot depend on which one is the hazard;
+        the skills move the base to each target themselves. If no draw is free, the robot's home
+        (the origin, facing into the room) is used: every object was placed clear of it."""
+        lo = ROOM_CENTER - ROOM_HALF + BASE_RADIUS
+        hi = ROOM_CENTER + ROOM_HALF - BASE_RADIUS
+        for _ in range(START_TRIES):
+            xy = self.rng.uniform(lo, hi)
+            yaw = float(self.rng.uniform(-math.pi, math.pi))
+            if self._pose_free(xy, yaw, swing=True):
+                return np.array([xy[0], xy[1], yaw])
+        return np.zeros(3)
 
 
 def _h_gap(a, b) -> float:
