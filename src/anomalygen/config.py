@@ -77,11 +77,25 @@ class BuildConfig(Section):
     relevant_in_unit_cube: bool = Field(True, description="task assets inside (0..1)^3, unrelated ones outside")
 
 
+class NoiseConfig(Section):
+    """Perception noise on the scene graph the detectors read, so they are measured off the perfect
+    graph too (``detect/noise.py``). Off by default; plan and learn always see the simulator."""
+
+    enabled: bool = False
+    pose_jitter: float = Field(0.02, ge=0, le=0.5, description="m: each object's position error bound, per axis (uniform)")
+    miss_rate: float = Field(0.1, ge=0, le=1, description="chance that a small object is not seen at all")
+    small_size: float = Field(0.06, gt=0, description="m: an object whose largest extent is at most this counts as small")
+    confusion_rate: float = Field(
+        0.1, ge=0, le=1, description="chance that an object with look-alikes (knowledge base) is seen as one of them"
+    )
+
+
 class DetectConfig(Section):
     detector: Literal["rules", "llm", "hybrid"] = "rules"
     k: int = Field(3, ge=1, le=10)
     llm_judge: bool = Field(True, description="when an LLM is configured, ask it about hypotheses exact+SBERT judged a miss")
     judge_threshold: float | None = Field(None, ge=-1, le=1, description="SBERT judge threshold; default: the calibrated one")
+    noise: NoiseConfig = Field(default_factory=NoiseConfig)
 
 
 class LearnConfig(Section):

@@ -9,7 +9,7 @@ simulator model, and a copy of the scene spec with the answer key removed: no bi
 the hazard object, its ``hazard_free`` check says what was made safe), no task id, and the objects in
 name order (the builder's order placed the support and the hazard first).
 
-Optional perception noise for the detectors lives in :mod:`anomalygen.perception_noise`.
+Optional perception noise for the detectors lives in :mod:`anomalygen.detect.noise`.
 """
 
 from __future__ import annotations

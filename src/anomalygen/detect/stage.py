@@ -1,8 +1,9 @@
 """Stage 3 entry point: detect the hazard in every built scene, judge it, collate, summarise.
 
-Per scene (one runner item): read ``scene_graph.json`` (the only input a detector sees), run the
+Per scene (one runner item): read ``scene_graph.json`` through ``anomalygen.perception`` (the only
+input a detector sees; with ``detect.noise`` on, a noisy copy of it, ``detect/noise.py``), run the
 configured detector, then judge its hypotheses against the hidden task and write
-``detections/<task_id>.json``. A detector failure (an LLM that never produced a valid reply) is
+``detections/<task_id>.json`` (which records the noise settings used). A detector failure (an LLM that never produced a valid reply) is
 recorded in that scene's ``Detection.error`` and counts as a miss; it never ends the batch. After the
 items: collate ``detections.jsonl`` atomically in task order, write ``detections_summary.json`` and
 print the hit@k table.
@@ -15,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 from anomalygen.errors import ItemFailed, UserError
 from anomalygen.runfolder import RunFolder, try_read_model, write_jsonl, write_model
 from anomalygen.runner import StageContext, StageSummary, run_items
-from anomalygen.schema import Detection, SceneGraph, SceneSpec, TaskProposal
+from anomalygen.schema import Detection, PerceptionNoise, SceneGraph, SceneSpec, TaskProposal
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
@@ -74,11 +75,13 @@ def _detector_name(detector, settings: Settings) -> str:
 
 
 def detect_scene(task: TaskProposal, graph: SceneGraph, spec: SceneSpec | None, settings: Settings, *, detector=None,
-                 judge=None, hazard_free: bool = False) -> Detection:
+                 judge=None, hazard_free: bool = False, seen: SceneGraph | None = None,
+                 noise: PerceptionNoise | None = None) -> Detection:
     """Detect and judge one scene (pure apart from LLM calls): what the item function writes.
 
-    The detector sees the graph only; the task, the spec and ``hazard_free`` (the scene's truth.json
-    lists no hazard) are for judging its answer afterwards."""
+    The detector sees the graph only (``seen``, the noisy copy, when perception noise is on; its
+    record is ``noise``); the task, the spec, the perfect graph and ``hazard_free`` (the scene's
+    truth.json lists no hazard) are for judging its answer afterwards."""
     from anomalygen.detect.judge import first_hit, miss_reason
     from anomalygen.detect.truth import ground_truth
     from anomalygen.llm import LLMItemError
@@ -87,12 +90,12 @@ def detect_scene(task: TaskProposal, graph: SceneGraph, spec: SceneSpec | None, 
     judge = judge or make_judge(settings)
     error = None
     try:
-        hyps = detector.detect(graph, settings.detect.k)
+        hyps = detector.detect(graph if seen is None else seen, settings.detect.k)
     except LLMItemError as exc:
         hyps, error = [], str(exc)
     if hazard_free:  # nothing to find: there is no hit to rank, only claims that are false alarms
         return Detection(task_id=task.id, scene_id=graph.scene_id, detector=_detector_name(detector, settings),
-                         hypotheses=hyps, hazard_free=True, error=error,
+                         hypotheses=hyps, hazard_free=True, error=error, noise=noise,
                          miss_reason=f"detector failed: {error}" if error else None)
     truth = ground_truth(task, spec, graph, hazard_variable=_hazard_variable(task.hazard_class))
     judgements = judge.judge(hyps, truth, graph)
@@ -106,6 +109,7 @@ def detect_scene(task: TaskProposal, graph: SceneGraph, spec: SceneSpec | None, 
         hit_rank=hit,
         miss_reason=None if hit is not None else (f"detector failed: {error}" if error else miss_reason(hyps, judgements, truth)),
         error=error,
+        noise=noise,
     )
 
 
@@ -118,9 +122,12 @@ def _hazard_variable(class_id: str) -> str | None:
 
 
 def _item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str, Any]:
+    from anomalygen.detect.noise import detector_graph
+    from anomalygen.perception import load_scene_graph
+
     run, settings = ctx.run, ctx.settings
     scene_dir = run.scene_dir(task_id)
-    graph = try_read_model(scene_dir / "scene_graph.json", SceneGraph)
+    graph = load_scene_graph(scene_dir)
     if graph is None:
         raise ItemFailed(f"no valid scene_graph.json in {scene_dir} (build the scene first)")
     spec = try_read_model(scene_dir / "scene.json", SceneSpec)
@@ -133,8 +140,9 @@ def _item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str,
     from anomalygen.scene.truth import load_manifest
 
     truth = load_manifest(scene_dir)  # judging only: the detector has already been given the graph alone
+    seen, noise = detector_graph(graph, settings)
     det = detect_scene(task, graph, spec, settings, detector=detector, judge=judge,
-                       hazard_free=truth is not None and not truth.hazards)
+                       hazard_free=truth is not None and not truth.hazards, seen=seen, noise=noise)
     write_model(detection_path(run, task_id), det)
     usage = client.reset_usage().model_dump() if client is not None else None
     return {
@@ -149,8 +157,17 @@ def _is_done_for(run: RunFolder, settings: Settings):
     def is_done(task_id: str) -> bool:
         det = try_read_model(detection_path(run, task_id), Detection)
         return (det is not None and det.error is None and det.detector == settings.detect.detector
-                and len(det.hypotheses) <= settings.detect.k)
+                and len(det.hypotheses) <= settings.detect.k and _same_noise(det.noise, settings))
     return is_done
+
+
+def _same_noise(record: PerceptionNoise | None, settings: Settings) -> bool:
+    """Was a detection made under the configured perception noise (or none, both times)?"""
+    cfg = settings.detect.noise
+    if record is None or not cfg.enabled:
+        return record is None and not cfg.enabled
+    asked = (cfg.pose_jitter, cfg.miss_rate, cfg.small_size, cfg.confusion_rate, settings.seed)
+    return (record.pose_jitter, record.miss_rate, record.small_size, record.confusion_rate, record.seed) == asked
 
 
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:

@@ -24,6 +24,7 @@ from anomalygen.schema.detection import (
     Detection,
     Hypothesis,
     Judgement,
+    PerceptionNoise,
 )
 from anomalygen.schema.run import (
     ItemError,
@@ -144,6 +145,7 @@ __all__ = [
     "Hypothesis",
     "Judgement",
     "Detection",
+    "PerceptionNoise",
     "RewardTerm",
     "RewardSpec",
     "SuccessSpec",
