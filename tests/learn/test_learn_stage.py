@@ -103,8 +103,9 @@ def test_no_robot_side_module_mentions_the_answer_key():
     root = Path(anomalygen.__file__).parent
     robot_side = [p for pkg in ("plan", "control", "rl") for p in (root / pkg).rglob("*.py")]
     robot_side += [p for p in (root / "learn").rglob("*.py") if p.name != "stage.py"]  # learn/stage.py calls the referee
-    robot_side += [root / "perception.py"]
-    robot_side += [root / "detect" / n for n in ("rules.py", "llm_detector.py", "hybrid.py", "observation.py", "kbcheck.py")]
+    robot_side += [root / "perception.py", root / "scene" / "env.py"]
+    robot_side += [root / "detect" / n for n in ("rules.py", "llm_detector.py", "hybrid.py", "observation.py", "kbcheck.py",
+                                                 "noise.py")]
     for p in robot_side:
         text = p.read_text()
         for key in ("truth.json", "TRUTH_FILE", "load_manifest", "evaluate.referee", "scene.truth", "HazardManifest"):
