@@ -8,7 +8,8 @@ inside the physics step), so a step costs almost exactly ``frameskip`` raw ``mj_
 Python IK loop. Arm actuators go limp in this mode (gravity compensation keeps the arm up); the base
 actuators hold the mobile base where the scene put it.
 
-Observation: a flat float64 vector, the same layout for every scene, named by ``obs_layout``:
+Observation: a flat float64 vector, the same groups in the same order for every scene (their sizes
+follow the scene's objects), named by ``obs_layout``:
 ``robot_qpos`` and ``robot_qvel`` (the robot's joints, ``robot.ROBOT_JOINTS`` order), ``ee_pos`` (3)
 and ``ee_quat`` (4, w x y z) of the end effector, then every object alike, in ``object_names`` order
 (instance names sorted; the scene builder numbers instances by where they stand, so neither the
