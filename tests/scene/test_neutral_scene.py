@@ -1,5 +1,5 @@
 """The built scene treats every object alike: names, order, sensors, cameras and the robot's start
-pose say nothing about which object is the hazard (issue 23, "perception with no hints")."""
+pose (its dock) say nothing about which object is the hazard (issue 23, "perception with no hints")."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from anomalygen.runfolder import read_model
 from anomalygen.scene import robot
 from anomalygen.scene.graph import FLOOR_GEOM, load_scene
 from anomalygen.scene.instances import renumber_by_position
-from anomalygen.scene.layout import Layout, Placed
+from anomalygen.scene.layout import DOCK_YAW, Layout, Placed
 from anomalygen.scene.sensors import sensor_items
 from anomalygen.schema import ObjectRole, SceneSpec
 
@@ -45,33 +45,39 @@ def _facing(base, point) -> bool:
     return abs((want - base[2] + math.pi) % (2 * math.pi) - math.pi) < 0.6
 
 
-def test_start_pose_is_free_and_not_set_by_the_hazard(built_scenes):
-    near_and_facing = 0
+def test_robot_starts_docked_the_same_in_every_scene_touching_nothing(built_scenes):
     for key, folder in built_scenes.items():
         model, data, _ = load_scene(folder)
         spec = read_model(folder / "scene.json", SceneSpec)
         base = np.array(spec.robot_base)
+        assert np.allclose(base, [0.0, 0.0, DOCK_YAW]), key  # not where the hazard is
         hazard = data.body(spec.bindings["$hazard"]).xpos
         d = float(np.hypot(*(hazard[:2] - base[:2])))
-        near_and_facing += OLD_REACH_BAND[0] <= d <= OLD_REACH_BAND[1] and _facing(base, hazard)
+        assert not (OLD_REACH_BAND[0] <= d <= OLD_REACH_BAND[1] and _facing(base, hazard)), key
         robot_geoms = set(robot.robot_geom_ids(model).tolist())
         floor = model.geom(FLOOR_GEOM).id
         for k in range(data.ncon):  # the robot touches nothing but the floor where it starts
             g1, g2 = int(data.contact.geom1[k]), int(data.contact.geom2[k])
             if (g1 in robot_geoms) != (g2 in robot_geoms):
                 assert floor in (g1, g2), (key, model.geom(g1).name, model.geom(g2).name)
-    assert near_and_facing <= 1  # the old builder: every scene
 
 
-def test_start_pose_draw_takes_no_object_as_its_aim():
-    """The same layout with the hazard role on another object gives the same start pose."""
-    def layout_with(hazard: str) -> Layout:
+def test_dock_takes_no_object_as_its_aim_and_turns_into_the_room_only_when_blocked():
+    def layout_with(hazard: str, blocker: bool = False) -> Layout:
         lay = Layout(np.random.default_rng(3))
         for name, x in (("mug_0", 1.0), ("pill_bottle_0", 1.8)):
             lay.items.append(_box(name, x, 0.3, ObjectRole.HAZARD if name == hazard else ObjectRole.CLUTTER))
+        if blocker:  # a tall thing where the arm would hang when turned along the front
+            shelf = _box("shelf_0", 0.0, 0.45)
+            shelf.lo, shelf.hi = np.array([-0.1, -0.05, 0.0]), np.array([0.1, 0.05, 1.2])
+            lay.items.append(shelf)
         return lay
 
-    assert np.array_equal(layout_with("mug_0").draw_start_pose(), layout_with("pill_bottle_0").draw_start_pose())
+    assert np.array_equal(layout_with("mug_0").dock_pose(), [0.0, 0.0, DOCK_YAW])
+    assert np.array_equal(layout_with("pill_bottle_0").dock_pose(), [0.0, 0.0, DOCK_YAW])
+    blocked = layout_with("mug_0", blocker=True)
+    assert np.array_equal(blocked.dock_pose(), [0.0, 0.0, 0.0])
+    assert blocked._pose_free(np.zeros(2), 0.0, swing=True)  # facing into the room, the arm clears it
 
 
 def _in_view(model, data, cam: str, point, aspect: float) -> bool:

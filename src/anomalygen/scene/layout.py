@@ -5,8 +5,8 @@ unrelated clutter outside it. The cube is mapped onto the floor area in front of
 (``REGION_ORIGIN`` .. + ``REGION_SIZE``). The solver then snaps each proposal onto its support (the
 floor, a support's top surface, a container's cavity, an edge band for ``*_edge`` placements),
 rejects proposals whose footprints overlap already placed objects (oriented boxes in the plane plus a
-height test), checks that some free base pose has the hazard within the arm's reach, and draws the
-robot's start pose on free floor. MuJoCo contacts re-check the result after compiling (build.py), so
+height test), checks that some free base pose has the hazard within the arm's reach, and starts the
+robot at its dock, the same pose in every scene. MuJoCo contacts re-check the result after compiling (build.py), so
 this solver only has to be conservative.
 """
 
@@ -32,7 +32,7 @@ WALKWAY_CLEAR = 0.42  # > the KB's 0.3 m walkway clearance, with margin
 TUCK_GAP = (0.03, 0.12)  # metres from a fixture's side for an item tucked out of the walkway (KB: 0.3)
 ARM_REACH = 0.95  # horizontal reach from the base centre to an object, with the arm's offset
 TRIES = 60
-START_TRIES = 200  # draws of a free start pose before the robot starts at its home
+DOCK_YAW = math.pi / 2  # rad: the docked robot faces along the room's open front (+y), not into the room
 
 
 @dataclass
@@ -379,23 +379,19 @@ class Layout:
         finally:
             self.base = old
 
-    def draw_start_pose(self) -> np.ndarray:
-        """Where the robot starts (x, y, yaw): a random free spot on the floor, any heading, drawn
-        from the scene's generator once everything is placed.
+    def dock_pose(self) -> np.ndarray:
+        """Where the robot starts (x, y, yaw): its dock at the room's home (the origin), the same in
+        every scene, turned along the room's open front (``DOCK_YAW``) rather than into it.
 
         Why: the base used to start 0.35-0.85 m from the hazard and facing it, which told the robot
-        what to look at. The draw aims at no object, so it cannot depend on which one is the hazard;
-        the skills move the base to each target themselves. If no draw is free, the robot's home
-        (the origin, facing into the room) is used: every object was placed clear of it."""
-        lo = ROOM_CENTER - ROOM_HALF + BASE_RADIUS
-        hi = ROOM_CENTER + ROOM_HALF - BASE_RADIUS
-        for _ in range(START_TRIES):
-            xy = self.rng.uniform(lo, hi)
-            yaw = float(self.rng.uniform(-math.pi, math.pi))
-            if self._pose_free(xy, yaw, swing=True):
-                return np.array([xy[0], xy[1], yaw])
+        what to look at. The dock aims at no object, so it cannot depend on which one is the hazard;
+        the skills move the base to each target themselves, choosing among the poses around it the
+        one nearest the dock, as the old start pose was the one nearest it. Every object was placed
+        clear of the robot standing there facing into the room (yaw 0), which is used when the arm
+        turned along the front would touch something."""
+        if self._pose_free(np.zeros(2), DOCK_YAW, swing=True):
+            return np.array([0.0, 0.0, DOCK_YAW])
         return np.zeros(3)
-
 
 def _h_gap(a, b) -> float:
     gap = np.maximum(0.0, np.maximum(a[0][:2] - b[1][:2], b[0][:2] - a[1][:2]))

@@ -2,7 +2,7 @@
 
 ``place`` lays out a ``selection.Selection`` with ``layout.Layout`` (the hazard where its scenario says,
 or safely for a hazard-free scene), checks that the robot can reach the hazard from some free base
-pose, and then draws the robot's start pose, which does not depend on the hazard.
+pose, and then starts the robot at its dock, which does not depend on the hazard.
 """
 
 from __future__ import annotations
@@ -144,9 +144,9 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
             raise
         _floor_the_holder(lay, holder, focus)  # a deep counter put the appliance out of reach
         lay.fit_base(focus, holder=holder)
-    # fit_base proved the hazard reachable from a free base pose; the robot starts elsewhere, at a
+    # fit_base proved the hazard reachable from a free base pose; the robot starts at its dock, a
     # pose that does not depend on which object is the hazard
-    lay.base = lay.draw_start_pose()
+    lay.base = lay.dock_pose()
     return lay, placed, support
 
 
