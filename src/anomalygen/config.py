@@ -75,6 +75,11 @@ class BuildConfig(Section):
     render_height: int = Field(240, ge=32)
     repair_attempts: int = Field(3, ge=0)
     relevant_in_unit_cube: bool = Field(True, description="task assets inside (0..1)^3, unrelated ones outside")
+    start: Literal["dock", "reach"] = Field(
+        "dock", description="where the robot starts: 'dock', the same pose in every scene (says nothing about the "
+        "hazard); 'reach', the free pose nearest the dock with the hazard within reach, facing it (the answer "
+        "key as a start pose: for tests and ablations of the skills alone)"
+    )
 
 
 class NoiseConfig(Section):
@@ -93,8 +98,6 @@ class NoiseConfig(Section):
 class DetectConfig(Section):
     detector: Literal["rules", "llm", "hybrid"] = "rules"
     k: int = Field(3, ge=1, le=10)
-    llm_judge: bool = Field(True, description="when an LLM is configured, ask it about hypotheses exact+SBERT judged a miss")
-    judge_threshold: float | None = Field(None, ge=-1, le=1, description="SBERT judge threshold; default: the calibrated one")
     noise: NoiseConfig = Field(default_factory=NoiseConfig)
 
 
@@ -125,7 +128,7 @@ class LearnConfig(Section):
         "more than 1 helps only with idle cores"
     )
     reward_mode: Literal["spec", "code"] = Field(
-        "spec", description="code: SAC sub-tasks learn from reward code run in the sandbox (rl/sandbox.py), "
+        "spec", description="code: SAC sub-tasks learn from reward code run in the sandbox (skills/learned/sandbox.py), "
         "the plan's own or its reward terms rendered as code; spec: the terms evaluated in-process"
     )
 
@@ -135,6 +138,11 @@ class EvaluateConfig(Section):
     vit_weights: str | None = Field(None, description="optional path to ViT/CLIP weights for image similarity")
     wmd_pairs: int = Field(300, ge=1, description="pairs sampled per text set for mean Word Mover's Distance")
     baselines: bool = Field(True, description="recompute the six benchmark baselines in the diversity table")
+    text_judge_llm: bool = Field(
+        False, description="text judge diagnostic: when an LLM is configured, ask it about hypotheses exact+SBERT "
+        "judged a miss (detection itself is scored against the truth, not by this judge)")
+    text_judge_threshold: float | None = Field(
+        None, ge=-1, le=1, description="text judge diagnostic's SBERT threshold; default: the calibrated one")
 
 
 class Settings(BaseSettings):

@@ -8,13 +8,17 @@ import math
 import numpy as np
 
 from anomalygen.config import Settings
+from anomalygen.rng import item_rng
+from anomalygen.robot.agent import Agent
 from anomalygen.runfolder import read_model
-from anomalygen.scene import robot
+from anomalygen.scene import build
 from anomalygen.scene.graph import FLOOR_GEOM, load_scene
 from anomalygen.scene.instances import renumber_by_position
 from anomalygen.scene.layout import DOCK_YAW, Layout, Placed
 from anomalygen.scene.sensors import sensor_items
 from anomalygen.schema import ObjectRole, SceneSpec
+
+from .conftest import TASKS
 
 OLD_REACH_BAND = (0.35, 0.85)  # m: where the builder used to start the base, facing the hazard
 
@@ -54,12 +58,25 @@ def test_robot_starts_docked_the_same_in_every_scene_touching_nothing(built_scen
         hazard = data.body(spec.bindings["$hazard"]).xpos
         d = float(np.hypot(*(hazard[:2] - base[:2])))
         assert not (OLD_REACH_BAND[0] <= d <= OLD_REACH_BAND[1] and _facing(base, hazard)), key
-        robot_geoms = set(robot.robot_geom_ids(model).tolist())
+        robot_geoms = set(Agent.geom_ids(model).tolist())
         floor = model.geom(FLOOR_GEOM).id
         for k in range(data.ncon):  # the robot touches nothing but the floor where it starts
             g1, g2 = int(data.contact.geom1[k]), int(data.contact.geom2[k])
             if (g1 in robot_geoms) != (g2 in robot_geoms):
                 assert floor in (g1, g2), (key, model.geom(g1).name, model.geom(g2).name)
+
+
+def test_reach_start_is_the_answer_key_pose_only_when_asked_for():
+    task = TASKS["floor"]
+    poses = {}
+    for start in ("dock", "reach"):
+        lay, bindings, placed = build._plan(task, Settings(build={"clutter": 1, "start": start}),
+                                            item_rng(0, task.id, 0))
+        poses[start] = lay.base
+        hazard = placed[bindings["$hazard"]].world_center()
+    assert np.array_equal(poses["dock"], [0.0, 0.0, DOCK_YAW])
+    d = float(np.hypot(*(hazard[:2] - poses["reach"][:2])))
+    assert OLD_REACH_BAND[0] <= d <= OLD_REACH_BAND[1] and _facing(poses["reach"], hazard)
 
 
 def test_dock_takes_no_object_as_its_aim_and_turns_into_the_room_only_when_blocked():
