@@ -1,5 +1,6 @@
 """What the robot reads of a real built scene carries no answer key and none of the task's words:
-the perceived spec, the scene graph, scene.xml, and SceneEnv's spec, observation layout and info."""
+the perceived spec, the scene graph, scene.xml, and the public env's spec, observation layout and info
+until its episode ends (then the referee's verdict)."""
 
 from __future__ import annotations
 
@@ -86,21 +87,33 @@ def test_perceived_spec_and_graph_carry_no_answer_key_or_task_words(scene):
     })
 
 
-def test_scene_env_spec_observation_and_info_carry_no_answer_key(scene):
+def test_make_env_shows_no_answer_key_before_the_end_and_the_verdict_at_it(scene):
+    """The public env (``anomalygen.make_env``): its spec, observation layout and every info before the
+    episode ends carry no bindings, roles, validation or task words; the last info holds the referee's
+    verdict on this scene (the robot did nothing, so nothing is resolved)."""
+    from anomalygen.schema import Verdict
+
     task, folder = scene
     env = anomalygen.make_env(folder, horizon=5)
-    assert env.scene == load_perceived_spec(folder)
+    base = env.unwrapped
+    assert base.scene == load_perceived_spec(folder)
     obs, info = env.reset(seed=0)
-    infos = [info]
-    truncated = False
-    while not truncated:
+    infos, ends = [info], [False]
+    while not ends[-1]:
         obs, _, terminated, truncated, info = env.step(np.zeros(7))
         infos.append(info)
-    assert set(env.obs_layout) == OBS_KEYS and obs.size == env.observation_space.shape[0]
-    assert all(info == {} for info in infos)  # no success to claim: the env has no answer key
+        ends.append(terminated or truncated)
+    assert ends == [False] * 5 + [True]
+    assert set(base.obs_layout) == OBS_KEYS and obs.size == env.observation_space.shape[0]
+    assert all(info == {} for info in infos[:-1])  # no success to claim: the env has no answer key
     _assert_no_task_words(task, {
-        "env scene": env.scene.model_dump(mode="json"),
-        "env layout": {"layout": sorted(env.obs_layout), "objects": env.object_names},
-        "env info": json.loads(json.dumps(infos)),
+        "env scene": base.scene.model_dump(mode="json"),
+        "env layout": {"layout": sorted(base.obs_layout), "objects": base.object_names},
+        "env info before the end": json.loads(json.dumps(infos[:-1])),
     })
+    end = infos[-1]
+    assert set(end) == {"verdict", "is_success", "own_check"} and end["own_check"] is None
+    verdict = end["verdict"]
+    assert isinstance(verdict, Verdict) and verdict.task_id == task.id and verdict.seed is None
+    assert verdict.status in ("unresolved", "no_action_needed") and end["is_success"] is verdict.resolved is False
     env.close()

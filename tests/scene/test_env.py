@@ -6,14 +6,13 @@ import gymnasium as gym
 import mujoco
 import numpy as np
 
-import anomalygen
 from anomalygen.runfolder import read_model
-from anomalygen.scene.env import ENV_ID, HORIZON
+from anomalygen.scene.env import ENV_ID, HORIZON, make_env
 from anomalygen.schema import SceneSpec
 
 
 def test_spaces_and_step(built_scenes):
-    env = anomalygen.make_env(built_scenes["knife_edge"], frameskip=2, horizon=5)
+    env = make_env(built_scenes["knife_edge"], frameskip=2, horizon=5)
     obs, info = env.reset(seed=0)
     assert env.action_space.shape == (7,)
     assert obs.shape == env.observation_space.shape
@@ -31,7 +30,7 @@ def test_spaces_and_step(built_scenes):
 def test_passes_gymnasiums_env_checker(built_scenes):
     from gymnasium.utils.env_checker import check_env
 
-    env = anomalygen.make_env(built_scenes["knife_edge"], frameskip=2, horizon=5)
+    env = make_env(built_scenes["knife_edge"], frameskip=2, horizon=5)
     check_env(env)
     env.close()
 
@@ -54,7 +53,7 @@ def test_registered_with_gymnasium_and_time_limited_by_it(built_scenes):
 
 
 def test_rotation_turns_the_cup_about_its_own_axes(built_scenes):
-    env = anomalygen.make_env(built_scenes["floor"], horizon=1000)
+    env = make_env(built_scenes["floor"], horizon=1000)
     env.reset(seed=0)
     d, r = env.data, env.agent
     before = d.mocap_quat[r.mocap].copy()
@@ -65,7 +64,7 @@ def test_rotation_turns_the_cup_about_its_own_axes(built_scenes):
 
 
 def test_reset_is_deterministic_under_seed(built_scenes):
-    env = anomalygen.make_env(built_scenes["floor"], init_noise=0.02)
+    env = make_env(built_scenes["floor"], init_noise=0.02)
     actions = np.random.default_rng(0).uniform(-1, 1, size=(10, 7))
     runs = []
     for _ in range(2):
@@ -80,7 +79,7 @@ def test_reset_is_deterministic_under_seed(built_scenes):
 
 
 def test_delta_action_moves_the_end_effector(built_scenes):
-    env = anomalygen.make_env(built_scenes["floor"], horizon=1000)
+    env = make_env(built_scenes["floor"], horizon=1000)
     obs, _ = env.reset(seed=0)
     L = env.obs_layout
     start = obs[L["ee_pos"]].copy()
@@ -91,7 +90,7 @@ def test_delta_action_moves_the_end_effector(built_scenes):
 
 def test_every_object_observed_in_name_order_from_the_compiled_sensors(built_scenes):
     for key, folder in built_scenes.items():
-        env = anomalygen.make_env(folder, horizon=5)
+        env = make_env(folder, horizon=5)
         obs, _ = env.reset(seed=0)
         spec = read_model(folder / "scene.json", SceneSpec)
         assert env.object_names == sorted(o.name for o in spec.objects), key  # clutter and decoys too
@@ -115,7 +114,7 @@ def _base_within_reach_of(env, point, distance: float = 0.55) -> None:
 
 
 def test_suction_attaches_and_carries(built_scenes):
-    env = anomalygen.make_env(built_scenes["knife_edge"], horizon=1000)
+    env = make_env(built_scenes["knife_edge"], horizon=1000)
     env.reset(seed=0)
     L = env.obs_layout
     name = read_model(built_scenes["knife_edge"] / "scene.json", SceneSpec).bindings["$hazard"]
@@ -146,7 +145,7 @@ def test_suction_attaches_and_carries(built_scenes):
 
 def test_reward_and_success_hooks(built_scenes):
     calls = []
-    env = anomalygen.make_env(
+    env = make_env(
         built_scenes["floor"],
         reward_fn=lambda e: calls.append(e.t) or 0.5,
         success_fn=lambda e: e.t >= 2,

@@ -11,8 +11,9 @@ shifts another's:
 
 - *pose jitter*: the object's position moves by up to ``pose_jitter`` metres per axis (uniform);
   what the graph derives from its box moves with it: height above the floor, the distance to the
-  edge of what it rests on (against that support's own jittered box), a child's reach (unless it
-  is inside something, whose doors decide), and the ``near`` relations (re-measured box to box);
+  edge of what it rests on (against that support's own jittered box), a child's reach (the graph's
+  rule at the new height; a latch the graph does not record is read off the true answer), and the
+  ``near`` relations (re-measured box to box);
 - *missed small objects*: an object whose largest extent is at most ``small_size`` is left out,
   with its relations, with probability ``miss_rate``;
 - *category confusions*: an object whose category has look-alikes in the knowledge base
@@ -29,7 +30,7 @@ import numpy as np
 from anomalygen.knowledge.predicates import aabb_gap
 from anomalygen.rng import item_rng
 from anomalygen.scene.graph import NEAR_DIST
-from anomalygen.schema import CHILD_REACH, GraphObject, PerceptionNoise, Relation, SceneGraph
+from anomalygen.schema import CHILD_REACH, GraphObject, PerceptionNoise, Relation, SceneGraph, within_child_reach
 
 if TYPE_CHECKING:
     from anomalygen.config import NoiseConfig, Settings
@@ -98,9 +99,21 @@ def _jittered(obj: GraphObject, shift: dict[str, np.ndarray], graph: SceneGraph,
     return obj.model_copy(update={
         "position": [float(v) for v in np.asarray(obj.position) + d],
         "height_above_floor": height,
-        "child_reachable": obj.child_reachable if inside else height <= CHILD_REACH,
+        "child_reachable": _reachable(obj, height, inside),
         "distance_to_edge": edge,
     })
+
+
+def _reachable(obj: GraphObject, height: float, inside: bool) -> bool:
+    """A child's reach at the jittered height, by the scene graph's own rule (``within_child_reach``).
+    Whether the object is shut in a latching container is not in the graph: when its true bottom is
+    within reach, the true answer tells it (only a latch keeps a low object out); when it is higher
+    and inside something, it cannot be told, so the object keeps its true answer."""
+    if not inside:
+        return within_child_reach(height, False)
+    if obj.height_above_floor <= CHILD_REACH:
+        return within_child_reach(height, not obj.child_reachable)
+    return obj.child_reachable
 
 
 def _edge_change(obj: GraphObject, shift: dict[str, np.ndarray], graph: SceneGraph,

@@ -3,7 +3,7 @@
 Every artefact is a file in the run folder, so each class is strict (unknown fields are errors, not
 silently dropped) and carries a ``schema_version`` so old runs can be detected rather than misread.
 Stages depend on these classes, never on each other's internals. One module per stage owns its
-artefacts (``tasks``, ``scenes``, ``detection``, ``skills``, ``run``) over the shared ``base`` and
+artefacts (``tasks``, ``scenes``, ``detection``, ``skills``, ``verdicts``, ``run``) over the shared ``base`` and
 ``vocabulary``; import every name from ``anomalygen.schema``.
 """
 
@@ -37,6 +37,7 @@ from anomalygen.schema.scenes import (
     CLOSED_TOL,
     CLOSURE_LABELS,
     ENCLOSING_LABELS,
+    LATCHING_PROPERTY,
     SWINGING_CLOSURES,
     AssetRef,
     GraphObject,
@@ -44,12 +45,14 @@ from anomalygen.schema.scenes import (
     JointState,
     ManifestHazard,
     NearMiss,
+    PlacedCavity,
     PlacedObject,
     Relation,
     SceneGraph,
     SceneSpec,
     ValidationCheck,
     ValidationReport,
+    within_child_reach,
 )
 from anomalygen.schema.skills import (
     FixOutcome,
@@ -70,6 +73,7 @@ from anomalygen.schema.tasks import (
     Scenario,
     TaskProposal,
 )
+from anomalygen.schema.verdicts import HazardVerdict, Verdict, VerdictStatus
 from anomalygen.schema.vocabulary import (
     AssetSource,
     BrainstormMode,
@@ -98,6 +102,7 @@ ARTEFACTS: dict[str, type[BaseModel]] = {
         RewardSpec,
         SuccessSpec,
         SkillResult,
+        Verdict,
         RunManifest,
         ItemError,
     )
@@ -131,7 +136,10 @@ __all__ = [
     "SWINGING_CLOSURES",
     "CLOSED_TOL",
     "CHILD_REACH",
+    "LATCHING_PROPERTY",
+    "within_child_reach",
     "JointState",
+    "PlacedCavity",
     "PlacedObject",
     "ValidationCheck",
     "ValidationReport",
@@ -155,6 +163,9 @@ __all__ = [
     "HazardOutcome",
     "FixOutcome",
     "SkillResult",
+    "HazardVerdict",
+    "Verdict",
+    "VerdictStatus",
     "StageRecord",
     "LLMUsage",
     "RunManifest",
