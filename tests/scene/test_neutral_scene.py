@@ -118,3 +118,30 @@ def test_room_cameras_see_every_object_and_sensors_cover_every_object(built_scen
             center = data.body(name).xpos
             for cam in ("front", "top"):
                 assert _in_view(model, data, cam, center, aspect), (key, name, cam)
+
+
+def _room_cameras(objects: list[Placed]) -> dict[str, np.ndarray]:
+    import mujoco
+
+    from anomalygen.scene.compose import add_room_cameras
+
+    spec = mujoco.MjSpec()
+    add_room_cameras(spec, objects, aspect=4 / 3)
+    model = spec.compile()
+    return {name: np.r_[model.camera(name).pos, model.camera(name).quat] for name in ("front", "top")}
+
+
+def test_room_cameras_aim_at_every_object_alike_never_at_the_hazard():
+    """Which object is the hazard never moves a camera; where any object stands does."""
+    spots = [(0.6, 0.4), (1.8, 0.5), (1.2, 1.9)]
+    as_hazard = [_box(f"thing_{k}", x, y, ObjectRole.HAZARD if k == 0 else ObjectRole.CLUTTER)
+                 for k, (x, y) in enumerate(spots)]
+    as_clutter = [_box(f"thing_{k}", x, y, ObjectRole.HAZARD if k == 2 else ObjectRole.CLUTTER)
+                  for k, (x, y) in enumerate(spots)]
+    first, second = _room_cameras(as_hazard), _room_cameras(as_clutter)
+    for cam in ("front", "top"):
+        assert np.allclose(first[cam], second[cam]), cam
+    # the top camera stands over the middle of all the footprints, not over the hazard at (0.6, 0.4)
+    assert np.allclose(first["top"][:2], [1.2, 1.15], atol=0.02)
+    moved = _room_cameras([_box("thing_0", 0.6, 0.4), _box("thing_1", 1.8, 0.5), _box("thing_2", 2.4, 2.4)])
+    assert not np.allclose(moved["top"], first["top"])  # a clutter object that moves moves the frame
