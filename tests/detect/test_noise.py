@@ -66,6 +66,32 @@ def test_jitter_moves_positions_within_the_bound_and_what_follows_from_them():
     assert moved == len(graph.objects)
 
 
+def test_jitter_redraws_a_childs_reach_by_the_graphs_rule():
+    """A child reaches an object whose bottom is at most CHILD_REACH up, unless it is shut in a latching
+    container: a low pill bottle locked away stays out of reach, one in a plain cupboard stays within
+    it, and bottles near the threshold, loose or in a plain cupboard, are judged at their jittered height."""
+    from anomalygen.schema import CHILD_REACH
+
+    locked = g.obj("pill_bottle_0", "pill_bottle", pos=(1.0, 1.0, 0.35), size=(0.05, 0.05, 0.1), reach=False)
+    cupboard = g.obj("pill_bottle_1", "pill_bottle", pos=(2.0, 1.0, 0.35), size=(0.05, 0.05, 0.1), reach=True)
+    loose = g.on_surface("pill_bottle_2", "pill_bottle", None, CHILD_REACH - 0.01, (3.0, 1.0), size=(0.05, 0.05, 0.1))
+    shelf = g.on_surface("pill_bottle_3", "pill_bottle", None, CHILD_REACH - 0.01, (4.0, 1.0), size=(0.05, 0.05, 0.1))
+    graph = g.scene("scene_reach", "bathroom", [locked, cupboard, loose, shelf], [
+        Relation(subject="pill_bottle_0", predicate="inside", object="medicine_cabinet_0"),
+        Relation(subject="pill_bottle_1", predicate="inside", object="cabinet_0"),
+        Relation(subject="pill_bottle_3", predicate="inside", object="cabinet_1")])
+    assert loose.child_reachable and shelf.child_reachable
+    flips = {"pill_bottle_2": 0, "pill_bottle_3": 0}
+    for seed in range(20):
+        seen, _ = _noisy(graph, seed=seed, pose_jitter=0.05, miss_rate=0.0, confusion_rate=0.0)
+        by = {o.name: o for o in seen.objects}
+        assert not by["pill_bottle_0"].child_reachable and by["pill_bottle_1"].child_reachable
+        for name in flips:  # a plain cupboard's door keeps nothing from a toddler: only the height counts
+            assert by[name].child_reachable == (by[name].height_above_floor <= CHILD_REACH), (seed, name)
+            flips[name] += not by[name].child_reachable
+    assert all(0 < n < 20 for n in flips.values()), flips  # the threshold is crossed both ways
+
+
 def test_only_small_objects_are_missed_at_the_configured_rate():
     graph = _graph(n_small=400)
     small = {o.name for o in graph.objects if max(o.size) <= SMALL}

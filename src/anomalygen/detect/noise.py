@@ -30,7 +30,14 @@ import numpy as np
 from anomalygen.knowledge.predicates import aabb_gap
 from anomalygen.rng import item_rng
 from anomalygen.scene.graph import NEAR_DIST
-from anomalygen.schema import CHILD_REACH, GraphObject, PerceptionNoise, Relation, SceneGraph, within_child_reach
+from anomalygen.schema import (
+    CHILD_REACH,
+    GraphObject,
+    PerceptionNoise,
+    Relation,
+    SceneGraph,
+    within_child_reach,
+)
 
 if TYPE_CHECKING:
     from anomalygen.config import NoiseConfig, Settings
