@@ -117,3 +117,12 @@ def test_container_that_is_also_the_target_fits_the_hazard():
 
 def test_hazard_that_is_the_target_fits_or_fails():
     _assert_fits_or_says_so(_outcomes(_litter("plastic_bag", "TrashCan", "plastic_bag")))
+
+
+def test_a_named_container_is_never_swapped_for_a_roomier_kind():
+    """The task says "the bucket" and the bucket's target is a chair: no trash can stands in for the
+    bucket; every attempt fails, naming the bucket and the class's other containers."""
+    outcomes = _outcomes(_litter("plastic_bag", "Bucket", "Chair"))
+    assert all(o[0] == "failed" for o in outcomes), outcomes
+    for _, message in outcomes:
+        assert "does not fit" in message and "names the Bucket" in message and "TrashCan" in message

@@ -142,12 +142,18 @@ def select_objects(task: TaskProposal, rng, hints=None) -> Selection:
                     break
                 sel.forget(container)
                 container = sel.choose(container_name, ObjectRole.CONTAINER)
-            if hazard.size > container_room(container.asset) and container is not target:
+            # Another kind only when the task left the container open: a named bucket stays a bucket.
+            if hazard.size > container_room(container.asset) and container is not target and not sc.container:
                 container = _roomier_kind(sel, hc, container, container_name, hazard.size)
             room = container_room(container.asset)
             if hazard.size > room and hazard is not target:
                 sel.forget(hazard)
-                hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=min(cap or room, room))
+                try:
+                    hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=min(cap or room, room))
+                except ItemFailed as exc:
+                    others = [c for c in hc.default_containers if c != container_name]
+                    raise ItemFailed(f"{exc}: the task names the {container_name}"
+                                     + (f" (the class also stores it in: {', '.join(others)})" if others else "")) from exc
             if hazard.size > room:
                 raise ItemFailed(f"{hazard.catalogue} ({hazard.size:.2f} m) does not fit {container.catalogue} "
                                  f"(room for {room:.2f} m)")
@@ -199,8 +205,8 @@ def _open_as_the_fix_would(chosen: select.Chosen, label: str, hc) -> None:
 
 
 def _roomier_kind(sel: Selection, hc, container, name: str, size: float):
-    """Another of the class's usual containers that the hazard fits (a plastic bag too big for any
-    bucket goes to the trash can), or the container as it was."""
+    """Another of the class's usual containers that the hazard fits, or the container as it was. Only
+    for a task that named no container (the class's first default did not fit)."""
     for alt in hc.default_containers:
         if alt == name:
             continue
