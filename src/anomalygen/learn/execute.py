@@ -164,14 +164,12 @@ def run_subtasks(ep: Episode, plan: Plan, retries: int = 1) -> list[SubTaskResul
 def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float | None, sac_steps: int,
                   retries: int = 1, reward_mode: str = "spec", final_graph_path=None, n_envs: int = 1,
                   recheck_fixes: int = 0, final_state_path=None) -> SkillResult:
-    from anomalygen.perception import perceived_spec
+    from anomalygen.perception import load_perceived_scene
     from anomalygen.rng import item_rng
-    from anomalygen.scene.graph import load_scene
     from anomalygen.skills.episode import Episode, EpisodeBudget, LearningSettings
 
     budget = EpisodeBudget() if max_wall_s is None else EpisodeBudget(seconds=max_wall_s)
-    model, data, spec = load_scene(scene_dir)
-    spec = perceived_spec(spec)  # the robot acts on what it perceives: no bindings, no roles
+    model, data, spec = load_perceived_scene(scene_dir)  # what it perceives: no bindings, roles or task
     timings = {"load_s": round(budget.elapsed(), 3)}
     rec = None
     if video_path is not None:
