@@ -16,8 +16,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from anomalygen.brainstorm.grounding import Grounder, class_targets
 from anomalygen.brainstorm.idea import Idea, Texts, task_id, to_proposal
+from anomalygen.brainstorm.idea_sampler import IdeaSampler, class_targets
 from anomalygen.brainstorm.line_compose import Composition, Refused, compose_line, placement_for
 from anomalygen.brainstorm.line_parse import ParsedLine, parse_line
 from anomalygen.brainstorm.realise import realise
@@ -52,7 +52,7 @@ class TextGrounder:
         self.g = grounder or NameGrounder(kb)
         self.seed = seed
         self.ms = load_mechanisms()
-        self.filler = Grounder(kb, None, rich=False)
+        self.filler = IdeaSampler(kb, None, rich=False)
         self._catalogue = catalogue
 
     @property

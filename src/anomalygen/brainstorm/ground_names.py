@@ -79,7 +79,7 @@ def ground_llm_names(raw: LLMProposal, g: NameGrounder, *, reader=None) -> Groun
     cls, hazard_other, new_class = _hazard_class(raw, g, hazard, str(category), matches, problems, reader)
     hc = kb.hazard_classes.get(cls) or new_class
     if target is None:
-        from anomalygen.brainstorm.grounding import class_targets
+        from anomalygen.brainstorm.idea_sampler import class_targets
 
         options = ([hazard] if hazard in kb.targets else []) + (class_targets(kb, hc) if hc is not None and hc.id in kb.hazard_classes else [])
         target = options[0] if options else (hc.target_assets[0] if hc is not None and hc.target_assets else "Table")

@@ -53,10 +53,13 @@ def vocabulary() -> dict[str, Any]:
 class KnowledgeBase:
     """Hazard classes, object knowledge and role profiles, validated and indexed."""
 
-    def __init__(self, hazard_classes: list[HazardClass], objects: list[ObjectInfo], roles: list[RoleProfile]):
+    def __init__(self, hazard_classes: list[HazardClass], objects: list[ObjectInfo], roles: list[RoleProfile],
+                 lookalike_groups: list[list[str]] | None = None):
         self.hazard_classes: dict[str, HazardClass] = {hc.id: hc for hc in hazard_classes}
         self.objects: dict[str, ObjectInfo] = {o.name: o for o in objects}
         self.roles: dict[str, RoleProfile] = {r.id: r for r in roles}
+        #: groups of objects a perceiver can mistake for one another (``lookalikes.json``)
+        self.lookalike_groups: list[list[str]] = [list(g) for g in lookalike_groups or []]
         self._candidates: dict[tuple[str, str], list[str]] = {}
 
     def add_composed(self, composed: list[HazardClass]) -> None:
@@ -102,6 +105,11 @@ class KnowledgeBase:
         """Perceived properties of a catalogue object (what the scene builder puts in GraphObject.properties)."""
         info = self.objects.get(name)
         return list(info.properties) if info else []
+
+    def lookalikes(self, name: str) -> list[str]:
+        """The other members of ``name``'s look-alike group (empty when it has none)."""
+        group = next((g for g in self.lookalike_groups if name in g), [])
+        return [n for n in group if n != name]
 
     def benign_objects(self) -> list[str]:
         """Household objects with no hazard-relevant property: safe clutter that triggers no class."""
@@ -232,6 +240,9 @@ class KnowledgeBase:
         from anomalygen.knowledge.mechanisms import load_mechanisms, mechanism_problems
 
         out += mechanism_problems(load_mechanisms(), names)
+        grouped = [n for g in self.lookalike_groups for n in g]
+        out += [f"look-alikes: unknown object {n}" for n in grouped if n not in names]
+        out += [f"look-alikes: {n} is in more than one group" for n in sorted({n for n in grouped if grouped.count(n) > 1})]
         for r in self.roles.values():
             out += [f"role {r.id}: unknown class {c}" for c in r.class_interests if c not in self.hazard_classes]
             out += [f"role {r.id}: unknown object {o}" for o in r.object_interests if o not in names]
@@ -297,7 +308,7 @@ def load_kb() -> KnowledgeBase:
     classes = [HazardClass.model_validate(c) for c in _data("hazard_classes.json")["classes"]]
     objects = [ObjectInfo.model_validate({"name": n, **o}) for n, o in _data("objects.json")["objects"].items()]
     roles = [RoleProfile.model_validate(r) for r in _data("roles.json")["roles"]]
-    kb = KnowledgeBase(classes, objects, roles)
+    kb = KnowledgeBase(classes, objects, roles, _data("lookalikes.json")["groups"])
     from anomalygen.knowledge.mechanisms import composed_classes
 
     kb.add_composed(composed_classes())

@@ -41,6 +41,7 @@ PROPERTIES: tuple[str, ...] = (
     "combustible",  # catches fire from a heat source: towels, blankets, curtains, paper
     "food",  # something people eat or drink (chemicals must not be stored among it)
     "water_source",  # holds or gives water: a sink, a bathtub
+    "lockable",
 )
 
 #: Properties that make an object part of *some* hazard; objects with none of them are safe clutter.
