@@ -19,7 +19,7 @@ from anomalygen.knowledge import HazardClass, KnowledgeBase
 @functools.cache
 def catalogue() -> frozenset[str]:
     """Every name the asset catalogue can build."""
-    from anomalygen.scene.select import catalogue_names
+    from anomalygen.scene.asset_choice import catalogue_names
 
     return frozenset(catalogue_names())
 
