@@ -126,9 +126,12 @@ POSITIVE = {
     "move_electrical_away_from_water": lambda: graph(obj("dryer_0", "hair_dryer", at="counter", xy=(0.45, 0.0)), sink("contains_water")),
     "turn_pan_handle_inward": lambda: graph(stated(obj("pot_0", "KitchenPot", at="counter"), "handle_out")),
     "stand_iron_upright": lambda: graph(stated(obj("iron_0", "iron", at="table"), "face_down")),
+    "clear_soft_things_from_crib": lambda: graph(
+        obj("blanket_0", "Blanket", at="low_table"), crib(), relations=[on("blanket_0", "crib_0")], room="nursery"),
 }
 
 NEGATIVE = {
+    "clear_soft_things_from_crib": lambda: graph(obj("blanket_0", "Blanket", at="floor", xy=(3.0, 3.0)), crib(), room="nursery"),
     "hot_low_surface": lambda: graph(obj("mug_0", "hot_mug", at="table")),
     "sharp_near_crib": lambda: graph(obj("knife_0", "Knife", at="floor", xy=(3.0, 3.0)), crib()),
     "choking_near_crib": lambda: graph(obj("coin_0", "coin", at="floor", xy=(3.0, 3.0)), crib()),
