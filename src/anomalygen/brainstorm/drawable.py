@@ -55,9 +55,9 @@ def state_shown(kb: KnowledgeBase, obj: str, state: str) -> bool:
 def asset_parts(obj: str) -> frozenset[str]:
     """The knowledge-base joint labels the catalogue's asset of ``obj`` has (a knob, a door)."""
     from anomalygen.assets.core import generate
-    from anomalygen.scene.select import kb_label
+    from anomalygen.schema.part_labels import canonical
 
-    return frozenset(kb_label(j.label) for j in generate(obj, 0).joints)
+    return frozenset(canonical(j.label) for j in generate(obj, 0).joints)
 
 
 def has_part(obj: str, part: str) -> bool:
