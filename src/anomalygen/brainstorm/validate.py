@@ -9,13 +9,14 @@ tasks.jsonl (the problems are reported per line).
 from __future__ import annotations
 
 from anomalygen.knowledge import PLACEMENTS, ROOMS, KnowledgeBase
+from anomalygen.knowledge.models import PLACEMENT_PREFIXES
 from anomalygen.schema import TaskProposal
 
 
 def placement_ok(placement: str, names: set[str]) -> bool:
     if placement in PLACEMENTS:
         return True
-    for prefix in ("inside:", "on:"):
+    for prefix in PLACEMENT_PREFIXES:
         if placement.startswith(prefix) and placement[len(prefix):] in names:
             return True
     return False
@@ -42,7 +43,7 @@ def proposal_problems(p: TaskProposal, kb: KnowledgeBase) -> list[str]:
     out += [f"auxiliary_items: '{a.name}' is not a catalogue object" for a in p.auxiliary_items if a.name not in names]
     out += [f"articulations: '{a.object}' is not a catalogue object" for a in p.articulations if a.object not in names]
     if not placement_ok(s.placement, names):
-        out.append(f"scenario.placement '{s.placement}' is not one of {', '.join(PLACEMENTS)}, inside:<object>, on:<object>")
+        out.append(f"scenario.placement '{s.placement}' is not one of {', '.join(PLACEMENTS)}, inside:<object>, on:<object>, near:<object>")
     if s.room not in ROOMS:
         out.append(f"scenario.room '{s.room}' is not one of {', '.join(ROOMS)}")
     return out
