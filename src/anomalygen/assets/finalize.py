@@ -166,7 +166,7 @@ def finalize(
         for s in draft.surfaces
     ]
     cavities = [
-        Cavity(c.name, tf(c.center), tuple(h * scale for h in c.half_extents), c.opening, c.joint)
+        Cavity(c.name, tf(c.center), tuple(h * scale for h in c.half_extents), c.opening, c.joint, c.open_above)
         for c in draft.cavities
     ]
     ext = (hi - lo) * scale
@@ -187,6 +187,7 @@ def finalize(
         description="",
         params=params,
         features=list(draft.features),
+        front_access=draft.front_access,
     )
     asset.description = describe(name, asset, draft.features)
     return asset

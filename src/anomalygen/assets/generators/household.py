@@ -31,6 +31,7 @@ from anomalygen.assets.generators.common import (
     pick,
     u,
 )
+from anomalygen.assets.generators.parts_lib import glow, knob, slide_switch
 from anomalygen.assets.model import Cavity, Draft, Surface
 from anomalygen.assets.parts import Part, axis_angle
 from anomalygen.assets.registry import register
@@ -307,7 +308,7 @@ def frying_pan(rng):
     c = colour(rng, [DARK, METAL[2]])
     r.cyl(rad, 0.003, (0, 0, 0.003), c, D_METAL)
     r.ring(rad, 0.006, 0.045, 0.003, 14, c, D_METAL)
-    r.box((hl / 2, 0.012, 0.008), (rad + hl / 2, 0, 0.03), DARK, 1100)
+    r.box((hl / 2, 0.012, 0.008), (rad + hl / 2, 0, 0.03), DARK, 1100, name="handle")  # scene/states.py
     return Draft(
         r,
         {"radius": rad},
@@ -650,8 +651,13 @@ def candle(rng):
     c = colour(rng, [WHITE, (0.95, 0.9, 0.75, 1), (0.8, 0.2, 0.2, 1)])
     r.cyl(rad, h / 2, (0, 0, h / 2), c, 900)
     r.cyl(0.001, 0.004, (0, 0, h + 0.004), DARK, 900)
-    r.ellipsoid((0.004, 0.004, 0.01), (0, 0, h + 0.015), (1.0, 0.6, 0.1, 0.9), 1, collide=False)
-    return _d(r, ["lit flame", colour_name(c)], height=h)
+    # The flame shows only while the candle is lit, i.e. its snuffer cap is open (label "switch":
+    # lit = on, capped = off). A suction cup puts a candle out by closing the cap like a lid.
+    glow(r, "snuffer", "ellipsoid", (0.004, 0.004, 0.01), (0, 0, h + 0.015))
+    cap = r.child("snuffer", (0, rad + 0.003, h))
+    cap.hinge("snuffer_hinge", (1, 0, 0), (-2.0, 0), "switch", 0.0)
+    cap.cyl(rad + 0.003, 0.015, (0, -rad - 0.003, 0.016), (0.75, 0.6, 0.3, 1), 2000)
+    return _d(r, ["hinged snuffer cap", colour_name(c)], height=h)
 
 
 @register("iron")
@@ -664,7 +670,9 @@ def iron(rng):
     r.ellipsoid((L * 0.95, w * 0.9, 0.035), (0, 0, 0.03), c, 300)
     r.segment((-L * 0.6, 0, 0.07), (L * 0.4, 0, 0.08), 0.012, c, 300)
     r.segment((-L * 0.6, 0, 0.07), (-L * 0.75, 0, 0.045), 0.012, c, 300)
-    return _d(r, [colour_name(c), "hot steel soleplate", "power cord"], length=2 * L)
+    knob(r, "dial", (L * 0.62, 0, 0.056), 0.014, DARK, axis=(0, 0, 1), label="switch")  # dial: 0 is off
+    glow(r, "dial", "sphere", (0.004,), (L * 0.25, 0, 0.095))  # the heating light
+    return _d(r, [colour_name(c), "hot steel soleplate", "temperature dial", "power cord"], length=2 * L)
 
 
 @register("hair_dryer")
@@ -675,7 +683,9 @@ def hair_dryer(rng):
     r.cyl(rb, lb, (0, 0, rb), c, 300, axis="x")
     r.cyl(rb * 0.7, 0.01, (lb + 0.01, 0, rb), DARK, 300, axis="x")
     r.box((0.02, 0.05, rb * 0.55), (-lb * 0.3, -rb - 0.045, rb * 0.55), c, 300)
-    return _d(r, [colour_name(c), "handle", "power cord"], length=2 * lb)
+    slide_switch(r, "switch", (-lb * 0.3, -rb - 0.06, rb * 1.1 + 0.004), (0.008, 0.012, 0.004), (0, 1, 0), 0.012,
+                 (0.85, 0.1, 0.1, 1))
+    return _d(r, [colour_name(c), "handle", "on/off switch", "power cord"], length=2 * lb)
 
 
 @register("matches")

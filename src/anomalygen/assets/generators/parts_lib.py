@@ -129,3 +129,33 @@ def top_lid(parent: Part, name: str, hx, hy, z, rgba, density, thick=0.01, open_
     lid.hinge(f"{name}_hinge", (1, 0, 0), (-open_angle, 0), label, 0.0)
     lid.box((hx, hy, thick / 2), (0, -hy, thick / 2), rgba, density)
     return lid
+
+
+# A geom named ``<control body>_glow`` is drawn only while that control is on (a burner's flame, a
+# heater's element, a candle's flame); the scene builder shows it (``scene/states.py``). Its rgba
+# here has alpha 0, so the asset on its own, and a scene with the control off, show nothing.
+GLOW = (1.0, 0.35, 0.05, 0.0)
+
+
+def glow(parent: Part, control: str, kind: str, size, pos, *, quat=None) -> None:
+    """A hidden, massless, non-colliding glow for the control body named ``control``."""
+    parent._geom(kind, size, pos, GLOW, 0.0, quat=quat, collide=False, name=f"{control}_glow")
+
+
+def slide_switch(parent: Part, name: str, pos, half, axis, travel: float, rgba):
+    """An on/off slide switch (label "switch") that stays where it is put: off at 0, on at ``travel``
+    along ``axis``. Joint friction holds it; no spring, so a switch left on stays on."""
+    s = parent.child(name, pos)
+    s.slide(f"{name}_slide", axis, (0, travel), "switch", 0.0, hold=True)
+    s.box(half, (0, 0, 0), rgba, 900)
+    return s
+
+
+def tap_lever(parent: Part, name: str, pos, length: float, rgba, lift: float = 0.6):
+    """A single-lever tap handle on a horizontal hinge (x), pointing to the front (-y): off rests
+    down on its limit (gravity keeps it there), on is lifted up to ``lift`` rad. Label "tap"."""
+    lv = parent.child(name, pos)
+    lv.hinge(f"{name}_hinge", (1, 0, 0), (-lift, 0), "tap", 0.0)
+    lv.box((0.008, length / 2, 0.006), (0, -length / 2, 0.006), rgba, D_METAL)
+    lv.cyl(0.014, 0.012, (0, 0, 0.0), rgba, D_METAL)
+    return lv
