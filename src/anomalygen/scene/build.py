@@ -39,6 +39,7 @@ from anomalygen.scene.judgement import check_hazard_free
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.placement import place
 from anomalygen.scene.selection import bind_roles, select_objects, set_initial_joints
+from anomalygen.scene.states import arrange_states
 from anomalygen.schema import (
     AssetRef,
     AssetSource,
@@ -78,6 +79,7 @@ def _plan(task: TaskProposal, settings: Settings, rng, hints=None,
     sel.hazard_free = hazard_free
     set_initial_joints(sel)
     lay, placed, support = place(sel, settings)
+    arrange_states(sel, lay, placed)
     return lay, ({} if hazard_free else bind_roles(sel, support)), placed
 
 
@@ -177,6 +179,7 @@ def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, mo
                 inside=p.inside,
                 joint_states=joints,
                 fixed=p.fixed,
+                states=list(p.states),
             )
         )
     return SceneSpec(

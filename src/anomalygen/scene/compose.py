@@ -15,6 +15,7 @@ from anomalygen.scene import furniture, layout, robot, robot_model
 from anomalygen.scene.graph import FLOOR_GEOM
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.sensors import add_observation_sensors
+from anomalygen.scene.states import show_states
 from anomalygen.schema import ObjectRole
 
 if TYPE_CHECKING:
@@ -119,6 +120,7 @@ def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rn
             furniture.emit(p.support_geom, body, rng)
             continue
         root = p.asset.attach(body, f"{p.name}/")
+        show_states(root, p)
         if not p.fixed:
             body.add_freejoint(name=f"{p.name}/free")
             loose.append((p.name, root.name))

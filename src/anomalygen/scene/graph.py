@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from anomalygen.scene.states import object_states
 from anomalygen.schema import (
     CHILD_REACH,
     GraphObject,
@@ -203,7 +204,7 @@ def scene_graph(model: mujoco.MjModel, data: mujoco.MjData, spec: SceneSpec) -> 
         container = inside_of[i]
         # low inside a bin is not on the floor: only a floor contact says so then (a bin's base is thin)
         on_floor = "floor" in supports[i] or (height < ON_FLOOR_TOL and container is None)
-        edge = None
+        edge = surface = None
         # distance from the object's footprint to the edge of its main support's top (the widest
         # supporting geom; a laptop also touching a mug in the middle of the table is not at an
         # edge), in x/y; negative when the object overhangs.
@@ -212,6 +213,7 @@ def scene_graph(model: mujoco.MjModel, data: mujoco.MjData, spec: SceneSpec) -> 
             geom = max(under, key=lambda g: float(np.prod(geom_hi[g][:2] - geom_lo[g][:2])))
             d = np.minimum(lo[i][:2] - geom_lo[geom][:2], geom_hi[geom][:2] - hi[i][:2])
             edge = float(np.min(d))
+            surface = (geom_lo[geom], geom_hi[geom])
         enclosed = container is not None and closed[container]
         objects.append(
             GraphObject(
@@ -225,6 +227,7 @@ def scene_graph(model: mujoco.MjModel, data: mujoco.MjData, spec: SceneSpec) -> 
                 distance_to_edge=edge,
                 child_reachable=height <= CHILD_REACH and not enclosed,
                 joints=joints[i],
+                states=object_states(model, data, obj, joints[i], surface),
             )
         )
         if on_floor:

@@ -46,6 +46,7 @@ class Placed:
     asset: object | None = None
     support_geom: Support | None = None
     joint_values: dict[str, float] = field(default_factory=dict)
+    states: list[str] = field(default_factory=list)  # instance states the builder set up (scene/states.py)
     front: np.ndarray | None = None  # local xy unit vector of the side doors/drawers open to
     pos: np.ndarray = field(default_factory=lambda: np.zeros(3))
     yaw: float = 0.0
@@ -273,6 +274,10 @@ class Layout:
                 obj.yaw = 0.0 if (obj.hi - obj.lo)[0] <= (obj.hi - obj.lo)[1] else math.pi / 2
                 half = obj.world_half()
                 slack = (hi_xy - lo_xy) / 2 - half[:2]
+                if np.any(slack < -1e-6):  # square the other way: a book across a deep shelf board
+                    obj.yaw = math.pi / 2 - obj.yaw
+                    half = obj.world_half()
+                    slack = (hi_xy - lo_xy) / 2 - half[:2]
                 if np.any(slack < -1e-6):
                     raise ItemFailed(
                         f"{obj.name} ({2 * half[0]:.2f}x{2 * half[1]:.2f} m) does not fit on {holder.name}"
@@ -307,6 +312,10 @@ class Layout:
         obj.yaw = holder.yaw
         half = obj.world_half()
         room = (hi[:2] - lo[:2]) / 2 - half[:2] - 0.01
+        if np.any(room < 0):  # long things lie along the cavity's long side
+            obj.yaw = holder.yaw + math.pi / 2
+            half = obj.world_half()
+            room = (hi[:2] - lo[:2]) / 2 - half[:2] - 0.01
         if np.any(room < 0) or (hi[2] - lo[2]) < 2 * half[2] + 0.01:
             raise ItemFailed(f"{obj.name} does not fit inside {holder.name}")
         center = (lo[:2] + hi[:2]) / 2 + self.rng.uniform(-0.5, 0.5, size=2) * room

@@ -17,6 +17,7 @@ from anomalygen.knowledge import load_kb
 from anomalygen.scene import select
 from anomalygen.scene.instances import cavity_cap, container_room, instance_name
 from anomalygen.scene.layout import Placed
+from anomalygen.scene.states import set_initial_states
 from anomalygen.schema import ENCLOSING_LABELS, ObjectRole, TaskProposal
 
 MAX_AUX = 3
@@ -251,6 +252,7 @@ def set_initial_joints(sel: Selection) -> None:
         _open_as_the_fix_would(sel.by_catalogue[class_part[0]], class_part[1], hc)
     if not sel.hazard_free:
         _check_articulations(task, hc, sel.by_catalogue, sel.target)
+    set_initial_states(sel)
 
 
 def bind_roles(sel: Selection, support: Placed | None) -> dict[str, str]:

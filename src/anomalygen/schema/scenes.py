@@ -28,9 +28,12 @@ class AssetRef(Artefact):
 
 # One definition of the closure concepts, shared by the scene builder, the scene graph, the
 # predicates, the planners and the skills.
-CLOSURE_LABELS = ("door", "drawer", "lid", "window", "sash")  # joint labels of parts that shut something
+GATE_LABELS = ("gate",)  # a safety gate: a closure that bars a way, holding nothing behind it
+CLOSURE_LABELS = ("door", "drawer", "lid", "window", "sash", *GATE_LABELS)  # joint labels of parts that shut something
 ENCLOSING_LABELS = ("door", "drawer", "lid")  # closures behind which an object is out of reach
-SWINGING_CLOSURES = ("door", "lid", "window", "sash")  # closures on a hinge: they sweep out when open
+SWINGING_CLOSURES = ("door", "lid", "window", "sash", *GATE_LABELS)  # closures on a hinge: they sweep out when open
+# on/off controls: a joint with one of these labels is "on" when it is away from its closed (off) value
+SWITCH_LABELS = ("knob", "switch", "button", "dial", "tap")
 CLOSED_TOL = 0.05  # open fraction at or below which a joint counts as closed (``joint_closed``'s default)
 CHILD_REACH = 1.0  # m: the highest a small child reaches (``child_reachable``, the detectors' checks)
 
@@ -76,6 +79,9 @@ class PlacedObject(Artefact):
     inside: str | None = Field(None, description="instance it is contained in, if any")
     joint_states: list[JointState] = Field(default_factory=list)
     fixed: bool = Field(False, description="welded to the world (furniture) rather than free")
+    states: list[str] = Field(
+        default_factory=list, description="instance states the builder set up: contains_water, wet, lit, ..."
+    )
 
 
 class ValidationCheck(Strict):
@@ -151,6 +157,10 @@ class GraphObject(Strict):
     distance_to_edge: float | None = Field(None, description="to the edge of the surface it rests on")
     child_reachable: bool
     joints: list[JointState] = Field(default_factory=list)
+    states: list[str] = Field(
+        default_factory=list,
+        description="what can be seen of this instance beyond its category: contains_water, wet, lit, handle_out, face_down",
+    )
 
 
 class Relation(Strict):

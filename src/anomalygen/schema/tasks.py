@@ -49,6 +49,10 @@ class Scenario(Strict):
     person_at_risk: str = ""
     container: str | None = Field(None, description="catalogue name of the safe destination, if the fix stores it")
     co_objects: list[str] = Field(default_factory=list, description="other catalogue objects in the story")
+    states: dict[str, list[str]] = Field(
+        default_factory=dict,
+        description="instance states the scene must show, by catalogue name: {'Sink': ['contains_water'], 'candle': ['lit']}",
+    )
 
 
 class GroundingMatch(Strict):
