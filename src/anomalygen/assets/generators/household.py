@@ -654,9 +654,10 @@ def candle(rng):
     # The flame shows only while the candle is lit, i.e. its snuffer cap is open (label "switch":
     # lit = on, capped = off). A suction cup puts a candle out by closing the cap like a lid.
     glow(r, "snuffer", "ellipsoid", (0.004, 0.004, 0.01), (0, 0, h + 0.015))
-    cap = r.child("snuffer", (0, rad + 0.003, h))
+    # the cap stays inside the lit candle's box (flame top h + 0.025), so the candle keeps its size
+    cap = r.child("snuffer", (0, rad, h))
     cap.hinge("snuffer_hinge", (1, 0, 0), (-2.0, 0), "switch", 0.0)
-    cap.cyl(rad + 0.003, 0.015, (0, -rad - 0.003, 0.016), (0.75, 0.6, 0.3, 1), 2000)
+    cap.cyl(rad, 0.012, (0, -rad, 0.013), (0.75, 0.6, 0.3, 1), 2000)
     return _d(r, ["hinged snuffer cap", colour_name(c)], height=h)
 
 
