@@ -178,7 +178,7 @@ def _turn_handle_out(lay, p, placed: dict) -> None:
 
 def _handle_tip_x(asset) -> float | None:
     """Local x of the free end of the asset's handle geom (None when it has none)."""
-    for geom in _geoms_below(asset.spec.worldbody):
+    for geom in geoms_below(asset.spec.worldbody):
         if geom.name == HANDLE_GEOM:
             return float(geom.pos[0] + geom.size[0])
     return None
@@ -204,7 +204,7 @@ def show_states(root, placed) -> None:
     the glow of each control that starts on. The asset hides both (alpha 0)."""
     on_bodies = {j.body for j in placed.asset.joints if _is_on(placed.joint_values, j)}
     prefix = f"{placed.name}/"
-    for geom in _geoms_below(root):
+    for geom in geoms_below(root):
         name = geom.name.removeprefix(prefix)
         if name == WATER_GEOM and CONTAINS_WATER in placed.states:
             geom.rgba = [*geom.rgba[:3], WATER_ALPHA]
@@ -226,10 +226,11 @@ def refresh_glows(model, data, spec) -> None:
                 model.geom_rgba[gid, 3] = GLOW_ALPHA if on else 0.0
 
 
-def _geoms_below(body) -> list:
+def geoms_below(body) -> list:
+    """Every geom of an MjSpec body and its descendants."""
     out = list(body.geoms)
     for child in body.bodies:
-        out.extend(_geoms_below(child))
+        out.extend(geoms_below(child))
     return out
 
 
