@@ -110,7 +110,7 @@ def test_killed_run_resumes_without_duplicates_or_losses(tmp_path):
     done = subprocess.run(_cli("run", "--out", str(run_dir), "--config", str(cfg), "--json"), env=_env(),
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr[-2000:]
-    result = json.loads(done.stdout[done.stdout.index("{"):])
+    result = json.loads(done.stdout)  # --json: nothing else on stdout
     ids = [json.loads(line)["id"] for line in (run_dir / "tasks.jsonl").read_text().splitlines() if line.strip()]
     assert len(ids) == len(set(ids)) == 5
     scenes = sorted(p.parent.name for p in (run_dir / "scenes").glob("*/scene.json"))

@@ -80,8 +80,6 @@ class BuildConfig(Section):
 class DetectConfig(Section):
     detector: Literal["rules", "llm", "hybrid"] = "rules"
     k: int = Field(3, ge=1, le=10)
-    llm_judge: bool = Field(True, description="when an LLM is configured, ask it about hypotheses exact+SBERT judged a miss")
-    judge_threshold: float | None = Field(None, ge=-1, le=1, description="SBERT judge threshold; default: the calibrated one")
 
 
 class LearnConfig(Section):
@@ -121,6 +119,11 @@ class EvaluateConfig(Section):
     vit_weights: str | None = Field(None, description="optional path to ViT/CLIP weights for image similarity")
     wmd_pairs: int = Field(300, ge=1, description="pairs sampled per text set for mean Word Mover's Distance")
     baselines: bool = Field(True, description="recompute the six benchmark baselines in the diversity table")
+    text_judge_llm: bool = Field(
+        False, description="text judge diagnostic: when an LLM is configured, ask it about hypotheses exact+SBERT "
+        "judged a miss (detection itself is scored against the truth, not by this judge)")
+    text_judge_threshold: float | None = Field(
+        None, ge=-1, le=1, description="text judge diagnostic's SBERT threshold; default: the calibrated one")
 
 
 class Settings(BaseSettings):

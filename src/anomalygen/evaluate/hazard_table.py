@@ -14,7 +14,7 @@ from collections import defaultdict
 from pydantic import Field
 
 from anomalygen.runfolder import RunFolder, try_read_model
-from anomalygen.schema import Detection, Plan, SkillResult, Strict
+from anomalygen.schema import Detection, Plan, Strict
 
 
 class ClassRow(Strict):
@@ -37,8 +37,8 @@ class HazardTable(Strict):
 
 def hazard_table(run: RunFolder, task_ids: list[str], seeds: int) -> HazardTable:
     """The table over ``task_ids`` (every scene with a truth.json), ``seeds`` runs per scene."""
-    from anomalygen.detect.score import claim_matches
-    from anomalygen.scene.truth import load_manifest
+    from anomalygen.evaluate.detection_scores import finds, load_manifest
+    from anomalygen.evaluate.verdicts import verdict_of
 
     rows: dict[str, ClassRow] = defaultdict(ClassRow)
     table = HazardTable()
@@ -51,21 +51,19 @@ def hazard_table(run: RunFolder, task_ids: list[str], seeds: int) -> HazardTable
         det = try_read_model(run.detections_dir / f"{tid}.json", Detection)
         plan = try_read_model(run.plan_path(tid), Plan)
         acted = {str(st.params.get("object")) for st in plan.subtasks} if plan is not None else set()
-        results = [r for s in range(seeds) if (r := try_read_model(run.skill_dir(tid, s) / "result.json", SkillResult))]
+        results = [v for s in range(seeds) if (v := verdict_of(run, tid, s)) is not None]
         for r in results:
-            if r.outcome is None:
-                continue
             table.runs += 1
-            table.runs_with_new_hazards += int(bool(r.outcome.new_hazards))
-            table.runs_acting_on_safe += int(bool(r.outcome.interventions_on_safe))
+            table.runs_with_new_hazards += int(bool(r.new_hazards))
+            table.runs_acting_on_safe += int(bool(r.interventions_on_safe))
         for h in manifest.hazards:
             row = rows[h.hazard_class]
             row.hazards += 1
             hyps = det.hypotheses if det is not None else []
-            row.detected += int(any(claim_matches(x, h.object, h.hazard_class, h.category) for x in hyps))
+            row.detected += int(finds(hyps, h))
             row.planned += int(h.object in acted)
             for r in results:
-                outcome = next((o for o in (r.outcome.hazards if r.outcome else []) if o.object == h.object), None)
+                outcome = next((o for o in r.hazards if o.object == h.object), None)
                 if outcome is not None:
                     row.runs += 1
                     row.resolved += int(outcome.resolved)

@@ -188,10 +188,9 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
     own actions created (:mod:`anomalygen.learn.recheck`); their steps are listed with ids ``recheck_*``.
     """
     if isolate:
-        from concurrent.futures import ProcessPoolExecutor
-        from multiprocessing import get_context
+        from anomalygen.procs import child_pool
 
-        with ProcessPoolExecutor(max_workers=1, mp_context=get_context("spawn")) as pool:
+        with child_pool(1) as pool:
             return pool.submit(_execute_here, str(scene_dir), plan, seed, None if video_path is None else
                                str(video_path), max_wall_s, sac_steps, retries, reward_mode,
                                None if final_graph_path is None else str(final_graph_path), n_envs,

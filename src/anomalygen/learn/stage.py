@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 from anomalygen.errors import ItemFailed
 from anomalygen.runfolder import RunFolder, try_read_model, write_model
-from anomalygen.runner import StageContext, StageSummary, run_items
+from anomalygen.runner import StageContext, StageSummary, check_only, config_section, run_items
 from anomalygen.schema import FixOutcome, Plan, SceneGraph, SkillResult
 
 if TYPE_CHECKING:
@@ -70,6 +70,12 @@ def referee_verdict(scene_dir, final_graph_path) -> FixOutcome | None:
     return judge_fix(manifest, initial, final, load_kb())
 
 
+def _inputs(run: RunFolder, task_id: str) -> list[Path]:
+    """What an execution is made from: its plan and the built scene (a re-plan or rebuild redoes it)."""
+    scene = run.scene_dir(task_id)
+    return [run.plan_path(task_id), scene / "scene.json", scene / "scene.xml", scene / "scene_graph.json"]
+
+
 def success_table(run: RunFolder, items: list[tuple[str, dict]]) -> dict[str, dict[str, float]]:
     """Per hazard class: executions; the robot's own verdict (``success``); the referee's verdict
     against the hidden truth (``resolved``, over the runs that have a truth manifest, ``judged``);
@@ -98,12 +104,11 @@ TABLE_COUNTS = ("n", "success", "judged", "resolved", "new_hazards", "on_safe")
 
 def _print_table(table: dict[str, dict[str, float]]) -> None:
     from rich.console import Console
-    from rich.table import Table
 
-    t = Table(title="fixes by hazard class (robot's verdict vs the hidden truth)")
-    columns = ("hazard class", "runs", "robot: done", "truth: resolved", "new hazards", "acted on safe")
-    for col in columns:
-        t.add_column(col, justify="left" if col == "hazard class" else "right")
+    from anomalygen.tables import name_table
+
+    t = name_table("fixes by hazard class (robot's verdict vs the hidden truth)", "hazard class",
+                   ("runs", "robot: done", "truth: resolved", "new hazards", "acted on safe"), [*table, "all"])
 
     def cells(name: str, row: dict) -> list[str]:
         n, judged = row["n"], row["judged"]
@@ -120,7 +125,9 @@ def _print_table(table: dict[str, dict[str, float]]) -> None:
 
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
     items: list[tuple[str, dict]] = []
-    for t in run.load_tasks():
+    tasks = run.load_tasks()
+    check_only(only, [t.id for t in tasks])
+    for t in tasks:
         if only and t.id not in only:
             continue
         if not run.plan_path(t.id).is_file() or not (run.scene_dir(t.id) / "scene.json").is_file():
@@ -132,7 +139,9 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
         task_id, seed = _split(item_id)
         return try_read_model(run.skill_dir(task_id, seed) / "result.json", SkillResult) is not None
 
-    summary = run_items(run, STAGE, items, learn_item, settings=settings, is_done=done, force=force)
+    summary = run_items(run, STAGE, items, learn_item, settings=settings, is_done=done, force=force,
+                        inputs=lambda item_id: _inputs(run, _split(item_id)[0]),
+                        config=config_section(settings, "learn", exclude=("seeds",)))
     table = success_table(run, items)
     summary.results["by_class"] = table
     if not settings.quiet and table:

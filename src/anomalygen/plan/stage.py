@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 from anomalygen.errors import ItemFailed, UserError
 from anomalygen.runfolder import RunFolder, read_jsonl, try_read_model, write_model
-from anomalygen.runner import StageContext, StageSummary, run_items
+from anomalygen.runner import StageContext, StageSummary, check_only, config_section, run_items
 from anomalygen.schema import Detection, Plan, SceneSpec, SuccessSpec, TaskProposal
 
 if TYPE_CHECKING:
@@ -144,6 +144,7 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
         raise UserError("the llm learn engine needs an LLM: pass --backend openai|anthropic|llamacpp "
                         "(or use --engine knowledge)")
     tasks = run.load_tasks()
+    check_only(only, [t.id for t in tasks])
     detections = {}
     if settings.learn.plan_source == "detected" and run.detections_path.is_file():
         detections = {d.task_id: d for d in read_jsonl(run.detections_path, Detection, strict=False)}
@@ -161,4 +162,6 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
         plan = try_read_model(run.plan_path(task_id), Plan)
         return plan is not None and plan.source == settings.learn.plan_source and plan.engine == engine
 
-    return run_items(run, STAGE, items, plan_item, settings=settings, is_done=done, force=force, workers=1)
+    return run_items(run, STAGE, items, plan_item, settings=settings, is_done=done, force=force, workers=1,
+                     inputs=lambda tid: [run.scene_dir(tid) / "scene.json", run.scene_dir(tid) / "scene_graph.json"],
+                     config=config_section(settings, "learn", exclude=("seeds",), llm=engine.value == "llm"))

@@ -1,4 +1,8 @@
-"""Stage 3 (detect): ranked hypotheses about the hazard and how each was judged."""
+"""Stage 3 (detect): ranked hypotheses about the hazards of a scene.
+
+Scoring happens on the evaluate side against the scene's truth; the judging fields of ``Detection``
+are kept only so detections written before that still read (the detect stage no longer fills them).
+"""
 
 from __future__ import annotations
 
@@ -32,10 +36,8 @@ class Detection(Artefact):
     scene_id: str
     detector: Literal["rules", "llm", "hybrid"]
     hypotheses: list[Hypothesis]
-    judgements: list[Judgement] = Field(default_factory=list)
-    hit_rank: int | None = Field(None, description="rank of the first hit, None for a miss")
-    miss_reason: str | None = None
     error: str | None = None
-    hazard_free: bool = Field(
-        False, description="the scene's truth lists no hazard: left out of hit@k (it counts in the false-alarm rate)"
-    )
+    judgements: list[Judgement] = Field(default_factory=list, description="legacy, not written any more")
+    hit_rank: int | None = Field(None, description="legacy, not written any more")
+    miss_reason: str | None = Field(None, description="legacy, not written any more")
+    hazard_free: bool = Field(False, description="legacy, not written any more")

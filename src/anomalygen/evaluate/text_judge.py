@@ -1,11 +1,16 @@
-"""The automatic judge that replaces the paper's three human annotators.
+"""The text judge: a hypothesis against the hidden task's words, kept as a labelled diagnostic only.
+
+Detection is scored against the builder's truth (``evaluate/detection_report.py``); this judge asks
+something else — does a hypothesis read like the task description? — and its hit@k appears only as
+"text judge vs task description (diagnostic)". It replaced the paper's three human annotators:
 
 A hypothesis hits when
 1. it names the object at fault and the task's hazard class (``exact``); or
 2. it is free text (no hazard class, or one from a detector whose class labels are not decisive) and
    its Sentence-BERT similarity to the task text clears a threshold calibrated on the labelled set in
    ``anomalygen/data/judge/calibration.jsonl`` (``sbert``); or
-3. an LLM judge, when one is configured, says it describes the same problem (``llm``).
+3. an LLM judge, when one is configured and ``evaluate.text_judge_llm`` is on, says it describes the
+   same problem (``llm``).
 
 Structured hypotheses from the rule and hybrid detectors carry a knowledge-base class and object, so
 for them the exact comparison is decisive: a wrong class on the right object is a miss, however
@@ -16,14 +21,28 @@ from __future__ import annotations
 
 import functools
 import json
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from importlib import resources
+from typing import TYPE_CHECKING
 
 import numpy as np
 from pydantic import BaseModel, Field
 
-from anomalygen.detect.truth import GroundTruth, norm_name
-from anomalygen.schema import Hypothesis, Judgement, SceneGraph
+from anomalygen.evaluate.detection_report import TextJudgeDiagnostic
+from anomalygen.evaluate.detection_scores import GroundTruth
+from anomalygen.runfolder import RunFolder, try_read_model
+from anomalygen.schema import (
+    Detection,
+    HazardManifest,
+    Hypothesis,
+    Judgement,
+    SceneGraph,
+    SceneSpec,
+    TaskProposal,
+)
+
+if TYPE_CHECKING:
+    from anomalygen.config import Settings
 
 # Used only if the calibration file is missing (a broken install); the calibrated value wins.
 _FALLBACK_THRESHOLD = 0.6
@@ -31,7 +50,7 @@ _FALLBACK_THRESHOLD = 0.6
 
 @functools.cache
 def calibrated_threshold() -> float:
-    """The SBERT threshold chosen by ``anomalygen.detect.calibrate`` and stored with the data."""
+    """The SBERT threshold chosen by ``anomalygen.evaluate.judge_calibration`` and stored with the data."""
     try:
         ref = resources.files("anomalygen.data").joinpath("judge/threshold.json")
         return float(json.loads(ref.read_text(encoding="utf-8"))["threshold"])
@@ -134,14 +153,6 @@ def first_hit(judgements: Sequence[Judgement]) -> int | None:
     return min(ranks) if ranks else None
 
 
-def miss_reason(hyps: Sequence[Hypothesis], judgements: Sequence[Judgement], truth: GroundTruth) -> str:
-    """One line that says why a scene was missed, for the report's miss list."""
-    if not hyps:
-        return f"no hypothesis at all (truth {truth.label})"
-    parts = [f"#{j.rank} {j.reason}" for j in judgements[:3]]
-    return "; ".join(parts)
-
-
 def best_threshold(sims: np.ndarray, labels: np.ndarray) -> tuple[float, float, float, float]:
     """Threshold maximising F1 over the labelled pairs: (threshold, precision, recall, f1).
 
@@ -168,4 +179,58 @@ def prf(pred: np.ndarray, labels: np.ndarray) -> tuple[float, float, float]:
     return p, r, f
 
 
-__all__ = ["Judge", "JudgeReply", "calibrated_threshold", "first_hit", "miss_reason", "best_threshold", "prf", "norm_name"]
+
+
+# --------------------------------------------------------------------------- the diagnostic over a run
+
+
+def make_judge(settings: Settings, detector: str) -> Judge:
+    """The text judge for detections of ``detector``; the LLM judge only when asked for and configured."""
+    client = None
+    if settings.llm.configured and settings.evaluate.text_judge_llm:
+        from anomalygen.llm import shared_client
+
+        client = shared_client(settings.llm)
+    # Rule and hybrid hypotheses name a knowledge-base class, so the exact comparison decides them.
+    return Judge(threshold=settings.evaluate.text_judge_threshold, llm_client=client,
+                 structured_decisive=detector in ("rules", "hybrid"))
+
+
+def text_judge_diagnostic(run: RunFolder, detections: Sequence[Detection], tasks: Sequence[TaskProposal],
+                          manifests: Mapping[str, HazardManifest], k: int, settings: Settings) -> TextJudgeDiagnostic:
+    """hit@1..k of the text judge over the scenes that hold a hazard (a scene without truth.json counts
+    as holding its task's hazard), per detector, and how the first hits were judged."""
+    from anomalygen.evaluate.detection_scores import ground_truth
+    from anomalygen.knowledge import load_kb
+
+    kb = load_kb()
+    by_task = {t.id: t for t in tasks}
+    judges: dict[str, Judge] = {}
+    ranks: dict[str, list[int | None]] = {}
+    methods: dict[str, int] = {}
+    for d in detections:
+        task, truth = by_task.get(d.task_id), manifests.get(d.task_id)
+        if task is None or (truth is not None and not truth.hazards):
+            continue
+        if d.detector not in judges:
+            judges[d.detector] = make_judge(settings, d.detector)
+        judge = judges[d.detector]
+        spec = try_read_model(run.scene_dir(d.task_id) / "scene.json", SceneSpec)
+        graph = try_read_model(run.scene_dir(d.task_id) / "scene_graph.json", SceneGraph)
+        hc = kb.hazard_classes.get(task.hazard_class)
+        truth_of_task = ground_truth(task, spec, graph, hazard_variable=hc.hazard_variable if hc else None)
+        judgements = judge.judge(d.hypotheses, truth_of_task, graph)
+        hit = first_hit(judgements)
+        ranks.setdefault(d.detector, []).append(hit)
+        if hit is not None:
+            method = next(j.method for j in judgements if j.rank == hit)
+            methods[method] = methods.get(method, 0) + 1
+    every = [r for rs in ranks.values() for r in rs]
+    return TextJudgeDiagnostic(scenes=len(every), hit_at_k=_hit_at_k(every, k),
+                               by_detector={name: _hit_at_k(rs, k) for name, rs in sorted(ranks.items())},
+                               methods=dict(sorted(methods.items())))
+
+
+def _hit_at_k(ranks: Sequence[int | None], k: int) -> dict[int, float]:
+    n = len(ranks)
+    return {j: round(sum(1 for r in ranks if r is not None and r <= j) / n, 4) if n else 0.0 for j in range(1, k + 1)}

@@ -1,17 +1,17 @@
-"""The automatic judge: exact object+class hits, calibrated SBERT for free text, honest reasons."""
+"""The text judge (a diagnostic): exact object+class hits, calibrated SBERT for free text, honest reasons."""
 
 from __future__ import annotations
 
 import json
 
-import detect_graphs as g
 import numpy as np
 import pytest
 
-from anomalygen.detect.calibrate import calibrate, calibration_path, load_pairs
-from anomalygen.detect.judge import Judge, best_threshold, calibrated_threshold, first_hit
-from anomalygen.detect.truth import ground_truth
+from anomalygen.evaluate.detection_scores import ground_truth
+from anomalygen.evaluate.judge_calibration import calibrate, calibration_path, load_pairs
+from anomalygen.evaluate.text_judge import Judge, best_threshold, calibrated_threshold, first_hit
 from anomalygen.schema import Hypothesis, SceneSpec
+from detect import detect_graphs as g  # tests/detect/detect_graphs.py: the hand-built scene graphs
 
 
 def hyp(rank, obj, cls, problem="p", solution="s"):

@@ -1,9 +1,9 @@
-"""Calibrate the judge's Sentence-BERT threshold on the hand-labelled pairs, and report how good it is.
+"""Calibrate the text judge's Sentence-BERT threshold on the hand-labelled pairs, and report how good it is.
 
-``python -m anomalygen.detect.calibrate`` embeds every (hypothesis, task) pair of
+``python -m anomalygen.evaluate.judge_calibration`` embeds every (hypothesis, task) pair of
 ``data/judge/calibration.jsonl``, picks the threshold with the best F1, prints precision and recall
 overall and per kind of pair, and with ``--write`` stores the threshold in ``data/judge/threshold.json``
-(which :func:`anomalygen.detect.judge.calibrated_threshold` reads). Precision and recall are also
+(which :func:`anomalygen.evaluate.text_judge.calibrated_threshold` reads). Precision and recall are also
 reported under leave-one-task-out cross-validation, so the figure is not only a training score.
 """
 
@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from anomalygen.detect.judge import best_threshold, prf
+from anomalygen.evaluate.text_judge import best_threshold, prf
 
 
 @dataclass(frozen=True)
@@ -115,7 +115,7 @@ def main(argv: list[str] | None = None) -> None:
         payload = {"threshold": round(result.threshold, 4), "precision": round(result.precision, 4),
                    "recall": round(result.recall, 4), "cv_precision": round(result.cv_precision, 4),
                    "cv_recall": round(result.cv_recall, 4), "n_pairs": result.n_pairs,
-                   "command": "python -m anomalygen.detect.calibrate --write"}
+                   "command": "python -m anomalygen.evaluate.judge_calibration --write"}
         atomic_write_text(path, json.dumps(payload, indent=2) + "\n")
         print(f"wrote {path}")
 
