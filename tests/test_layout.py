@@ -1,5 +1,6 @@
 """The package layout's rules: imports form no cycles, counting imports inside functions and
-type-checking-only imports too; no module is longer than MAX_LINES, except catalogues of generators."""
+type-checking-only imports too; no module is longer than MAX_LINES, except catalogues of generators;
+the robot's element names and controllers live in ``robot/`` only; the old homes of the skills are gone."""
 
 import ast
 from pathlib import Path
@@ -73,8 +74,8 @@ def _cycles(edges: dict[str, set[str]]) -> list[set[str]]:
 
 def test_no_import_cycles():
     edges = _module_graph()
-    # imports inside functions count: execute.py imports the part skills inside _drive_joints
-    assert "anomalygen.control.parts" in edges["anomalygen.learn.execute"]
+    # imports inside functions count: execute.py imports the skill catalogue inside _run_skill
+    assert "anomalygen.skills.catalogue" in edges["anomalygen.learn.execute"]
     # so do type-checking-only ones: placement.py names Settings only in annotations
     assert "anomalygen.config" in edges["anomalygen.scene.placement"]
     cycles = _cycles(edges)
@@ -92,3 +93,46 @@ def test_no_module_is_longer_than_the_limit():
         if (n := len(path.read_text().splitlines())) > MAX_LINES
     }
     assert {p: n for p, n in long.items() if p not in CATALOGUES} == {}
+
+
+def _string_constants(tree: ast.AST) -> list[str]:
+    """Every string literal of a module, f-string pieces included."""
+    return [n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)]
+
+
+def test_only_the_robot_package_names_robot_elements_or_drives_its_actuators():
+    """The agent owns the element names and the controllers: no module outside ``robot/`` spells a
+    distinctive element name (a Panda joint or link, the cup's geom and sites, the end-effector target
+    and its weld, the suction weld prefix) or writes actuator gains (a control mode of its own)."""
+    from anomalygen.robot.agent import Agent
+
+    names = {*Agent.ROBOT_JOINTS, Agent.CUP_GEOM, Agent.CUP_SITE, Agent.EE_SITE, Agent.EE_TARGET, Agent.EE_TRACK,
+             Agent.TORSO, Agent.SUCTION_PREFIX}
+    spelled, driven = {}, {}
+    for path in ROOT.rglob("*.py"):
+        rel = path.relative_to(ROOT).as_posix()
+        if rel.startswith("robot/"):
+            continue
+        tree = ast.parse(path.read_text())
+        hits = {c for c in _string_constants(tree) if c in names or Agent.ARM_LINK_PREFIX + "joint" in c
+                or Agent.ARM_LINK_PREFIX + "link" in c}
+        if hits:
+            spelled[rel] = sorted(hits)
+        gains = {n.attr for n in ast.walk(tree) if isinstance(n, ast.Attribute)
+                 and n.attr in ("actuator_gainprm", "actuator_biasprm")}
+        if gains:
+            driven[rel] = sorted(gains)
+    assert spelled == {} and driven == {}, (spelled, driven)
+
+
+def test_the_checker_sees_an_element_name_spelled_out():
+    tree = ast.parse('ARM = [f"panda_joint{i}" for i in range(1, 8)]\nCUP = "suction_site"')
+    assert "suction_site" in _string_constants(tree)
+    assert any("panda_joint" in c for c in _string_constants(tree))
+
+
+def test_skills_have_one_home():
+    """``control/`` and ``rl/`` are gone: scripted and learned skills live in ``skills/``, the motion
+    layer in ``robot/``."""
+    assert not (ROOT / "control").exists() and not (ROOT / "rl").exists()
+    assert (ROOT / "robot" / "agent.py").is_file() and (ROOT / "skills" / "registry.py").is_file()

@@ -109,7 +109,7 @@ class LearnConfig(Section):
         "more than 1 helps only with idle cores"
     )
     reward_mode: Literal["spec", "code"] = Field(
-        "spec", description="code: SAC sub-tasks learn from reward code run in the sandbox (rl/sandbox.py), "
+        "spec", description="code: SAC sub-tasks learn from reward code run in the sandbox (skills/learned/sandbox.py), "
         "the plan's own or its reward terms rendered as code; spec: the terms evaluated in-process"
     )
 

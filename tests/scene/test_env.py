@@ -52,7 +52,7 @@ def test_registered_with_gymnasium_and_time_limited_by_it(built_scenes):
 def test_rotation_turns_the_cup_about_its_own_axes(built_scenes):
     env = anomalygen.make_env(built_scenes["floor"], horizon=1000)
     env.reset(seed=0)
-    d, r = env.data, env.robot
+    d, r = env.data, env.agent
     before = d.mocap_quat[r.mocap].copy()
     env.step(np.array([0, 0, 0, 0, 0, 1.0, -1.0]))  # +dr about the cup's z axis
     want = np.zeros(4)
@@ -84,7 +84,7 @@ def test_delta_action_moves_the_end_effector(built_scenes):
     start = obs[L["ee_pos"]].copy()
     for _ in range(40):
         obs, *_ = env.step(np.array([0, 0, 1, 0, 0, 0, -1.0]))
-    assert obs[L["ee_pos"]][2] > start[2] + 0.2  # 40 steps of +2 cm upward
+    assert obs[L["ee_pos"]][2] > start[2] + 0.2  # 40 steps of up to +3 cm (the agent's step) upward
 
 
 def test_suction_attaches_and_carries(built_scenes):
@@ -98,10 +98,10 @@ def test_suction_attaches_and_carries(built_scenes):
     above = target + [0, 0, 0.12]
     for _ in range(150):  # hover above the object first, then come straight down onto it
         ee = obs[L["ee_pos"]]
-        obs, *_ = env.step(np.r_[np.clip((above - ee) / 0.02, -1, 1), 0, 0, 0, -1.0])
+        obs, *_ = env.step(np.r_[np.clip((above - ee) / env.max_delta_pos, -1, 1), 0, 0, 0, -1.0])
     for _ in range(150):
         ee = obs[L["ee_pos"]]
-        obs, *_ = env.step(np.r_[np.clip((target - ee) / 0.02, -1, 1), 0, 0, 0, 1.0])
+        obs, *_ = env.step(np.r_[np.clip((target - ee) / env.max_delta_pos, -1, 1), 0, 0, 0, 1.0])
         if env.held:
             break
     assert env.held == name

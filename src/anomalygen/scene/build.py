@@ -32,8 +32,9 @@ import numpy as np
 from anomalygen.errors import ItemFailed
 from anomalygen.knowledge import load_kb
 from anomalygen.rng import item_rng, stable_hash
+from anomalygen.robot.agent import Agent
 from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
-from anomalygen.scene import robot, robot_model, select
+from anomalygen.scene import select
 from anomalygen.scene.compose import compose_scene, hold_gravity_hinges, latch_switched_on, set_joints
 from anomalygen.scene.judgement import check_hazard_free
 from anomalygen.scene.layout import Layout, Placed
@@ -102,7 +103,7 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
     data = mujoco.MjData(model)
     hold_gravity_hinges(model, placed, mjspec)
     latch_switched_on(model, placed, mjspec)
-    robot.set_home(model, data, tuple(lay.base))
+    Agent(model).set_home(data, tuple(lay.base))
     set_joints(model, data, placed)
     mujoco.mj_forward(model, data)
     spec = _scene_spec(task, seed, lay, placed, bindings, model, data)
@@ -279,9 +280,9 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_cla
 
 def _write_xml(mjspec, out_dir: Path) -> None:
     """scene.xml with robot meshes under assets/franka, loadable from any working directory."""
-    src = robot_model.franka_assets_dir() / "meshes"
+    src, files = Agent.mesh_files()
     dst = out_dir / "assets" / "franka"
-    for rel in robot_model.mesh_files():
+    for rel in files:
         target = dst / rel
         if target.exists():
             continue

@@ -11,7 +11,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from anomalygen.scene import furniture, layout, robot, robot_model
+from anomalygen.robot.agent import Agent
+from anomalygen.scene import furniture, layout
 from anomalygen.scene.graph import FLOOR_GEOM
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.sensors import add_observation_sensors
@@ -40,7 +41,7 @@ def look_at_xyaxes(eye, target) -> list[float]:
 def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rng):
     import mujoco
 
-    spec = robot_model.build_robot_spec(tuple(lay.base))
+    spec = Agent.build_spec(tuple(lay.base))
     spec.modelname = "anomalygen_scene"
     spec.option.timestep = 0.002
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
@@ -138,11 +139,11 @@ def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rn
                 geom.priority = 1
                 geom.solref = [LOOSE_SOLREF, 1.0]
     # Suction can also hold a door, lid or drawer, so primitives can pull parts open or lift them shut.
-    robot_model.add_suction_welds(spec, [n for n, _ in loose] + parts, [r for _, r in loose] + parts)
+    Agent.add_suction_welds(spec, [n for n, _ in loose] + parts, [r for _, r in loose] + parts)
     task_objects = [p for p in placed.values() if p.role != ObjectRole.CLUTTER]
     add_observation_sensors(
         spec,
-        list(robot.ROBOT_JOINTS),
+        list(Agent.ROBOT_JOINTS),
         [p.name for p in task_objects],
         [f"{p.name}/{j.name}" for p in task_objects if p.asset is not None for j in p.asset.joints],
     )

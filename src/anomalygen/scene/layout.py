@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from anomalygen.errors import ItemFailed
+from anomalygen.robot.agent import Agent
 from anomalygen.scene.furniture import Support
-from anomalygen.scene.robot import BASE_RADIUS
 from anomalygen.schema import ObjectRole, ValidationCheck
 
 REGION_ORIGIN = np.array([0.8, -0.6, 0.0])  # world position of the cube corner (0, 0, 0)
@@ -29,7 +29,6 @@ DROP_GAP = 0.002  # objects start this far above their support and settle onto i
 EDGE_BAND = (0.015, 0.07)  # metres from the edge for *_edge placements (KB threshold: 0.12)
 WALKWAY_CLEAR = 0.42  # > the KB's 0.3 m walkway clearance, with margin
 TUCK_GAP = (0.03, 0.12)  # metres from a fixture's side for an item tucked out of the walkway (KB: 0.3)
-ARM_REACH = 0.95  # horizontal reach from the base centre to an object, with the arm's offset
 TRIES = 60
 
 
@@ -121,7 +120,7 @@ class Layout:
         for _ in range(100):
             p = ROOM_CENTER + self.rng.uniform(-1, 1, size=2) * ROOM_HALF
             u = (p - REGION_ORIGIN[:2]) / REGION_SIZE[:2]
-            if not np.all((u >= 0) & (u <= 1)) and np.linalg.norm(p - self.base[:2]) > BASE_RADIUS + 0.4:
+            if not np.all((u >= 0) & (u <= 1)) and np.linalg.norm(p - self.base[:2]) > Agent.BASE_RADIUS + 0.4:
                 return p
         return ROOM_CENTER + np.array([1.2, 0.0])
 
@@ -144,7 +143,7 @@ class Layout:
         """Does a world AABB intrude on the robot: its base disc, or the arm's box at the home pose?"""
         if box[0][2] < 0.35:
             closest = np.clip(self.base[:2], box[0][:2], box[1][:2])
-            if float(np.linalg.norm(closest - self.base[:2])) < BASE_RADIUS + 0.08:
+            if float(np.linalg.norm(closest - self.base[:2])) < Agent.BASE_RADIUS + 0.08:
                 return True
         return any(overlaps(box, arm, margin=0.03) for arm in self.arm_boxes())
 
@@ -331,36 +330,37 @@ class Layout:
     def fit_base(self, focus: Placed, holder: Placed | None = None) -> None:
         """Move the base so ``focus`` is within reach, facing it, clear of every footprint.
 
-        Loose objects: the base centre within 0.35-0.85 m (horizontally) of the object's centre.
-        Furniture: 0.45-0.9 m from its footprint (doors swept open included), so the arm's home
-        pose clears it and the arm still reaches the door edge or handle. An object inside
-        furniture (``holder``): the furniture rule, and the object within 1.05 m. Among valid poses the one
-        closest to the room's robot home (the origin) wins, so scenes look alike.
+        The distances are the agent's reach envelope (``Agent.REACH``, robot/reach.py): loose objects
+        within its ``object_band`` of the base centre (horizontally); furniture with its footprint
+        (doors swept open included) within ``furniture_band``, so the arm's home pose clears it and
+        the arm still reaches the door edge or handle; an object inside furniture (``holder``): the
+        furniture rule, and the object within ``inside_max``. Among valid poses the one closest to the
+        room's robot home (the origin) wins, so scenes look alike.
         """
         target = focus.world_center()
-        if target[2] > 1.45 and not focus.fixed:
+        if target[2] > Agent.REACH.max_height and not focus.fixed:
             raise ItemFailed(f"the robot cannot reach {focus.name} at {target[2]:.2f} m")
         inner = None
         if holder is not None and holder.fixed:
             inner, focus = target, holder
         box = focus.footprint()
         best, best_cost = None, np.inf
-        lo = ROOM_CENTER - ROOM_HALF + BASE_RADIUS
-        hi = ROOM_CENTER + ROOM_HALF - BASE_RADIUS
+        lo = ROOM_CENTER - ROOM_HALF + Agent.BASE_RADIUS
+        hi = ROOM_CENTER + ROOM_HALF - Agent.BASE_RADIUS
         for x in np.arange(lo[0], hi[0] + 1e-9, 0.1):
             for y in np.arange(lo[1], hi[1] + 1e-9, 0.1):
                 xy = np.array([x, y])
                 if focus.fixed:
                     closest = np.clip(xy, box[0][:2], box[1][:2])
                     gap = float(np.linalg.norm(closest - xy))
-                    if not 0.45 <= gap <= 0.9:
+                    if not Agent.REACH.furniture_band[0] <= gap <= Agent.REACH.furniture_band[1]:
                         continue
-                    if inner is not None and np.linalg.norm(inner[:2] - xy) > 1.05:
+                    if inner is not None and np.linalg.norm(inner[:2] - xy) > Agent.REACH.inside_max:
                         continue
                     aim = closest if inner is None else inner[:2]
                 else:
                     d = float(np.linalg.norm(target[:2] - xy))
-                    if not 0.35 <= d <= 0.85:
+                    if not Agent.REACH.object_band[0] <= d <= Agent.REACH.object_band[1]:
                         continue
                     aim = target[:2]
                 cost = float(np.linalg.norm(xy))

@@ -9,7 +9,7 @@ returned state by one timestep (2 ms).
 
 from __future__ import annotations
 
-from anomalygen.scene.robot import CUP_BODY, EE_SITE
+from anomalygen.robot.agent import Agent
 
 GROUPS = ("robot_qpos", "robot_qvel", "ee_pos", "ee_quat", "object_pos", "object_quat", "object_joints")
 
@@ -29,8 +29,8 @@ def add_observation_sensors(
         add("robot_qpos", j, S.mjSENS_JOINTPOS, Obj.mjOBJ_JOINT, j)
     for j in robot_joints:
         add("robot_qvel", j, S.mjSENS_JOINTVEL, Obj.mjOBJ_JOINT, j)
-    add("ee_pos", EE_SITE, S.mjSENS_FRAMEPOS, Obj.mjOBJ_SITE, EE_SITE)
-    add("ee_quat", EE_SITE, S.mjSENS_FRAMEQUAT, Obj.mjOBJ_XBODY, CUP_BODY)
+    add("ee_pos", Agent.EE_SITE, S.mjSENS_FRAMEPOS, Obj.mjOBJ_SITE, Agent.EE_SITE)
+    add("ee_quat", Agent.EE_SITE, S.mjSENS_FRAMEQUAT, Obj.mjOBJ_XBODY, Agent.CUP_BODY)
     for o in objects:
         add("object_pos", o, S.mjSENS_FRAMEPOS, Obj.mjOBJ_XBODY, o)
     for o in objects:

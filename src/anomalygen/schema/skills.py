@@ -56,6 +56,13 @@ class Plan(Artefact):
 
 
 class SubTaskResult(Strict):
+    """One sub-task's execution. ``method`` is the method the plan asked for; ``executed_by`` is the
+    skill that actually executed it, as ``method:action`` of the skill registry (``*``: the method's
+    skill for any action, as SAC learns whatever the reward asks). They differ when a SAC sub-task
+    failed and the primitive of its action ran in its place (``method`` "sac", ``executed_by``
+    "primitive:push"). None when no skill executed it: CEM on a wheeled robot, the time budget
+    spent, no skill registered for its action, or a skill that reported "not executed"."""
+
     id: str
     method: SkillMethod
     success: bool
@@ -63,6 +70,10 @@ class SubTaskResult(Strict):
     wall_s: float = 0.0
     detail: str = ""
     attempts: int = Field(1, ge=1, description="executions of the sub-task: retried when its check failed")
+    executed_by: str | None = Field(
+        None, description="registry key (method:action) of the skill that executed the sub-task, e.g. "
+                          "'sac:switch_off', 'primitive:push'; None when none did"
+    )
 
 
 class HazardOutcome(Strict):
