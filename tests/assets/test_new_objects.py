@@ -98,3 +98,25 @@ def test_bookcase_high_shelf_stairs_crib_and_gate():
 def test_validates(name):
     res = validate_asset(generate(name, 0), render=False)
     assert res.ok, res.reason
+
+
+@pytest.mark.parametrize("name", ["PowerStrip", "iron", "hair_dryer", "candle"])
+def test_push_switches_stay_on_and_stop_at_off_when_pressed(name):
+    """A push switch (a candle's snuffer too) stands proud when on and stays so; pressed down hard from
+    above it stops at off instead of being driven through its end stop (which reads as on again)."""
+    a = generate(name, 1)
+    (j,) = a.joints
+    assert j.type == "slide" and j.axis == (0.0, 0.0, 1.0) and j.range[0] == 0.0
+    model = a.spec.copy().compile()
+    data = mujoco.MjData(model)
+    adr = model.jnt_qposadr[model.joint(j.name).id]
+    travel = j.range[1]
+    data.qpos[adr] = 0.8 * travel
+    mujoco.mj_step(model, data, nstep=2000)  # 4 s
+    assert data.qpos[adr] > 0.75 * travel
+    data.xfrc_applied[model.body(j.body).id, 2] = -20.0  # a firm press, 20 N
+    mujoco.mj_step(model, data, nstep=250)
+    assert abs(data.qpos[adr]) < 0.03 * travel
+    data.xfrc_applied[:] = 0.0
+    mujoco.mj_step(model, data, nstep=250)
+    assert abs(data.qpos[adr]) < 0.03 * travel  # let go, it stays off

@@ -22,6 +22,9 @@ def _joint_gains(part: Part, scale: float) -> tuple[float, float]:
     return max(2.0 * eff, 1e-5), max(0.2 * eff, 1e-6)
 
 
+HARD_SOLREF = [0.004, 1.0]  # s time constant (twice the 2 ms step), damping ratio
+HARD_SOLIMP = [0.999, 0.9999, 0.001, 0.5, 2.0]  # impedance near 1: the constraint hardly yields
+
 _GEOM_TYPES = {
     "box": "mjGEOM_BOX",
     "sphere": "mjGEOM_SPHERE",
@@ -86,6 +89,14 @@ def _emit(mujoco, part: Part, body, scale: float, offset: np.ndarray, joints: li
         )
         if "frictionloss" in extra:
             joint.frictionloss = extra["frictionloss"]
+            if j.type == "slide":
+                # A small slide held by friction (a push switch, a snuffer): MuJoCo's default soft
+                # friction lets it creep ~5 mm/s under gravity (left on, it switched itself off while
+                # the scene settled), and its soft end stops, scaled by its few grams, let a cup push
+                # it a centimetre through them; near-hard constraints creep ~0.02 mm/s and stop it
+                # (the friction's force is still capped by the frictionloss)
+                joint.solref_friction = joint.solref_limit = HARD_SOLREF
+                joint.solimp_friction = joint.solimp_limit = HARD_SOLIMP
         if "stiffness" in extra:
             cur = joint.stiffness
             joint.stiffness = (

@@ -24,7 +24,7 @@ from anomalygen.assets.generators.common import (
     colour_name,
     u,
 )
-from anomalygen.assets.generators.parts_lib import glow, knob, slide_switch
+from anomalygen.assets.generators.parts_lib import glow, knob, push_switch
 from anomalygen.assets.model import Draft
 from anomalygen.assets.parts import Part
 from anomalygen.assets.registry import register
@@ -53,7 +53,7 @@ def space_heater(rng):
 
 @register("PowerStrip")
 def power_strip(rng):
-    """A multi-socket strip with a lit rocker-style slide switch at one end and a short lead."""
+    """A multi-socket strip with a lit push switch at one end (proud when on) and a short lead."""
     r = Part("root")
     n = int(rng.integers(3, 7))
     hx, hy, hz = 0.025 * n + 0.04, u(rng, 0.026, 0.034), u(rng, 0.017, 0.022)
@@ -64,7 +64,7 @@ def power_strip(rng):
         r.cyl(0.017, 0.0008, (x, 0, 2 * hz + 0.0008), DARK if c[0] > 0.5 else METAL[1], 1, collide=False)
     lead = u(rng, 0.08, 0.15)
     r.segment((-hx, 0, 0.004), (-hx - lead, 0.01, 0.004), 0.004, DARK, 1200, kind="cylinder")
-    slide_switch(r, "switch", (hx - 0.025, 0, 2 * hz + 0.004), (0.007, 0.012, 0.004), (1, 0, 0), 0.01, SWITCH_RED)
+    push_switch(r, "switch", (hx - 0.025, 0, 2 * hz + 0.002), (0.008, 0.012, 0.004), SWITCH_RED)
     glow(r, "switch", "box", (0.005, 0.008, 0.0008), (hx - 0.045, 0, 2 * hz + 0.0008))
     return Draft(r, {"sockets": n}, [], [], [colour_name(c), f"{n} sockets", "on/off switch", "power lead"])
 

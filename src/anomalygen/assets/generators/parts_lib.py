@@ -142,12 +142,17 @@ def glow(parent: Part, control: str, kind: str, size, pos, *, quat=None) -> None
     parent._geom(kind, size, pos, GLOW, 0.0, quat=quat, collide=False, name=f"{control}_glow")
 
 
-def slide_switch(parent: Part, name: str, pos, half, axis, travel: float, rgba):
-    """An on/off slide switch (label "switch") that stays where it is put: off at 0, on at ``travel``
-    along ``axis``. Joint friction holds it; no spring, so a switch left on stays on."""
+PUSH_SWITCH_TRAVEL = 0.006  # m a push switch stands proud when on
+
+
+def push_switch(parent: Part, name: str, pos, half, rgba, travel: float = PUSH_SWITCH_TRAVEL):
+    """A latching on/off push switch on a top face (label "switch"): off pressed down at 0 (its box
+    centred at ``pos``), on standing ``travel`` proud. Joint friction is the latch, so a switch left on
+    stays on; pressing it down from above puts it off, which is how a suction cup meets a top face
+    (the switch-off family's buttons, ``skills/learned/part_skill.py``)."""
     s = parent.child(name, pos)
-    s.slide(f"{name}_slide", axis, (0, travel), "switch", 0.0, hold=True)
-    s.box(half, (0, 0, 0), rgba, 900)
+    s.slide(f"{name}_press", (0, 0, 1), (0, travel), "switch", 0.0, hold=True)
+    s.box(half, (0, 0, 0), rgba, D_METAL)  # as heavy as its latch: a 3 g cap rang against the cup's hold
     return s
 
 
