@@ -131,9 +131,14 @@ def test_hair_dryer_on_by_a_full_bathtub(scenes):
 
 
 def test_heater_on_near_the_curtains(scenes):
-    _, _, _, graph = _load(scenes, "heater")
+    model, data, spec, graph = _load(scenes, "heater")
     heater, curtains = _one(graph, "SpaceHeater"), _one(graph, "Curtains")
     assert "on" in heater.states and "lit" not in heater.states and heater.on_floor
+    # a loose heater is turned with its dial to the robot, the side it is switched off from
+    (dial,) = heater.joints
+    out = data.xaxis[model.joint(dial.name).id][:2]  # the dial turns about its front, the catalogue -y
+    to_base = np.array(spec.robot_base[:2]) - np.array(heater.position[:2])
+    assert np.dot(out, to_base) / np.linalg.norm(to_base) > 0.7
     assert curtains.size[2] >= 1.5 and curtains.states == []
     assert _one(graph, "Blanket").states == []
 

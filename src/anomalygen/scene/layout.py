@@ -92,6 +92,12 @@ def face_robot_yaw(front: np.ndarray | None, target_dir: np.ndarray) -> float:
     return math.atan2(target_dir[1], target_dir[0]) - math.atan2(front[1], front[0])
 
 
+def reached_from_front(obj: Placed) -> bool:
+    """A loose thing worked from its front (a space heater's dial): the builder turns that side to the
+    open floor where it can, as it turns furniture to the robot."""
+    return obj.front is not None and obj.asset is not None and obj.asset.front_access
+
+
 def overlaps(
     a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], margin: float = 0.02
 ) -> bool:
@@ -211,8 +217,10 @@ class Layout:
             f = bodies[int(self.rng.integers(len(bodies)))]
             c, h = f.world_center(), f.world_half()  # the body itself, not its doors' sweep
             obj.yaw = float(self.rng.uniform(-math.pi, math.pi))
-            oh = obj.world_half()
             axis, sign = int(self.rng.integers(2)), float(self.rng.choice([-1.0, 1.0]))
+            if reached_from_front(obj):  # its controls face the open floor, away from the furniture
+                obj.yaw = face_robot_yaw(obj.front, np.eye(2)[axis] * sign)
+            oh = obj.world_half()
             xy = c[:2].copy()
             xy[axis] += sign * (h[axis] + oh[axis] + self.rng.uniform(*TUCK_GAP))
             xy[1 - axis] += self.rng.uniform(-1.0, 1.0) * max(h[1 - axis] - oh[1 - axis], 0.0)
