@@ -2,10 +2,12 @@
 
 Runs the real pipeline through the CLI: ``brainstorm --engine knowledge --n N --seed S``, ``build``
 (default judgement mix: near-misses, second hazards, hazard-free scenes), ``detect --detector rules``,
-then plan and learn twice from the same scenes and detections: from perception (the default,
+then plan, learn and judge twice from the same scenes and detections: from perception (the default,
 ``plan_source = detected``) and with the oracle (``ground_truth``: the builder's class and bindings).
-Prints the detection scores and, per mode, the table by class (hazards present, detected, planned,
-resolved; runs that created a hazard or acted on a safe object), then one JSON line.
+Every figure is the referee's (``anomalygen judge``: each run's final state released, settled and
+judged against truth.json). Prints the detection scores and, per mode, the table by class (hazards
+present, detected, planned, resolved — no class firing on the object and no new hazard in the run;
+runs that created a hazard or acted on a safe object), then one JSON line.
 
     .venv/bin/python benchmarks/bench_loop.py [--n 111] [--seed 0] [--seeds 1] [--workers 2] [--out DIR]
         [--compare-detectors N] [--skip-learn]
@@ -46,8 +48,8 @@ def _copy_run(src: Path, dst: Path) -> None:
 
 def _detection_scores(folder: Path, ids: set[str] | None = None):
     """The run's detections scored against truth.json (only the tasks in ``ids`` when given)."""
-    from anomalygen.detect.score import score_detections
     from anomalygen.evaluate.run_metrics import load_detections, load_manifests
+    from anomalygen.referee.score import score_detections
     from anomalygen.runfolder import RunFolder
 
     run = RunFolder(folder)
@@ -97,6 +99,7 @@ def main() -> int:
         menv = {**env, "ANOMALYGEN_LEARN__PLAN_SOURCE": mode}
         _cli("plan", "--run", str(folder), env=menv)
         _cli("learn", "--run", str(folder), "--seeds", str(a.seeds), "--workers", str(a.workers), env=menv)
+        _cli("judge", "--run", str(folder), "--workers", str(a.workers), env=menv)  # the referee, after the robot
         table = hazard_table(RunFolder(folder), ids, a.seeds)
         print(markdown(table, f"plan_source = {mode}"))
         tot = table.total

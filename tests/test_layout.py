@@ -1,6 +1,8 @@
 """The package layout's rules: imports form no cycles, counting imports inside functions and
 type-checking-only imports too; no module is longer than MAX_LINES, except catalogues of generators;
-the robot's element names and controllers live in ``robot/`` only; the old homes of the skills are gone."""
+and the robot's side reaches neither the referee nor the builder's internals, not even through a
+shared module; the robot's element names and controllers live in ``robot/`` only; the old homes of
+the skills are gone."""
 
 import ast
 from pathlib import Path
@@ -11,7 +13,19 @@ ROOT = Path(anomalygen.__file__).parent
 MAX_LINES = 500
 # one generator function per vocabulary name: long, but a list, not a tangle
 CATALOGUES = {"assets/generators/household.py", "assets/generators/furniture.py"}
-
+# The robot's side: it perceives the scene (scene graph, renders, simulator state, the spec without the
+# answer key) and acts on it.
+ROBOT_SIDE = ("anomalygen.detect", "anomalygen.plan", "anomalygen.learn", "anomalygen.robot", "anomalygen.skills")
+# What the robot's side may not reach: the referee (truth manifests, matching, scoring, judging), the
+# evaluation and report built on it, the task generator (task words), and the builder's internals
+# (what it chose, why, and how it checked it). The builder's shared products stay allowed: the scene
+# graph, the env, the robot, the room layout and furniture it composes, renders, sensors, saved states.
+FORBIDDEN = ("anomalygen.referee", "anomalygen.evaluate", "anomalygen.brainstorm",
+             "anomalygen.scene.build", "anomalygen.scene.stage", "anomalygen.scene.selection",
+             "anomalygen.scene.select", "anomalygen.scene.placement", "anomalygen.scene.instances",
+             "anomalygen.scene.judgement", "anomalygen.scene.mix", "anomalygen.scene.llm_engine",
+             "anomalygen.scene.hints", "anomalygen.scene.validate", "anomalygen.scene.verify",
+             "anomalygen.scene.set_states")
 
 
 def _module_graph() -> dict[str, set[str]]:
@@ -95,6 +109,48 @@ def test_no_module_is_longer_than_the_limit():
     assert {p: n for p, n in long.items() if p not in CATALOGUES} == {}
 
 
+def _under(module: str, packages: tuple[str, ...]) -> bool:
+    return any(module == p or module.startswith(p + ".") for p in packages)
+
+
+def _forbidden_paths(edges: dict[str, set[str]], sources: tuple[str, ...], forbidden: tuple[str, ...]) -> list[list[str]]:
+    """One shortest import path from each source module to a forbidden module it reaches, through
+    any modules in between (imports inside functions count: they run when the function does)."""
+    found = []
+    for start in sorted(m for m in edges if _under(m, sources)):
+        parent: dict[str, str | None] = {start: None}
+        queue = [start]
+        while queue:
+            v = queue.pop(0)
+            if _under(v, forbidden):
+                path = [v]
+                while parent[path[-1]] is not None:
+                    path.append(parent[path[-1]])
+                found.append(path[::-1])
+                break
+            for w in sorted(edges.get(v, ())):
+                if w not in parent:
+                    parent[w] = v
+                    queue.append(w)
+    return found
+
+
+def test_the_robot_side_reaches_neither_the_referee_nor_the_builders_internals():
+    edges = _module_graph()
+    robot = [m for m in edges if _under(m, ROBOT_SIDE)]
+    assert "anomalygen.learn.stage" in robot and "anomalygen.detect.stage" in robot
+    # the answer-key side is real and reaches what it must: the builder writes truth.json through the referee
+    assert _forbidden_paths(edges, ("anomalygen.scene.build",), ("anomalygen.referee",))
+    paths = _forbidden_paths(edges, ROBOT_SIDE, FORBIDDEN)
+    assert paths == [], "robot side reaches the answer key: " + "; ".join(" -> ".join(p) for p in paths)
+
+
+def test_the_reach_check_follows_imports_through_shared_modules():
+    edges = {"anomalygen.plan.x": {"anomalygen.shared"}, "anomalygen.shared": {"anomalygen.referee.truth"},
+             "anomalygen.referee.truth": set(), "anomalygen.detect.y": {"anomalygen.scene.graph"},
+             "anomalygen.scene.graph": set()}
+    assert _forbidden_paths(edges, ROBOT_SIDE, FORBIDDEN) == [
+        ["anomalygen.plan.x", "anomalygen.shared", "anomalygen.referee.truth"]]
 def _string_constants(tree: ast.AST) -> list[str]:
     """Every string literal of a module, f-string pieces included."""
     return [n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)]

@@ -46,7 +46,7 @@ def test_one_registry_names_every_stage_the_cli_and_the_pipeline_run():
     from anomalygen.cli import app
 
     names = [s.name for s in registry.STAGES]
-    assert names == ["brainstorm", "build", "detect", "plan", "learn", "evaluate", "report"]
+    assert names == ["brainstorm", "build", "detect", "plan", "learn", "judge", "evaluate", "report"]
     commands = {c.name or c.callback.__name__ for c in app.registered_commands}
     assert set(names) <= commands
     for s in registry.STAGES:  # every module exists and has the entry point the registry calls
@@ -55,6 +55,7 @@ def test_one_registry_names_every_stage_the_cli_and_the_pipeline_run():
     # stage modules live in the package of the same name (build's package is scene/, report's evaluate/)
     assert registry.stage("plan").module == "anomalygen.plan.stage"
     assert registry.stage("learn").module == "anomalygen.learn.stage"
+    assert registry.stage("judge").module == "anomalygen.referee.stage"  # the referee judges after the robot
 
 
 def test_a_whole_run_stage_refuses_only(tmp_path):

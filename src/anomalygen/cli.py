@@ -267,6 +267,25 @@ def learn(
 
 
 @app.command()
+def judge(
+    run: RunOpt = Path("runs/default"),
+    only: OnlyOpt = None,
+    workers: WorkersOpt = None,
+    config: ConfigOpt = None,
+    force: ForceOpt = False,
+    quiet: QuietOpt = False,
+    as_json: JsonOpt = False,
+    executor: ExecutorOpt = None,
+    address: AddressOpt = None,
+):
+    """The referee, after the robot: judge every run's released, settled final state against the hidden
+    truth (writes skills/<task>/seed<k>/verdict.json)."""
+    settings = _common(config, None, quiet, workers, executor, address)
+    folder = _open_run(run)
+    _finish(_run_stage("judge", folder, settings, force=force, only=only), as_json)
+
+
+@app.command()
 def evaluate(
     run: RunOpt = Path("runs/default"),
     config: ConfigOpt = None,

@@ -39,3 +39,14 @@ def group_table(title: str, columns: Sequence[str], rows: Mapping[str, Sequence[
         for member, cells in members:
             table.add_row(INDENT + member, *cells)
     return table
+
+
+def print_with_total(table, rows: Mapping[str, Mapping[str, float]], counts: Sequence[str], cells) -> None:
+    """Add one row per name of ``rows`` and a total row ``all`` (the sum of ``counts`` over them), each
+    made by ``cells(name, row)``, and print the table on stderr."""
+    from rich.console import Console
+
+    for name, row in rows.items():
+        table.add_row(*cells(name, row))
+    table.add_row(*cells("all", {k: sum(r[k] for r in rows.values()) for k in counts}))
+    Console(stderr=True).print(table)

@@ -4,12 +4,11 @@ suction carries an object, success reaches ``info["is_success"]``."""
 import gymnasium as gym
 import numpy as np
 
-import anomalygen
-from anomalygen.scene.env import ENV_ID, HORIZON
+from anomalygen.scene.env import ENV_ID, HORIZON, make_env
 
 
 def test_spaces_and_step(built_scenes):
-    env = anomalygen.make_env(built_scenes["knife_edge"], frameskip=2, horizon=5)
+    env = make_env(built_scenes["knife_edge"], frameskip=2, horizon=5)
     obs, info = env.reset(seed=0)
     assert env.action_space.shape == (7,)
     assert obs.shape == env.observation_space.shape
@@ -27,7 +26,7 @@ def test_spaces_and_step(built_scenes):
 def test_passes_gymnasiums_env_checker(built_scenes):
     from gymnasium.utils.env_checker import check_env
 
-    env = anomalygen.make_env(built_scenes["knife_edge"], frameskip=2, horizon=5)
+    env = make_env(built_scenes["knife_edge"], frameskip=2, horizon=5)
     check_env(env)
     env.close()
 
@@ -50,7 +49,7 @@ def test_registered_with_gymnasium_and_time_limited_by_it(built_scenes):
 
 
 def test_rotation_turns_the_cup_about_its_own_axes(built_scenes):
-    env = anomalygen.make_env(built_scenes["floor"], horizon=1000)
+    env = make_env(built_scenes["floor"], horizon=1000)
     env.reset(seed=0)
     d, r = env.data, env.agent
     before = d.mocap_quat[r.mocap].copy()
@@ -63,7 +62,7 @@ def test_rotation_turns_the_cup_about_its_own_axes(built_scenes):
 
 
 def test_reset_is_deterministic_under_seed(built_scenes):
-    env = anomalygen.make_env(built_scenes["floor"], init_noise=0.02)
+    env = make_env(built_scenes["floor"], init_noise=0.02)
     actions = np.random.default_rng(0).uniform(-1, 1, size=(10, 7))
     runs = []
     for _ in range(2):
@@ -78,7 +77,7 @@ def test_reset_is_deterministic_under_seed(built_scenes):
 
 
 def test_delta_action_moves_the_end_effector(built_scenes):
-    env = anomalygen.make_env(built_scenes["floor"], horizon=1000)
+    env = make_env(built_scenes["floor"], horizon=1000)
     obs, _ = env.reset(seed=0)
     L = env.obs_layout
     start = obs[L["ee_pos"]].copy()
@@ -88,7 +87,7 @@ def test_delta_action_moves_the_end_effector(built_scenes):
 
 
 def test_suction_attaches_and_carries(built_scenes):
-    env = anomalygen.make_env(built_scenes["knife_edge"], horizon=1000)
+    env = make_env(built_scenes["knife_edge"], horizon=1000)
     obs, _ = env.reset(seed=0)
     L = env.obs_layout
     name = env.scene.bindings["$hazard"]
@@ -117,7 +116,7 @@ def test_suction_attaches_and_carries(built_scenes):
 
 def test_reward_and_success_hooks(built_scenes):
     calls = []
-    env = anomalygen.make_env(
+    env = make_env(
         built_scenes["floor"],
         reward_fn=lambda e: calls.append(e.t) or 0.5,
         success_fn=lambda e: e.t >= 2,

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-from anomalygen.detect.score import DetectionScores, claim_matches, score_detections
-from anomalygen.detect.truth import GroundTruth, ground_truth, norm_name
-from anomalygen.scene.truth import load_manifest
+from anomalygen.referee.ground_truth import GroundTruth, ground_truth, norm_name
+from anomalygen.referee.score import DetectionScores, claim_matches, score_detections
+from anomalygen.referee.truth import load_manifest
 from anomalygen.schema import Detection, HazardManifest, Hypothesis, ManifestHazard
 
 __all__ = [

@@ -2,9 +2,10 @@
 
 Every figure is counted against the builder's hidden truth (``truth.json``), hazard by hazard, over
 every class: a hazard is *detected* when a claim of the scene's detection names it, *planned* when the
-scene's plan acts on its object, *resolved* when the referee found it fixed at the end of a run (over
-the runs of its scene). Harm is counted per run: runs that created a new hazard, and runs that acted
-on a near-miss (an object that was already safe).
+scene's plan acts on its object, *resolved* when the referee's verdict found it fixed at the end of a
+run — no hazard class still fires on its object — in a run that created no new hazard (over the runs
+of its scene). Harm is counted per run: runs that created a new hazard, and runs that acted on a
+near-miss (an object that was already safe).
 """
 
 from __future__ import annotations
@@ -22,7 +23,8 @@ class ClassRow(Strict):
     detected: int = 0
     planned: int = 0
     runs: int = Field(0, description="(hazard, seed) executions judged")
-    resolved: int = Field(0, description="of those, the hazard was fixed at the end")
+    resolved: int = Field(0, description="of those, the hazard was fixed at the end (no hazard class fires on its "
+                          "object) and the run created no new hazard")
 
 
 class HazardTable(Strict):
@@ -66,7 +68,7 @@ def hazard_table(run: RunFolder, task_ids: list[str], seeds: int) -> HazardTable
                 outcome = next((o for o in r.hazards if o.object == h.object), None)
                 if outcome is not None:
                     row.runs += 1
-                    row.resolved += int(outcome.resolved)
+                    row.resolved += int(outcome.resolved and not r.new_hazards)  # new hazards count against the run
     table.by_class = dict(sorted(rows.items()))
     for row in table.by_class.values():
         for key in ("hazards", "detected", "planned", "runs", "resolved"):

@@ -3,8 +3,9 @@
 Why one accessor: a headline (report tile, chart, table, benchmark figure) must come from the
 referee's judgement of the settled final state against the hidden truth, never from the robot's own
 check (``SkillResult.success``, which may only appear beside it, labelled "robot's own check").
-Today the referee's verdict is stored in ``result.json`` as ``outcome`` (``FixOutcome``); when it
-moves to a file of its own, :func:`verdict_of` changes and nothing that reads it does.
+The verdict is the judge stage's ``skills/<task>/seed<k>/verdict.json`` (``schema.Verdict``, read
+through :func:`anomalygen.referee.load_verdict`); a run judged before that file existed has its
+verdict in ``result.json`` as ``outcome`` (``FixOutcome``), read the same way.
 
 A hazard-free scene is never "resolved": the robot either left it alone (``no_action_needed``) or
 acted on something that was already safe or created a hazard (``acted_on_safe``). A scene with
@@ -54,6 +55,14 @@ class RunVerdict(Strict):
 
 def verdict_of(run: RunFolder, task_id: str, seed: int) -> RunVerdict | None:
     """The referee's verdict on ``task_id`` at ``seed``; None when the run was not judged (no truth)."""
+    from anomalygen.referee import load_verdict
+
+    verdict = load_verdict(run, task_id, seed)
+    if verdict is not None:
+        hazards = [HazardVerdict(hazard_class=h.hazard_class, object=h.object, resolved=h.resolved, detail=h.detail)
+                   for h in verdict.hazards]
+        return RunVerdict(status=verdict.status, resolved=verdict.resolved, hazards=hazards,
+                          new_hazards=list(verdict.new_hazards), interventions_on_safe=list(verdict.interventions_on_safe))
     result = try_read_model(run.skill_dir(task_id, seed) / "result.json", SkillResult)
     if result is None or result.outcome is None:
         return None

@@ -40,7 +40,8 @@ def _evaluate(calls, ep: Episode, bindings) -> list[PredicateResult]:
 def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: str | Path | None = None,
                  max_wall_s: float = 600.0, sac_steps: int = 0, isolate: bool = True,
                  retries: int = 1, reward_mode: str = "spec",
-                 final_graph_path: str | Path | None = None, n_envs: int = 1, recheck_fixes: int = 0) -> SkillResult:
+                 final_graph_path: str | Path | None = None, n_envs: int = 1, recheck_fixes: int = 0,
+                 final_state_path: str | Path | None = None) -> SkillResult:
     """Load the scene, run the plan's sub-tasks in order, check success, optionally record a video.
 
     Execution is closed-loop: a primitive sub-task whose success check fails on the scene right after
@@ -56,8 +57,9 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
     ``reward_mode`` is ``learn.reward_mode``: "code" trains SAC sub-tasks on sandboxed reward code
     (:func:`~anomalygen.skills.learned.sac_subtask.run_sac_subtask`).
 
-    ``final_graph_path`` receives the scene graph of the final, settled state: what the referee
-    judges against the hidden truth (the robot's own verdict is ``success``).
+    ``final_graph_path`` receives the scene graph of the final, settled state as the robot perceives it;
+    ``final_state_path`` the simulator state itself (``scene.state``), which the referee's judge stage
+    releases, settles and judges against the hidden truth (the robot's own verdict is ``success``).
 
     ``recheck_fixes`` > 0: after the plan the robot looks again and fixes up to that many hazards its
     own actions created (:mod:`anomalygen.learn.recheck`); their steps are listed with ids ``recheck_*``.
@@ -69,9 +71,9 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
             return pool.submit(_execute_here, str(scene_dir), plan, seed, None if video_path is None else
                                str(video_path), max_wall_s, sac_steps, retries, reward_mode,
                                None if final_graph_path is None else str(final_graph_path), n_envs,
-                               recheck_fixes).result()
+                               recheck_fixes, None if final_state_path is None else str(final_state_path)).result()
     return _execute_here(scene_dir, plan, seed, video_path, max_wall_s, sac_steps, retries, reward_mode,
-                         final_graph_path, n_envs, recheck_fixes)
+                         final_graph_path, n_envs, recheck_fixes, final_state_path)
 
 
 def _look_again(ep: Episode, before, plan: Plan, max_fixes: int, retries: int) -> list[SubTaskResult]:
@@ -158,7 +160,7 @@ def run_subtasks(ep: Episode, plan: Plan, retries: int = 1) -> list[SubTaskResul
 
 def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float, sac_steps: int,
                   retries: int = 1, reward_mode: str = "spec", final_graph_path=None, n_envs: int = 1,
-                  recheck_fixes: int = 0) -> SkillResult:
+                  recheck_fixes: int = 0, final_state_path=None) -> SkillResult:
     from anomalygen.perception import perceived_spec
     from anomalygen.rng import item_rng
     from anomalygen.scene.graph import load_scene
@@ -188,6 +190,10 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
         from anomalygen.runfolder import write_model
 
         write_model(Path(final_graph_path), ep.graph())
+    if final_state_path is not None:
+        from anomalygen.scene.state import save_state
+
+        save_state(final_state_path, ep.model, ep.data)
     timings["execute_s"] = round(budget.elapsed() - timings["load_s"], 3)
     timings["control_steps"] = float(ep.steps)
     video = None

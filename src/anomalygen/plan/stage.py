@@ -154,7 +154,9 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
             continue
         det = detections.get(t.id)
         if settings.learn.plan_source == "detected":  # the robot's side: its detection, never the task
-            items.append((t.id, {"detection": det.model_dump(mode="json") if det else None}))
+            # what the detector claimed, never how the referee judged it
+            items.append((t.id, {"detection": det.model_dump(mode="json", include={"task_id", "hypotheses"})
+                                 if det else None}))
         else:
             items.append((t.id, {"hazard_class": t.hazard_class, "task": t.model_dump(mode="json")}))
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 import logging
 import os
 import shutil
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -35,12 +35,13 @@ from anomalygen.rng import item_rng, stable_hash
 from anomalygen.robot.agent import Agent
 from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
 from anomalygen.scene import select
+from anomalygen.scene.cavities import placed_cavities
 from anomalygen.scene.compose import compose_scene, hold_gravity_hinges, latch_switched_on, set_joints
 from anomalygen.scene.judgement import check_hazard_free
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.placement import place
 from anomalygen.scene.selection import bind_roles, select_objects, set_initial_joints
-from anomalygen.scene.states import arrange_states
+from anomalygen.scene.set_states import arrange_states
 from anomalygen.schema import (
     AssetRef,
     AssetSource,
@@ -69,6 +70,7 @@ class Built:
     data: object
     report: ValidationReport
     graph: object
+    intents: dict = field(default_factory=dict)  # instance -> referee.truth.Intent of the judgement mix
 
 
 def _plan(task: TaskProposal, settings: Settings, rng, hints=None,
@@ -123,7 +125,7 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
     if hazard_free and report.ok:
         report = check_hazard_free(report, graph, task.hazard_class)
     report.checks = notes + report.checks
-    return Built(spec, mjspec, model, data, report, graph)
+    return Built(spec, mjspec, model, data, report, graph, {p.name: p.intent for p in placed.values() if p.intent})
 
 
 def _hint_notes(hints, lay: Layout) -> list[ValidationCheck]:
@@ -168,6 +170,7 @@ def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, mo
             )
             size = s.size
             joints = []
+        cavities = placed_cavities(model, p.name, p.asset) if p.asset is not None else []
         objects.append(
             PlacedObject(
                 name=p.name,
@@ -180,6 +183,7 @@ def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, mo
                 inside=p.inside,
                 joint_states=joints,
                 fixed=p.fixed,
+                cavities=cavities,
                 states=list(p.states),
             )
         )
@@ -253,8 +257,8 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_cla
     """scene.xml, renders, scene_graph.json, the hidden truth.json, scene.json last.
 
     ``hazard_class`` is the hazard the builder set up (None for a hazard-free scene)."""
+    from anomalygen.referee.truth import TRUTH_FILE, hazard_manifest
     from anomalygen.scene.render import SceneRenderer, png_bytes
-    from anomalygen.scene.truth import TRUTH_FILE, hazard_manifest
 
     out_dir.mkdir(parents=True, exist_ok=True)
     model, data, mjspec = built.model, built.data, built.mjspec
@@ -273,7 +277,7 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_cla
             files[f"render_{cam}"] = f"render_{cam}.png"
     spec = built.spec.model_copy(update={"validation": built.report, "files": files})
     write_model(out_dir / "scene_graph.json", built.graph)
-    write_model(out_dir / TRUTH_FILE, hazard_manifest(spec, hazard_class, built.graph, load_kb()))
+    write_model(out_dir / TRUTH_FILE, hazard_manifest(spec, hazard_class, built.graph, load_kb(), built.intents))
     write_model(out_dir / "scene.json", spec)  # last: its presence marks the scene done
     return spec
 

@@ -1,7 +1,10 @@
 """The builder's part of the judgement mix (``mix.py`` chooses what; this places and checks it).
 
-Near-misses go well inside a table top, a second hazard on the floor with its bin; a hazard-free
-scene puts the task's object where it is no hazard and, once settled, checks that it really is none.
+Near-misses go on a table top, well clear of its edges or on the borderline of the edge rule; a state
+near-miss stands on a table with its part safe (a switch off, a lid ajar two degrees); a second
+hazard goes on the floor with its bin. Each carries its intent (``referee.truth.Intent``) to the truth
+manifest. A hazard-free scene puts the task's object where it is no hazard and, once settled, checks
+that it really is none.
 """
 
 from __future__ import annotations
@@ -9,41 +12,94 @@ from __future__ import annotations
 from anomalygen.errors import ItemFailed
 from anomalygen.knowledge import load_kb
 from anomalygen.knowledge.predicates import ROOM_FIXTURES
+from anomalygen.referee.truth import Intent
 from anomalygen.scene import mix, select
 from anomalygen.scene.instances import (
     HAZARD_NEAR_SIDE,
     INWARD,
     cavity_world,
+    container_room,
     instance_name,
     placed_instance,
     surface_of,
 )
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.selection import Selection
-from anomalygen.schema import ENCLOSING_LABELS, ObjectRole, ValidationCheck, ValidationReport
+from anomalygen.schema import (
+    ENCLOSING_LABELS,
+    LATCHING_PROPERTY,
+    ObjectRole,
+    ValidationCheck,
+    ValidationReport,
+)
 
 
 def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed], surfaces: list[Placed],
                           items: mix.JudgementItems) -> None:
-    """Near-misses well inside a table top (any that find no room are left out); the second hazard
-    on the floor, with its bin when the scene has none."""
+    """Near-misses on a table top (any that find no room are left out): well clear of its edges, or
+    the chosen distance from the edge facing the robot; the state near-miss likewise, its part set safe;
+    the second hazard on the floor, with its bin when the scene has none."""
     rng = items.rng
-    for cat in items.near_misses if surfaces else []:
-        asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng)
-        p = placed_instance(select.Chosen(instance_name(cat, sel.used), cat, ObjectRole.CLUTTER, asset))
+    for pick in items.near_misses if surfaces else []:
+        p = _chosen(sel, pick.category, rng)
         holder = surfaces[int(rng.integers(len(surfaces)))]
-        try:
-            lay.place_on_surface(p, holder, surface_of(holder), inward=INWARD)
-        except ItemFailed:
+        if not _on_surface_clear_of_edges(lay, p, holder, pick.edge_gap):
             continue
+        if pick.edge_gap is not None:
+            rule = f"{pick.edge_gap:.2f} m from the edge, just {pick.kind.split('_')[1]} {pick.hazard_class}'s rule"
+            p.intent = Intent("hazard" if pick.kind == "just_inside" else "borderline", pick.hazard_class, rule)
         placed[p.name] = p
+    if items.state is not None and surfaces:
+        _place_state_near_miss(sel, lay, placed, surfaces, items.state, rng)
     for cat, role, face in ((items.second_hazard, ObjectRole.HAZARD, False), (items.bin, ObjectRole.CONTAINER, True)):
         if cat is None:
             continue
         asset = select.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng)
         p = placed_instance(select.Chosen(instance_name(cat, sel.used), cat, role, asset))
         lay.place_on_floor(p, relevant=True, face=face)
+        if role == ObjectRole.HAZARD:
+            p.intent = Intent("hazard", mix.SECOND_HAZARD_CLASS, "the judgement mix's second hazard")
         placed[p.name] = p
+
+
+def _on_surface_clear_of_edges(lay: Layout, p: Placed, holder: Placed, edge_gap: float | None = None) -> bool:
+    """Rest ``p`` on ``holder``'s top ``FAR_M`` from its edges (the robot-facing one ``edge_gap`` away
+    when given), else ``NEAR_FAR_M`` when the top is too crowded for that; False when it finds no room."""
+    for inward in (mix.FAR_M, mix.NEAR_FAR_M):
+        try:
+            lay.place_on_surface(p, holder, surface_of(holder), inward=inward, edge_gap=edge_gap)
+            return True
+        except ItemFailed:
+            continue
+    return False
+
+
+def _chosen(sel: Selection, category: str, rng) -> Placed:
+    asset = select.pick_asset(category, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng)
+    return placed_instance(select.Chosen(instance_name(category, sel.used), category, ObjectRole.CLUTTER, asset))
+
+
+def _place_state_near_miss(sel: Selection, lay: Layout, placed: dict[str, Placed], surfaces: list[Placed],
+                           pick: mix.StatePick, rng) -> None:
+    """An object whose class is about a part's state, on a table top with that part safe: its doors,
+    lids and drawers ``AJAR_RAD`` (``AJAR_M``) open, its knobs and switches exactly off."""
+    p = _chosen(sel, pick.category, rng)
+    wanted = pick.labels.split("|")
+    parts = [j for j in p.asset.joints if select.kb_label(j.label) in wanted or "*" in wanted]
+    if not parts:
+        sel.used.discard(p.name)
+        return
+    for j in parts:
+        step = (mix.AJAR_M if j.type == "slide" else mix.AJAR_RAD) if pick.ajar else 0.0
+        far = j.range[1] if abs(j.range[1] - j.closed_value) >= abs(j.range[0] - j.closed_value) else j.range[0]
+        p.joint_values[j.name] = float(j.closed_value + step * (1 if far >= j.closed_value else -1))
+    holder = surfaces[int(rng.integers(len(surfaces)))]
+    if not _on_surface_clear_of_edges(lay, p, holder):
+        sel.used.discard(p.name)
+        return
+    state = "ajar" if pick.ajar else "off"
+    p.intent = Intent("state", pick.hazard_class, f"its {'/'.join(sorted({select.kb_label(j.label) for j in parts}))} {state}")
+    placed[p.name] = p
 
 
 def room_fixtures(kb, lay: Layout) -> list[Placed]:
@@ -54,8 +110,12 @@ def room_fixtures(kb, lay: Layout) -> list[Placed]:
 
 def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None) -> None:
     """The task's object where it is no hazard: shut inside its container, else well inside the
-    surface, else on the floor beside a piece of furniture, out of the walkway."""
+    surface, else on the floor beside a piece of furniture, out of the walkway. For a class whose
+    danger is a child reaching it, only a container that latches keeps it safe (a toddler opens a
+    cupboard or a box): such a container is added when the task's own does not latch."""
     hazard, container = sel.hazard, sel.container
+    if _guards_a_child(sel.hc) and (container is None or not _latches(sel.kb, container.catalogue)):
+        container = _latching_container(sel, hazard) or container
     hp = placed[hazard.name] = placed_instance(hazard)
     if container is not None and container is not hazard and container.asset.cavities:
         holder = placed.get(container.name)
@@ -75,9 +135,30 @@ def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], 
     lay.place_beside(hp, room_fixtures(sel.kb, lay))
 
 
+def _guards_a_child(hc) -> bool:
+    return hc is not None and any(c.name == "child_reachable" and not c.negate for c in hc.preconditions)
+
+
+def _latches(kb, catalogue: str) -> bool:
+    return LATCHING_PROPERTY in kb.properties_of(catalogue)
+
+
+def _latching_container(sel: Selection, hazard) -> select.Chosen | None:
+    """A container of a kind that latches (the knowledge base's ``lockable`` objects) the object fits in."""
+    for name in sorted(n for n in sel.kb.objects if _latches(sel.kb, n)):
+        try:
+            cand = sel.choose(name, ObjectRole.CONTAINER)
+        except (ItemFailed, KeyError):
+            continue
+        if cand.asset.cavities and hazard.size <= container_room(cand.asset):
+            return cand
+        sel.forget(cand)
+    return None
+
+
 def check_hazard_free(report: ValidationReport, graph, hazard_class: str) -> ValidationReport:
     """A hazard-free variant must not show the task's hazard anywhere once settled."""
-    from anomalygen.scene.truth import class_matches
+    from anomalygen.referee.truth import class_matches
 
     still = sorted(obj for cls, obj, _ in class_matches(graph, load_kb()) if cls == hazard_class)
     check = ValidationCheck(name="hazard_free", passed=not still,

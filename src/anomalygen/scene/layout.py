@@ -56,6 +56,7 @@ class Placed:
     # (a counter 2 cm in front of a cabinet's doors keeps them shut); unlike ``sweep`` the base may
     # stand in it, and it does not push the base back from the front
     swing: float = 0.0
+    intent: object = None  # what the judgement mix meant it to be (a referee.truth.Intent), for truth.json
 
     def world_half(self) -> np.ndarray:
         c, s = abs(math.cos(self.yaw)), abs(math.sin(self.yaw))
@@ -258,11 +259,13 @@ class Layout:
         label: str | None = None,
         near_side: float | None = None,
         yaw: float | None = None,
+        edge_gap: float | None = None,
     ) -> None:
         """Rest ``obj`` on a rectangle (world lo_xy, hi_xy, top z) of ``holder``.
 
         ``edge``: the footprint ends 1.5-7 cm from the surface edge that faces the robot (the
-        knowledge base counts <= 12 cm as "near the edge"). ``inward``: keep this far from all edges
+        knowledge base counts <= 12 cm as "near the edge"); ``edge_gap``: exactly this far from that
+        edge instead (a near-miss just either side of the rule). ``inward``: keep this far from all edges
         (less when the object is too big for that). ``near_side``: the object's centre at most this
         far from the robot-facing edge, so the arm reaches it from beside the support. ``yaw``: stand
         it at this yaw (an appliance whose door faces out over the edge) instead of a random one.
@@ -292,9 +295,9 @@ class Layout:
             room = np.where(slack - inward >= 0, slack - inward, 0.0)
             center = (lo_xy + hi_xy) / 2 + self.rng.uniform(-1, 1, size=2) * room
             bound = hi_xy[axis] if sign > 0 else lo_xy[axis]
-            if edge:
+            if edge or edge_gap is not None:
                 # The robot-facing edge of the surface: the side whose outward normal points to the base.
-                gap = self.rng.uniform(*EDGE_BAND)
+                gap = edge_gap if edge_gap is not None else self.rng.uniform(*EDGE_BAND)
                 center[axis] = bound - sign * (half[axis] + gap)
             elif near_side is not None:
                 depth = abs(center[axis] - bound)

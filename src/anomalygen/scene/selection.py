@@ -17,7 +17,7 @@ from anomalygen.knowledge import load_kb
 from anomalygen.scene import select
 from anomalygen.scene.instances import cavity_cap, container_room, instance_name
 from anomalygen.scene.layout import Placed
-from anomalygen.scene.states import set_initial_states
+from anomalygen.scene.set_states import set_initial_states
 from anomalygen.schema import ENCLOSING_LABELS, ObjectRole, TaskProposal
 
 MAX_AUX = 3

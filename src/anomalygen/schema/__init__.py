@@ -3,7 +3,7 @@
 Every artefact is a file in the run folder, so each class is strict (unknown fields are errors, not
 silently dropped) and carries a ``schema_version`` so old runs can be detected rather than misread.
 Stages depend on these classes, never on each other's internals. One module per stage owns its
-artefacts (``tasks``, ``scenes``, ``detection``, ``skills``, ``run``) over the shared ``base`` and
+artefacts (``tasks``, ``scenes``, ``detection``, ``skills``, ``verdicts``, ``run``) over the shared ``base`` and
 ``vocabulary``; import every name from ``anomalygen.schema``.
 """
 
@@ -37,6 +37,7 @@ from anomalygen.schema.scenes import (
     CLOSURE_LABELS,
     ENCLOSING_LABELS,
     GATE_LABELS,
+    LATCHING_PROPERTY,
     SWINGING_CLOSURES,
     SWITCH_LABELS,
     AssetRef,
@@ -45,12 +46,14 @@ from anomalygen.schema.scenes import (
     JointState,
     ManifestHazard,
     NearMiss,
+    PlacedCavity,
     PlacedObject,
     Relation,
     SceneGraph,
     SceneSpec,
     ValidationCheck,
     ValidationReport,
+    within_child_reach,
 )
 from anomalygen.schema.skills import (
     FixOutcome,
@@ -71,6 +74,7 @@ from anomalygen.schema.tasks import (
     Scenario,
     TaskProposal,
 )
+from anomalygen.schema.verdicts import HazardVerdict, Verdict, VerdictStatus
 from anomalygen.schema.vocabulary import (
     AssetSource,
     BrainstormMode,
@@ -99,6 +103,7 @@ ARTEFACTS: dict[str, type[BaseModel]] = {
         RewardSpec,
         SuccessSpec,
         SkillResult,
+        Verdict,
         RunManifest,
         ItemError,
     )
@@ -134,7 +139,10 @@ __all__ = [
     "SWITCH_LABELS",
     "CLOSED_TOL",
     "CHILD_REACH",
+    "LATCHING_PROPERTY",
+    "within_child_reach",
     "JointState",
+    "PlacedCavity",
     "PlacedObject",
     "ValidationCheck",
     "ValidationReport",
@@ -157,6 +165,9 @@ __all__ = [
     "HazardOutcome",
     "FixOutcome",
     "SkillResult",
+    "HazardVerdict",
+    "Verdict",
+    "VerdictStatus",
     "StageRecord",
     "LLMUsage",
     "RunManifest",

@@ -86,7 +86,7 @@ class HazardOutcome(Strict):
 
 
 class FixOutcome(Strict):
-    """The hidden-truth verdict on one execution (written by the referee, never read by the robot)."""
+    """An old run's hidden-truth verdict, kept readable (new runs: ``schema.Verdict`` in verdict.json)."""
 
     hazards: list[HazardOutcome] = Field(default_factory=list)
     resolved: bool = Field(description="every manifest hazard is resolved (a hazard-free scene: True)")
@@ -107,4 +107,6 @@ class SkillResult(Artefact):
     video: str | None = None
     timings: dict[str, float] = Field(default_factory=dict)
     error: str | None = None
-    outcome: FixOutcome | None = Field(None, description="the referee's verdict against truth.json; None without one")
+    outcome: FixOutcome | None = Field(
+        None, description="read only for old runs: the referee's verdict is now written after the robot's items, "
+        "by the judge stage, to verdict.json (schema.Verdict); new results leave this None")

@@ -14,7 +14,7 @@ from collections.abc import Mapping, Sequence
 
 from pydantic import Field
 
-from anomalygen.detect.truth import norm_name
+from anomalygen.referee.ground_truth import norm_name
 from anomalygen.schema import Detection, HazardManifest, Hypothesis, Strict
 
 

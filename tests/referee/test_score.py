@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from anomalygen.detect.score import claim_matches, score_detections
+from anomalygen.referee.score import claim_matches, score_detections
 from anomalygen.schema import Detection, HazardManifest, Hypothesis, ManifestHazard
 
 
