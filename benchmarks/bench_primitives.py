@@ -41,7 +41,7 @@ def main() -> int:
     run = Path(a.out or tempfile.mkdtemp(prefix="bench_primitives_")) / "run"
     # the oracle plans on single-hazard scenes: this figure measures the skills, not detection (that is
     # bench_loop.py), so plans come from the builder's bindings and the judgement mix is off
-    env = {**os.environ, "ANOMALYGEN_LEARN__VIDEO": "false", "ANOMALYGEN_LEARN__PLAN_SOURCE": "ground_truth",
+    env = {**os.environ, "ANOMALYGEN_LEARN__VIDEO": "false", "ANOMALYGEN_PLAN__SOURCE": "ground_truth",
            "ANOMALYGEN_BUILD__HAZARD_FREE": "0", "ANOMALYGEN_BUILD__MULTI_HAZARD": "0",
            "ANOMALYGEN_BUILD__NEAR_MISSES": "0"}
     if a.retries is not None:

@@ -45,7 +45,7 @@ def main() -> int:
     else:
         run = Path(a.run)
     exe = Path(sys.executable).with_name("anomalygen")
-    env = {**os.environ, "ANOMALYGEN_LEARN__VIDEO": "false", "ANOMALYGEN_LEARN__PLAN_SOURCE": "ground_truth"}
+    env = {**os.environ, "ANOMALYGEN_LEARN__VIDEO": "false", "ANOMALYGEN_PLAN__SOURCE": "ground_truth"}
     tasks = [json.loads(x) for x in (run / "tasks.jsonl").read_text().splitlines() if x.strip()]
     ids = [t["id"] for t in tasks if t["hazard_class"] == CLASS and (run / "scenes" / t["id"] / "scene.json").is_file()]
     only = [x for tid in ids for x in ("--only", tid)]

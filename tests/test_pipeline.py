@@ -65,7 +65,7 @@ def test_a_whole_run_stage_refuses_only(tmp_path):
 
 def test_demo_defaults_are_the_embedded_offline_ones():
     s = load_settings(pipeline.demo_config_path())
-    assert (s.brainstorm.engine, s.build.engine, s.learn.engine) == ("knowledge",) * 3
+    assert (s.brainstorm.engine, s.build.engine, s.plan.engine) == ("knowledge",) * 3
     assert s.detect.detector == "rules" and s.llm.backend == "none"
     assert 15 <= s.brainstorm.n <= 25 and s.learn.sac_steps <= 1000
 

@@ -76,7 +76,7 @@ def test_cable_across_a_walkway_is_lifted_off_the_floor(built, tmp_path):
 
 
 def test_cables_are_loose_whatever_their_length():
-    from anomalygen.scene.select import FIXED_SIZE, Chosen
+    from anomalygen.scene.asset_choice import FIXED_SIZE, Chosen
     from anomalygen.schema import ObjectRole
 
     class _Big:

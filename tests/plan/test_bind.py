@@ -6,6 +6,7 @@ from tests.knowledge.graphs import furniture, graph, joint, obj
 
 from anomalygen.knowledge import load_kb
 from anomalygen.plan.bind import choose_container, ends_hazard
+from anomalygen.schema import LATCHING_PROPERTY
 
 
 def _scene():
@@ -28,6 +29,23 @@ def test_a_choking_hazard_goes_where_a_latch_keeps_a_toddler_out_not_into_a_near
     assert ends_hazard([hc], marble, by["safe_0"], g)  # a shut safe latches
     g = g.model_copy(update={"objects": [o for o in g.objects if o.name != "safe_0"]})
     assert choose_container(hc, marble, g, kb) == "box_0"  # nothing ends it: the nearest that takes it
+
+
+def test_shut_flaps_count_as_a_shut_lid_a_latching_box_keeps_a_choking_hazard_out_of_reach_by_either():
+    """Flaps enclose as a lid does (the part-label table): a box that latches keeps a toddler out once
+    either is shut, and not when it has nothing that shuts."""
+    kb, g = load_kb(), _scene()
+    hc = kb.hazard_classes["remove_choking_hazards"]
+    marble = next(o for o in g.objects if o.name == "marble_0")
+    carton = next(o for o in g.objects if o.name == "box_0")
+    latching = carton.model_copy(update={"properties": [*carton.properties, LATCHING_PROPERTY]})
+    flapped = latching.model_copy(update={"joints": [joint("flap", 0.0)]})
+    lidded = latching.model_copy(update={"joints": [joint("lid", 0.0)]})
+    open_top = latching.model_copy(update={"joints": []})
+    assert ends_hazard([hc], marble, flapped, g) and ends_hazard([hc], marble, lidded, g)
+    assert not ends_hazard([hc], marble, open_top, g)
+    g = g.model_copy(update={"objects": [flapped if o is carton else o for o in g.objects]})
+    assert choose_container(hc, marble, g, kb) == "box_0"  # the nearest container that ends it
 
 
 def test_litter_is_done_with_once_in_the_nearest_bin():

@@ -36,6 +36,22 @@ def test_names_and_home_pose_points_the_cup_down():
     assert np.allclose(arm, Agent.HOME_ARM, atol=0.02)
 
 
+def test_the_home_pose_boxes_hold_the_arm_at_its_home_pose():
+    """The builder keeps objects out of HOME_ARM_BOXES: every arm link and the cup must lie in them."""
+    model, data = _robot_with_box()
+    boxes = [(np.array([a[0] for a in box]), np.array([a[1] for a in box])) for box in Agent.HOME_ARM_BOXES]
+
+    def boxed(p) -> bool:
+        return any(np.all(p >= lo) and np.all(p <= hi) for lo, hi in boxes)
+
+    links = [b for b in range(model.nbody) if model.body(b).name.startswith(Agent.ARM_LINK_PREFIX)]
+    assert len(links) == 8
+    for b in links:
+        assert boxed(data.xpos[b]), model.body(b).name
+    assert boxed(data.body(Agent.CUP_BODY).xpos) and boxed(data.site(Agent.CUP_SITE).xpos)
+    assert not boxed(np.array([0.6, 0.0, 1.0]))  # half a metre ahead of the cup is free
+
+
 def test_suction_grabs_only_within_range_and_carries_the_object():
     model, data = _robot_with_box()
     agent = Agent(model)

@@ -52,7 +52,7 @@ def learn_item(item_id: str, payload: dict, ctx: StageContext) -> dict:
                           sac_steps=settings.learn.sac_steps, retries=settings.learn.retries,
                           reward_mode=settings.learn.reward_mode, final_graph_path=final_graph,
                           final_state_path=out / FINAL_STATE, n_envs=settings.learn.n_envs,
-                          recheck_fixes=settings.learn.max_fixes if settings.learn.recheck else 0)
+                          recheck_fixes=settings.plan.max_fixes if settings.learn.recheck else 0)
     if result.video:
         result = result.model_copy(update={"video": "video.mp4"})
     write_model(out / "result.json", result)

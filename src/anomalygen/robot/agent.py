@@ -73,6 +73,14 @@ class Agent:
     BASE_HEIGHT: ClassVar[float] = 0.30  # m: top of the mobile base, where link0 stands with the lift down
     LIFT_MAX: ClassVar[float] = 0.30  # m the torso lift raises the arm
     BASE_RADIUS: ClassVar[float] = 0.22  # m
+    # The space the arm takes at HOME_ARM with the lift down, as boxes in the base frame (x forward,
+    # y left, z up from the floor; (lo, hi) in metres per axis): the column above the base, and the
+    # forearm with the cup, which hangs 0.3 m forward with its lowest point at ~1.01 m (above counters).
+    # The scene builder keeps every object out of them (``scene/layout.py::Layout.arm_boxes``).
+    HOME_ARM_BOXES: ClassVar[tuple[tuple[tuple[float, float], ...], ...]] = (
+        ((-0.2, 0.12), (-0.15, 0.15), (0.3, 1.35)),
+        ((0.12, 0.42), (-0.15, 0.15), (0.98, 1.35)),
+    )
     # m: suction takes hold of a body whose nearest geom is at most this far from the cup geom
     SUCTION_RANGE: ClassVar[float] = 0.012
     # m: the mocap target never runs further than this ahead of the cup, so the weld never yanks the arm

@@ -3,12 +3,12 @@
 This module runs the attempts and writes the outputs; each step has a module of its own. Pipeline of
 one attempt (all randomness from ``item_rng(seed, task.id, attempt)``):
 
-1. select assets (selection.py, with select.py for each asset): hazard, target, the object the hazard
+1. select assets (casting.py, with asset_choice.py for each asset): hazard, target, the object the hazard
    sits in/on, the container of the fix, task co-objects, unrelated clutter; sizes from the knowledge
    base, clamped by spatial rules; initial joint states that make the hazard real;
 2. place them (placement.py on layout.py; instances.py for holders' surfaces and cavities;
    judgement.py for near-misses, a second hazard and hazard-free scenes) and move the robot base
-   within reach; bind the role variables to instance names (selection.py);
+   within reach; bind the role variables to instance names (casting.py);
 3. compose one MjSpec (compose.py: robot + room + objects), compile, reject initial interpenetration;
 4. settle the physics for ``settings.build.settle_s``;
 5. validate (validate.py): interpenetration <= 1 mm, velocities settled, and the hazard class's
@@ -34,13 +34,13 @@ from anomalygen.knowledge import load_kb
 from anomalygen.rng import item_rng, stable_hash
 from anomalygen.robot.agent import Agent
 from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
-from anomalygen.scene import select
+from anomalygen.scene.casting import bind_roles, select_objects, set_initial_joints
 from anomalygen.scene.cavities import placed_cavities
 from anomalygen.scene.compose import compose_scene, hold_gravity_hinges, latch_switched_on, set_joints
+from anomalygen.scene.instances import renumber_by_position
 from anomalygen.scene.judgement import check_hazard_free
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.placement import place
-from anomalygen.scene.selection import bind_roles, select_objects, set_initial_joints
 from anomalygen.scene.set_states import arrange_states
 from anomalygen.schema import (
     AssetRef,
@@ -51,6 +51,7 @@ from anomalygen.schema import (
     TaskProposal,
     ValidationCheck,
     ValidationReport,
+    part_labels,
 )
 
 if TYPE_CHECKING:
@@ -83,7 +84,8 @@ def _plan(task: TaskProposal, settings: Settings, rng, hints=None,
     set_initial_joints(sel)
     lay, placed, support = place(sel, settings)
     arrange_states(sel, lay, placed)
-    return lay, ({} if hazard_free else bind_roles(sel, support)), placed
+    placed, bindings = renumber_by_position(lay, placed, {} if hazard_free else bind_roles(sel, support))
+    return lay, bindings, placed
 
 
 # ============================================================================ attempt
@@ -152,7 +154,7 @@ def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, mo
             joints = [
                 JointState(
                     name=f"{p.name}/{j.name}",
-                    label=select.kb_label(j.label),
+                    label=part_labels.canonical(j.label),
                     type=j.type,
                     value=float(data.joint(f"{p.name}/{j.name}").qpos[0]),
                     range=(float(j.range[0]), float(j.range[1])),

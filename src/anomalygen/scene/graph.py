@@ -118,35 +118,48 @@ def _index(model, spec: SceneSpec) -> _Index:
 
 
 def _cavity_tables(model, spec: SceneSpec):
-    """Every declared cavity of the scene as arrays, and the joints that must be shut to close each.
-
-    A cavity is shut by its own joint when that is a door, drawer or lid; a cavity whose joint only
-    moves it (an oven rack) or that names none is shut by the object's doors, drawers and lids. A door
-    no cavity names (a fridge's second door) must be shut too: either leaf open leaves the way in.
-    """
+    """Every declared cavity of the scene as arrays, and the joints that must be shut to close each
+    (``cavity_closers``)."""
     from anomalygen.scene.cavities import cavities_of
 
     owners, bodies, centers, halves, closers = [], [], [], [], []
     for i, obj in enumerate(spec.objects):
         cavities = cavities_of(model, obj)
-        if not cavities:
-            continue
-        by_name = {js.name: js for js in obj.joint_states}
-        enclosing = [js for js in obj.joint_states if js.encloses]
-        named = {c.joint for c in cavities if c.joint}
-        orphans = [js for js in enclosing if js.name not in named]
-        for c in cavities:
-            own = by_name.get(c.joint) if c.joint else None
-            shut = ([own] if own is not None and own.encloses else enclosing) + orphans
+        for c, shut in zip(cavities, cavity_closers(obj.joint_states, [c.joint for c in cavities]), strict=True):
             owners.append(i)
             bodies.append(model.body(c.body).id)
             centers.append(c.center)
             halves.append(c.half_extents)
-            closers.append(tuple({js.name: (int(model.jnt_qposadr[model.joint(js.name).id]), js)
-                                  for js in shut}.values()))
+            closers.append(tuple((int(model.jnt_qposadr[model.joint(js.name).id]), js) for js in shut))
     half = np.asarray(halves, float).reshape(-1, 3)
     return (np.asarray(owners, int), np.asarray(bodies, int), np.asarray(centers, float).reshape(-1, 3), half,
             np.prod(2 * half, axis=1), tuple(closers))
+
+
+def cavity_closers(joint_states: list[JointState], cavity_joints: list[str | None]) -> list[list[JointState]]:
+    """Per cavity of one object (named by the joint it declares, or None), the joints that shut it.
+
+    A cavity is shut by its own joint when that encloses (a door, drawer, lid or flap:
+    ``JointState.encloses``); a cavity whose joint only moves it (an oven rack) or that names none is
+    shut by all the object's enclosing parts. An enclosing part no cavity names (a fridge's second
+    door, a box's second flap) must be shut too: either leaf open leaves the way in.
+    """
+    by_name = {js.name: js for js in joint_states}
+    enclosing = [js for js in joint_states if js.encloses]
+    named = {j for j in cavity_joints if j}
+    orphans = [js for js in enclosing if js.name not in named]
+    out = []
+    for joint in cavity_joints:
+        own = by_name.get(joint) if joint else None
+        shut = ([own] if own is not None and own.encloses else enclosing) + orphans
+        out.append(list({js.name: js for js in shut}.values()))
+    return out
+
+
+def cavity_shut(closers: list[tuple[JointState, float]]) -> bool:
+    """A cavity is shut when something shuts it and every joint that does is (nearly) closed at its
+    value (joint, value)."""
+    return bool(closers) and all(js.is_closed(ENCLOSED_TOL, float(v)) for js, v in closers)
 
 
 def _holding_welds(model, body_owner: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -261,8 +274,7 @@ def _support_contacts(model, data, owner: np.ndarray, floor: int, n: int):
 def _cavities_closed(idx: _Index, data) -> np.ndarray:
     """Per cavity: every joint that shuts it is (nearly) closed; a cavity nothing shuts is open."""
     qpos = data.qpos
-    return np.array([bool(shut) and all(js.is_closed(ENCLOSED_TOL, float(qpos[adr])) for adr, js in shut)
-                     for shut in idx.cav_closers], dtype=bool)
+    return np.array([cavity_shut([(js, qpos[adr]) for adr, js in shut]) for shut in idx.cav_closers], dtype=bool)
 
 
 def _containment(idx: _Index, data, center: np.ndarray, held: set[int]) -> np.ndarray:

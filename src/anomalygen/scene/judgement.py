@@ -13,7 +13,8 @@ from anomalygen.errors import ItemFailed
 from anomalygen.knowledge import load_kb
 from anomalygen.knowledge.predicates import ROOM_FIXTURES
 from anomalygen.referee.truth import Intent
-from anomalygen.scene import mix, select
+from anomalygen.scene import asset_choice, mix
+from anomalygen.scene.casting import Selection
 from anomalygen.scene.instances import (
     HAZARD_NEAR_SIDE,
     INWARD,
@@ -24,14 +25,7 @@ from anomalygen.scene.instances import (
     surface_of,
 )
 from anomalygen.scene.layout import Layout, Placed
-from anomalygen.scene.selection import Selection
-from anomalygen.schema import (
-    ENCLOSING_LABELS,
-    LATCHING_PROPERTY,
-    ObjectRole,
-    ValidationCheck,
-    ValidationReport,
-)
+from anomalygen.schema import LATCHING_PROPERTY, ObjectRole, ValidationCheck, ValidationReport, part_labels
 
 
 def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed], surfaces: list[Placed],
@@ -54,8 +48,8 @@ def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed]
     for cat, role, face in ((items.second_hazard, ObjectRole.HAZARD, False), (items.bin, ObjectRole.CONTAINER, True)):
         if cat is None:
             continue
-        asset = select.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng)
-        p = placed_instance(select.Chosen(instance_name(cat, sel.used), cat, role, asset))
+        asset = asset_choice.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng)
+        p = placed_instance(asset_choice.Chosen(instance_name(cat, sel.used), cat, role, asset))
         lay.place_on_floor(p, relevant=True, face=face)
         if role == ObjectRole.HAZARD:
             p.intent = Intent("hazard", mix.SECOND_HAZARD_CLASS, "the judgement mix's second hazard")
@@ -75,8 +69,8 @@ def _on_surface_clear_of_edges(lay: Layout, p: Placed, holder: Placed, edge_gap:
 
 
 def _chosen(sel: Selection, category: str, rng) -> Placed:
-    asset = select.pick_asset(category, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng)
-    return placed_instance(select.Chosen(instance_name(category, sel.used), category, ObjectRole.CLUTTER, asset))
+    asset = asset_choice.pick_asset(category, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng)
+    return placed_instance(asset_choice.Chosen(instance_name(category, sel.used), category, ObjectRole.CLUTTER, asset))
 
 
 def _place_state_near_miss(sel: Selection, lay: Layout, placed: dict[str, Placed], surfaces: list[Placed],
@@ -84,8 +78,8 @@ def _place_state_near_miss(sel: Selection, lay: Layout, placed: dict[str, Placed
     """An object whose class is about a part's state, on a table top with that part safe: its doors,
     lids and drawers ``AJAR_RAD`` (``AJAR_M``) open, its knobs and switches exactly off."""
     p = _chosen(sel, pick.category, rng)
-    wanted = pick.labels.split("|")
-    parts = [j for j in p.asset.joints if select.kb_label(j.label) in wanted or "*" in wanted]
+    wanted = part_labels.alternatives(pick.labels)
+    parts = [j for j in p.asset.joints if part_labels.canonical(j.label) in wanted or "*" in wanted]
     if not parts:
         sel.used.discard(p.name)
         return
@@ -98,7 +92,7 @@ def _place_state_near_miss(sel: Selection, lay: Layout, placed: dict[str, Placed
         sel.used.discard(p.name)
         return
     state = "ajar" if pick.ajar else "off"
-    p.intent = Intent("state", pick.hazard_class, f"its {'/'.join(sorted({select.kb_label(j.label) for j in parts}))} {state}")
+    p.intent = Intent("state", pick.hazard_class, f"its {'/'.join(sorted({part_labels.canonical(j.label) for j in parts}))} {state}")
     placed[p.name] = p
 
 
@@ -125,7 +119,7 @@ def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], 
         lo, hi, _ = cavity_world(holder)
         lay.place_in_cavity(hp, holder, (lo, hi))
         for joint in container.asset.joints:  # shut every lid, door and drawer of the container
-            if select.kb_label(joint.label) in ENCLOSING_LABELS:
+            if part_labels.encloses(joint.label):
                 holder.joint_values[joint.name] = float(joint.closed_value)
         holder.sweep = 0.0
         return
@@ -143,7 +137,7 @@ def _latches(kb, catalogue: str) -> bool:
     return LATCHING_PROPERTY in kb.properties_of(catalogue)
 
 
-def _latching_container(sel: Selection, hazard) -> select.Chosen | None:
+def _latching_container(sel: Selection, hazard) -> asset_choice.Chosen | None:
     """A container of a kind that latches (the knowledge base's ``lockable`` objects) the object fits in."""
     for name in sorted(n for n in sel.kb.objects if _latches(sel.kb, n)):
         try:

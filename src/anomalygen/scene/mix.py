@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from anomalygen.rng import item_rng
+from anomalygen.schema import part_labels
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
@@ -55,7 +56,7 @@ AJAR_M = 0.005  # m: a drawer left out by half a centimetre
 
 def near_miss_names(kb, exclude: set[str]) -> list[str]:
     """Catalogue objects that look like a hazard class's object but are safe on a table's middle."""
-    from anomalygen.scene.select import catalogue_names
+    from anomalygen.scene.asset_choice import catalogue_names
 
     out = []
     for name in catalogue_names():
@@ -86,7 +87,7 @@ def edge_threshold(kb, category: str) -> tuple[str, float] | None:
 def state_near_miss_names(kb, exclude: set[str]) -> list[tuple[str, str, str]]:
     """(catalogue name, class, part labels) of hand-sized objects a class flags by a part's state
     (``joint_open``): a kettle's switch, a box's lid. Built with the part safe, they are near-misses."""
-    from anomalygen.scene.select import catalogue_names
+    from anomalygen.scene.asset_choice import catalogue_names
 
     out = []
     names = set(catalogue_names())
@@ -149,7 +150,7 @@ def choose_judgement_items(task_id: str, hazard_class: str, in_scene: set[str], 
         states = state_near_miss_names(kb, in_scene)
         if states and kinds_rng.random() < STATE_NEAR_MISS_SHARE:
             name, hc_id, labels = states[int(kinds_rng.integers(len(states)))]
-            ajar = any(lbl in labels for lbl in ("door", "lid", "drawer", "flap", "window"))
+            ajar = any(part_labels.is_closure(lbl) for lbl in part_labels.alternatives(labels))
             items.state = StatePick(name, hc_id, labels, ajar)
     second = rng.random() < cfg.multi_hazard if cfg.multi_hazard > 0 else False
     if second and not hazard_free and hazard_class != SECOND_HAZARD_CLASS:

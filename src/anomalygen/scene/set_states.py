@@ -28,7 +28,7 @@ from anomalygen.scene.states import (
     _is_on,
     geoms_below,
 )
-from anomalygen.schema import SWITCH_LABELS
+from anomalygen.schema import part_labels
 
 BURNER, BURNER_CONTROL = "burner_", "knob_"  # surface "burner_k" is heated by the control body "knob_k"
 HANDLE_OVERHANG = (0.04, 0.08)  # m the handle's tip reaches past the edge for "handle_out"
@@ -40,7 +40,7 @@ def wanted_states(sel) -> list[tuple[object, str]]:
     """(chosen object, state word) pairs the task asks for: its class's non-negated ``has_state`` /
     ``is_on`` preconditions on the role variables, and ``scenario.states`` by catalogue name."""
     from anomalygen.errors import ItemFailed
-    from anomalygen.scene.select import resolve_name
+    from anomalygen.scene.asset_choice import resolve_name
 
     out = []
     by_var = {"$hazard": sel.hazard_var or sel.hazard, "$target": sel.target, "$container": sel.container,
@@ -62,7 +62,7 @@ def wanted_states(sel) -> list[tuple[object, str]]:
 
 
 def set_initial_states(sel) -> None:
-    """Make the asked-for states true on the chosen objects (``scene/selection.py``), before placement.
+    """Make the asked-for states true on the chosen objects (``scene/casting.py``), before placement.
 
     A water state goes to a basin that can hold water; "on"/"lit" turns one on/off control on (one
     burner of a stove; ``arrange_states`` may move it under what was put on the stove) unless one
@@ -83,7 +83,7 @@ def set_initial_states(sel) -> None:
             if not controls:
                 _add(ch.states, state)
             elif not any(_is_on(ch.joint_values, j) for j in controls):
-                from anomalygen.scene.select import open_value
+                from anomalygen.scene.asset_choice import open_value
 
                 joint = controls[int(sel.rng.integers(len(controls)))]
                 ch.joint_values[joint.name] = open_value(joint, "on", sel.rng)
@@ -169,6 +169,4 @@ def _handle_tip_x(asset) -> float | None:
 
 def switch_joints(asset) -> list:
     """The asset's on/off controls (knobs, switches, taps; a button is a switch)."""
-    from anomalygen.scene.select import kb_label
-
-    return [j for j in asset.joints if kb_label(j.label) in SWITCH_LABELS]
+    return [j for j in asset.joints if part_labels.is_switch(j.label)]

@@ -5,7 +5,7 @@ Why a module of its own: the builder, the compose step and the scene graph must 
 The builder records the states it creates and no joint carries (a basin it filled:
 ``contains_water``; a wet patch: ``wet``) in ``PlacedObject.states``, and draws them (the water in the
 basin, the glow of a burner that is on). The scene graph reports those plus what the simulation
-says now, so a fix shows at once: ``on`` while any on/off control (``SWITCH_LABELS``) is away from off
+says now, so a fix shows at once: ``on`` while any on/off control (a switch part in ``schema.part_labels``) is away from off
 (else ``off``), ``lit`` for a burner or candle that is on, ``running`` for an open tap, ``handle_out``
 for a pan whose handle reaches past the edge of what it stands on, ``face_down`` for an iron lying on
 its soleplate.
@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from anomalygen.schema import SWITCH_LABELS, JointState
+from anomalygen.schema import JointState, part_labels
 
 ON, OFF, LIT, RUNNING = "on", "off", "lit", "running"
 CONTAINS_WATER, WET = "contains_water", "wet"
@@ -102,13 +102,13 @@ def object_states(model, data, obj, joints: list[JointState], support_box=None) 
     on/off reading of its controls, and the pose-based ones. ``support_box`` is the world (lo, hi)
     of the surface geom it rests on, if any."""
     out = list(obj.states)
-    controls = [j for j in joints if j.label in SWITCH_LABELS]
+    controls = [j for j in joints if part_labels.is_switch(j.label)]
     if controls:
         on = [j for j in controls if not j.is_closed()]
         _add(out, ON if on else OFF)
         if on and obj.asset.category in LIT_WHEN_ON:
             _add(out, LIT)
-        if any(j.label == "tap" for j in on):
+        if any(part_labels.canonical(j.label) == part_labels.TAP for j in on):
             _add(out, RUNNING)
     body = model.body(obj.name)
     if obj.asset.category in FACE_DOWN_CATEGORIES and data.xmat[body.id][8] > UPRIGHT_COS:

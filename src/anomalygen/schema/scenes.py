@@ -1,8 +1,7 @@
 """Stage 2 (build): the scene, its hidden answer key (truth.json) and the scene graph detection sees.
 
-The closure concepts (which joint labels shut something, when a joint counts as closed, how high a
-child reaches) are defined once here, for the builder, the scene graph, the predicates, the planners
-and the skills.
+What each joint label means (closure, enclosing, switch) and when a joint counts as closed or off
+is the table in ``part_labels.py``; ``JointState`` asks it. How high a child reaches is defined here.
 """
 
 from __future__ import annotations
@@ -11,7 +10,9 @@ from typing import Any, Literal
 
 from pydantic import Field
 
+import anomalygen.schema.part_labels as part_labels
 from anomalygen.schema.base import Artefact, Quat, Strict, Vec3
+from anomalygen.schema.part_labels import CLOSED_TOL
 from anomalygen.schema.vocabulary import AssetSource, ObjectRole, PredicateCall
 
 
@@ -26,15 +27,6 @@ class AssetRef(Artefact):
     path: str | None = Field(None, description="file path for imported assets")
 
 
-# One definition of the closure concepts, shared by the scene builder, the scene graph, the
-# predicates, the planners and the skills.
-GATE_LABELS = ("gate",)  # a safety gate: a closure that bars a way, holding nothing behind it
-CLOSURE_LABELS = ("door", "drawer", "lid", "window", "sash", *GATE_LABELS)  # joint labels of parts that shut something
-ENCLOSING_LABELS = ("door", "drawer", "lid")  # closures behind which an object is out of reach
-SWINGING_CLOSURES = ("door", "lid", "window", "sash", *GATE_LABELS)  # closures on a hinge: they sweep out when open
-# on/off controls: a joint with one of these labels is "on" when it is away from its closed (off) value
-SWITCH_LABELS = ("knob", "switch", "button", "dial", "tap")
-CLOSED_TOL = 0.05  # open fraction at or below which a joint counts as closed (``joint_closed``'s default)
 CHILD_REACH = 1.0  # m: the highest a small child reaches (``child_reachable``, the detectors' checks)
 # Property of a container whose shut door or lid latches (a safe's lock, a medicine cabinet's catch). The
 # simulator models no latch mechanism, so the knowledge base declares it per object; only a shut
@@ -70,12 +62,21 @@ class JointState(Artefact):
 
     @property
     def encloses(self) -> bool:
-        """A door, drawer or lid: shut, what is behind it is out of reach."""
-        return any(lbl in self.label for lbl in ENCLOSING_LABELS)
+        """A door, drawer, lid or flap: shut, what is behind it is out of reach."""
+        return part_labels.encloses(self.label)
+
+    @property
+    def is_switch(self) -> bool:
+        """An on/off control: its closed value is off."""
+        return part_labels.is_switch(self.label)
 
     def is_closed(self, tol: float = CLOSED_TOL, value: float | None = None) -> bool:
         """At most ``tol`` of its travel away from closed (at ``value`` if given, else its own)."""
         return self.open_fraction_at(self.value if value is None else value) <= tol
+
+    def is_off(self, tol: float = CLOSED_TOL, value: float | None = None) -> bool:
+        """A switch's word for closed: at most ``tol`` of its travel from off, its closed value."""
+        return self.is_closed(tol, value)
 
 
 class PlacedCavity(Strict):

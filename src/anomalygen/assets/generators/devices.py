@@ -28,6 +28,7 @@ from anomalygen.assets.generators.parts_lib import glow, knob, push_switch
 from anomalygen.assets.model import Draft
 from anomalygen.assets.parts import Part
 from anomalygen.assets.registry import register
+from anomalygen.schema import DIAL, SWITCH
 
 SWITCH_RED = (0.85, 0.1, 0.1, 1)
 
@@ -45,7 +46,7 @@ def space_heater(rng):
     for i in range(6):  # grille bars (decoration)
         z = gz0 + (gz1 - gz0) * (i + 0.5) / 6
         r.box((hx * 0.8, 0.002, 0.004), (0, -hy - 0.002, z), DARK, D_METAL, collide=False)
-    glow(r, "dial", "box", (hx * 0.75, 0.001, (gz1 - gz0) / 2), (0, -hy - 0.0005, (gz0 + gz1) / 2))
+    glow(r, DIAL, "box", (hx * 0.75, 0.001, (gz1 - gz0) / 2), (0, -hy - 0.0005, (gz0 + gz1) / 2))
     knob(r, "dial", (hx * 0.5, -hy, h * 0.86), 0.018, DARK)
     return Draft(r, {"height": h}, [], [], [colour_name(c), "front grille", "thermostat dial", "hot when on"],
                  front_access=True)
@@ -65,7 +66,7 @@ def power_strip(rng):
     lead = u(rng, 0.08, 0.15)
     r.segment((-hx, 0, 0.004), (-hx - lead, 0.01, 0.004), 0.004, DARK, 1200, kind="cylinder")
     push_switch(r, "switch", (hx - 0.025, 0, 2 * hz + 0.002), (0.008, 0.012, 0.004), SWITCH_RED)
-    glow(r, "switch", "box", (0.005, 0.008, 0.0008), (hx - 0.045, 0, 2 * hz + 0.0008))
+    glow(r, SWITCH, "box", (0.005, 0.008, 0.0008), (hx - 0.045, 0, 2 * hz + 0.0008))
     return Draft(r, {"sockets": n}, [], [], [colour_name(c), f"{n} sockets", "on/off switch", "power lead"])
 
 

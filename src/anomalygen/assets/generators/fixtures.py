@@ -31,6 +31,7 @@ from anomalygen.assets.generators.parts_lib import glow, knob, tap_lever
 from anomalygen.assets.model import Cavity, Draft, Surface
 from anomalygen.assets.parts import Part, axis_angle
 from anomalygen.assets.registry import register
+from anomalygen.schema import GATE
 
 WATER = (0.25, 0.5, 0.9, 0.0)  # hidden until the builder fills the basin (``scene/states.py``)
 WATER_FILL = 0.7  # of a basin's depth
@@ -286,7 +287,7 @@ def baby_gate(rng):
     r.box((hx, p, 0.008), (0, 0, 0.008), c, D_WOOD)  # threshold bar
     x0, x1 = -hx + 2 * p, hx - 2 * p
     gate = r.child("gate", (x0, 0, 0))
-    gate.hinge("gate_hinge", (0, 0, 1), (-1.7, 0), "gate", 0.0)
+    gate.hinge("gate_hinge", (0, 0, 1), (-1.7, 0), GATE, 0.0)
     w = x1 - x0 - 0.006
     for z in (0.04, h - 0.04):
         gate.box((w / 2, 0.012, 0.015), (w / 2, 0, z), c, D_WOOD)

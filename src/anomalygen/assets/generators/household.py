@@ -35,6 +35,7 @@ from anomalygen.assets.generators.parts_lib import glow, push_switch
 from anomalygen.assets.model import Cavity, Draft, Surface
 from anomalygen.assets.parts import Part, axis_angle
 from anomalygen.assets.registry import register
+from anomalygen.schema import DOOR, LID, SWITCH
 
 
 def _d(root, features=(), **params):
@@ -658,7 +659,7 @@ def candle(rng):
     glow(r, "snuffer", "ellipsoid", (0.004, 0.004, 0.007), (0, 0, h + 0.01))
     # down, the bell fills the lit candle's old box (flame top h + 0.025), so the candle keeps its size
     cap = r.child("snuffer", (0, 0, h))
-    cap.slide("snuffer_press", (0, 0, 1), (0, SNUFFER_TRAVEL), "switch", 0.0, hold=True)
+    cap.slide("snuffer_press", (0, 0, 1), (0, SNUFFER_TRAVEL), SWITCH, 0.0, hold=True)
     cap.cyl(rad * 0.9, 0.0125, (0, 0, 0.0125), (0.75, 0.6, 0.3, 1), 1200)
     cap.cyl(0.0015, 0.02, (0, rad * 0.8, -0.02), (0.75, 0.6, 0.3, 1), 1, collide=False)  # its guide pin
     return _d(r, ["bell snuffer", colour_name(c)], height=h)
@@ -679,7 +680,7 @@ def iron(rng):
     xs = L * 0.75
     top = 0.03 + 0.035 * float(np.sqrt(max(0.0, 1.0 - ((xs - 0.02) / (L * 0.95)) ** 2)))
     push_switch(r, "switch", (xs, 0, top - 0.001), (0.008, 0.008, 0.004), DARK)
-    glow(r, "switch", "sphere", (0.004,), (L * 0.25, 0, 0.095))  # the heating light
+    glow(r, SWITCH, "sphere", (0.004,), (L * 0.25, 0, 0.095))  # the heating light
     return _d(r, [colour_name(c), "hot steel soleplate", "power switch", "power cord"], length=2 * L)
 
 
@@ -882,7 +883,7 @@ def storage_box(rng):
     c = colour(rng, PLASTIC + WOOD[:2])
     open_box(r, hx, hy, hz, t, c, 900)
     lid = r.child("lid", (0, hy, 2 * hz + 0.002))
-    lid.hinge("lid_hinge", (1, 0, 0), (-1.9, 0), "lid", 0.0)
+    lid.hinge("lid_hinge", (1, 0, 0), (-1.9, 0), LID, 0.0)
     # a 6 mm plastic lid: the 12 mm one weighed 1.5 kg and its holding friction tipped the box
     lid.box((hx + 0.004, hy + 0.002, 0.003), (0, -hy, 0.003), c, 900)
     return Draft(
@@ -968,7 +969,7 @@ def medicine_cabinet(rng):
     open_box(r, hx, hy, hz, t, c, D_WOOD, top=True, front=False)
     r.box((hx - t, hy - t, t / 2), (0, 0, hz), c, D_WOOD)  # shelf
     door = r.child("door", (-hx, -hy - 0.003, hz))
-    door.hinge("door_hinge", (0, 0, 1), (-2.0, 0), "door", 0.0)
+    door.hinge("door_hinge", (0, 0, 1), (-2.0, 0), DOOR, 0.0)
     door.box((hx - 0.002, 0.006, hz - 0.002), (hx, -0.003, 0), c, D_WOOD)
     door.box((hx * 0.8, 0.001, hz * 0.8), (hx, -0.0095, 0), (0.8, 0.88, 0.92, 1), D_GLASS, collide=False)
     door.box((0.006, 0.01, 0.03), (2 * hx - 0.03, -0.018, 0), METAL[0], D_METAL)

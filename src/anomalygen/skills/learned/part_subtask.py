@@ -54,7 +54,7 @@ def is_switch_off(ep: Episode, st: SubTask) -> bool:
         return True
     js = _joint_state(ep, str(st.params.get("joint", "")))
     target = st.params.get("target")
-    return js is not None and js.label in ("knob", "switch") and (
+    return js is not None and js.is_switch and (
         target is None or abs(float(target) - js.closed_value) < 1e-6)
 
 

@@ -106,28 +106,28 @@ def spec_to_code(spec: RewardSpec) -> str:
         "    total = 0.0",
     ]
     for t in spec.terms:
-        w, s = repr(float(t.weight)), repr(float(t.scale))
-        if t.kind == "distance":
-            other = repr(t.b) if t.b is not None else f"np.array({list(t.target)!r})"
-            b = f"pos(state, {other})" if t.b is not None else other
-            lines.append(f"    total = total + {w} * (-{s} * np.norm(pos(state, {t.a!r}) - {b}))")
-        elif t.kind == "joint":
-            lines.append(f"    total = total + {w} * (-{s} * abs(state['joints'][{(t.joint or t.a)!r}] - {float(t.target)!r}))")
-        elif t.kind == "inside":
-            lines += [
-                f"    lo, hi = box(state, {t.b!r})",
-                f"    p = pos(state, {t.a!r})",
-                "    gap = np.norm(np.maximum(np.maximum(lo - p, p - hi), 0.0))",
-                f"    total = total + {w} * (1.0 if gap == 0.0 else -{s} * gap)",
-            ]
-        elif t.kind == "lifted":
-            lines.append(f"    total = total + {w} * (-{s} * max(0.0, {float(t.target)!r} - pos(state, {t.a!r})[2]))")
-        elif t.kind == "upright":
-            lines += [
-                f"    q = state['objects'][{t.a!r}]['quat']",
-                f"    total = total + {w} * ({s} * (1.0 - 2.0 * (q[1] * q[1] + q[2] * q[2])))",
-            ]
-        elif t.kind == "action_penalty":
-            lines.append(f"    total = total + {w} * (-{s} * float(np.sum(np.square(np.array(state['action'])))))")
+        lines += [f"    {line}" for line in _TERM_CODE[t.kind](t, repr(float(t.scale)))]
+        lines.append(f"    total = total + {float(t.weight)!r} * v")
     lines.append("    return float(total)")
     return "\n".join(lines) + "\n"
+
+
+def _distance_code(t: RewardTerm, s: str) -> list[str]:
+    b = f"pos(state, {t.b!r})" if t.b is not None else f"np.array({list(t.target)!r})"
+    return [f"v = -{s} * np.norm(pos(state, {t.a!r}) - {b})"]
+
+
+def _inside_code(t: RewardTerm, s: str) -> list[str]:
+    return [f"lo, hi = box(state, {t.b!r})", f"p = pos(state, {t.a!r})",
+            "gap = np.norm(np.maximum(np.maximum(lo - p, p - hi), 0.0))", f"v = 1.0 if gap == 0.0 else -{s} * gap"]
+
+
+# Per term kind, the sandbox lines that set ``v`` to the term's value (``term_value`` in code).
+_TERM_CODE = {
+    "distance": _distance_code,
+    "joint": lambda t, s: [f"v = -{s} * abs(state['joints'][{(t.joint or t.a)!r}] - {float(t.target)!r})"],
+    "inside": _inside_code,
+    "lifted": lambda t, s: [f"v = -{s} * max(0.0, {float(t.target)!r} - pos(state, {t.a!r})[2])"],
+    "upright": lambda t, s: [f"q = state['objects'][{t.a!r}]['quat']", f"v = {s} * (1.0 - 2.0 * (q[1] * q[1] + q[2] * q[2]))"],
+    "action_penalty": lambda t, s: [f"v = -{s} * float(np.sum(np.square(np.array(state['action']))))"],
+}

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from anomalygen.schema import CLOSED_TOL, Plan, SubTask
+from anomalygen.schema import CLOSED_TOL, Plan, SubTask, part_labels
 from anomalygen.skills.registry import ANY, Skill, SkillOutcome, register
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -69,7 +69,7 @@ def retarget_joints(ep: Episode, st: SubTask) -> tuple[SubTask, str]:
     labels = {str(st.params["part"])} if st.params.get("part") else set()
     for call in st.success.predicates:
         if "label" in call.args:
-            labels |= {v.strip() for v in str(call.args["label"]).split("|")}
+            labels |= set(part_labels.alternatives(str(call.args["label"])))
 
     def gap(js) -> float:
         return js.open_fraction_at(float(drv.data.joint(js.name).qpos[0]))

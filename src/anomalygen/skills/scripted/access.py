@@ -10,12 +10,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from anomalygen.schema import DOOR, DRAWER, ENCLOSING_LABELS, LID_LABELS
 from anomalygen.skills.episode import Episode
 from anomalygen.skills.geometry import HINGE, static_box
 from anomalygen.skills.registry import SkillOutcome
 from anomalygen.skills.scripted.parts import _world, actuate_part, grasp_candidates
 
-LIDS = ("lid", "flap")
+LIDS = LID_LABELS
 OPEN_FRACTION = 0.85  # how far a lid, flap or drawer is opened to put something in
 
 
@@ -95,11 +96,11 @@ def holding_closure(ep: Episode, obj: str, contents: str):
     drv = ep.driver
     lo_c, hi_c = drv.aabb(contents)
     c = (lo_c + hi_c) / 2
-    for js in closure_joints(ep, obj, ["door"]):
+    for js in closure_joints(ep, obj, [DOOR]):
         lo, hi, out = _compartment_when_shut(ep, obj, js)
         if np.all(c >= lo - 0.03) and np.all(c <= hi + 0.03):
             return js, (lo, hi, out)
-    for js in closure_joints(ep, obj, ["drawer"]):
+    for js in closure_joints(ep, obj, [DRAWER]):
         lo, hi = drv.aabb(drv.joint_body(js.name))
         if np.all(c[:2] >= lo[:2]) and np.all(c[:2] <= hi[:2]) and lo[2] <= c[2] <= hi[2] + 0.05:
             return js, None
@@ -137,14 +138,14 @@ def open_for_access(ep: Episode, obj: str, labels, contents: str | None = None):
     else:
         chosen = closure_joints(ep, obj, [lab for lab in labels if lab in LIDS])
     if not chosen:
-        drawer = best_drawer(ep, obj, closure_joints(ep, obj, ["drawer"]))
+        drawer = best_drawer(ep, obj, closure_joints(ep, obj, [DRAWER]))
         chosen = [drawer] if drawer is not None else []
     if not chosen and obj in ep.memory.compartments:
         # a second attempt on a door left part open: the door and its compartment were chosen and
         # measured (shut) the first time; now it is open, best_door would not know it any more
-        chosen = [js for js in closure_joints(ep, obj, ["door"]) if js.name in ep.memory.opened.get(obj, [])]
+        chosen = [js for js in closure_joints(ep, obj, [DOOR]) if js.name in ep.memory.opened.get(obj, [])]
     if not chosen:
-        door = best_door(ep, obj, closure_joints(ep, obj, ["door"]))
+        door = best_door(ep, obj, closure_joints(ep, obj, [DOOR]))
         if door is None:
             return SkillOutcome(False, 0, f"{obj} has no lid, flap, drawer or door with a reachable "
                                              "compartment behind it")
@@ -255,4 +256,4 @@ def close_opened(ep: Episode, obj: str, *, every: bool = False):
     return SkillOutcome(ok, drv.steps - s0, "; ".join(details) or f"nothing of {obj} left open")
 
 
-CLOSURES_ALL = ("lid", "flap", "drawer", "door")
+CLOSURES_ALL = ENCLOSING_LABELS

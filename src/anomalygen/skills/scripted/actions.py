@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from anomalygen.schema import SubTask
+from anomalygen.schema import DOOR, LID, LID_LABELS, SubTask, part_labels
 from anomalygen.skills import geometry
 from anomalygen.skills.registry import Skill, SkillOutcome, register
 from anomalygen.skills.scripted import access, primitives, push, relocate, transfer
@@ -79,7 +79,7 @@ class Place(Skill):
             or subtask.primitive == "place_inside"
         res = primitives.move_to(episode, obj, region, release_after=bool(prm.get("release", True)), into=into)
         opened = episode.memory.opened
-        shut = [lab for lab in closed_parts(episode, region) if lab != "door" or not opened.get(region)]
+        shut = [lab for lab in closed_parts(episode, region) if lab != DOOR or not opened.get(region)]
         if shut and into and not opened.get(region):  # say why an 'inside' will fail
             res.detail += f"; {region}'s {', '.join(shut)} closed and the plan did not open it"
         return res
@@ -110,7 +110,7 @@ class Lid(Skill):
 
     def run(self, episode: Episode, subtask: SubTask) -> SkillOutcome:
         prm = dict(subtask.params)
-        prm.setdefault("part", "lid|flap")
+        prm.setdefault("part", part_labels.any_of(LID_LABELS))
         motion = "push" if subtask.primitive == "close_lid" else "pull"
         return drive_joints(episode, subtask, _object(episode, subtask), motion, prm)
 
@@ -124,7 +124,7 @@ class PushPull(Skill):
         prm, obj = dict(subtask.params), _object(episode, subtask)
         if prm.get("access"):
             if subtask.primitive == "pull":
-                return access.open_for_access(episode, obj, str(prm.get("part", "lid")).split("|"), prm.get("contents"))
+                return access.open_for_access(episode, obj, part_labels.alternatives(str(prm.get("part", LID))), prm.get("contents"))
             return access.close_opened(episode, obj, every=bool(prm.get("contents")))
         return drive_joints(episode, subtask, obj, subtask.primitive or "", prm)
 

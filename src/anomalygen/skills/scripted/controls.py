@@ -16,13 +16,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from anomalygen.schema import CLOSED_TOL
+from anomalygen.schema import CLOSED_TOL, part_labels
 from anomalygen.skills.registry import SkillOutcome
 
 if TYPE_CHECKING:  # pragma: no cover
     from anomalygen.skills.episode import Episode
 
-CONTROL_LABELS = ("knob", "switch", "button", "dial")  # parts turned or pressed to off by this primitive
+CONTROL_LABELS = (part_labels.KNOB, part_labels.SWITCH, part_labels.BUTTON, part_labels.DIAL)  # turned or pressed to off here
 OFF_TOL = 0.01  # fraction of the travel from off at which the script lets go (the graph's "off" is 5 %)
 HORIZON = 90  # control steps per hold (the reference turns a knob from 90 % on to off in 15-26)
 ATTEMPTS = 2  # holds tried before giving up (a hold can slip off a small knob)

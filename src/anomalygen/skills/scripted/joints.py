@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from anomalygen.schema import CLOSED_TOL, ENCLOSING_LABELS, SubTask
+from anomalygen.schema import CLOSED_TOL, ENCLOSING_LABELS, SubTask, part_labels
 from anomalygen.skills.registry import SkillOutcome
 from anomalygen.skills.scripted.controls import CONTROL_LABELS, switch_off_control
 from anomalygen.skills.scripted.parts import actuate_part
@@ -17,7 +17,7 @@ from anomalygen.skills.scripted.parts import actuate_part
 if TYPE_CHECKING:  # pragma: no cover
     from anomalygen.skills.episode import Episode
 
-ACCESS_LABELS = (*ENCLOSING_LABELS, "flap")  # parts that open a way into a container
+ACCESS_LABELS = ENCLOSING_LABELS  # parts that open a way into a container
 NEARLY_CLOSED_TOL = 0.1  # open fraction under which a part still blocks the way in
 PART_TOL = 0.025  # fraction of its travel within which a door, lid or drawer counts as where it was led
 OPEN_FRACTION = 0.6  # how far an opened part goes unless the recipe says (a window for air: a crack)
@@ -44,7 +44,7 @@ def drive_joints(ep: Episode, st: SubTask, obj: str, prim: str, prm: dict) -> Sk
         if o.name != obj:
             continue
         for js in o.joint_states:
-            if label is not None and js.label not in label.split("|") and js.name != prm.get("joint"):
+            if label is not None and js.label not in part_labels.alternatives(label) and js.name != prm.get("joint"):
                 continue
             lo, hi = js.range
             closed = js.closed_value

@@ -212,6 +212,12 @@ def _accessible(n_w: np.ndarray) -> bool:
     return bool(n_w[2] > -0.5)
 
 
+def _joint_of(m, joint: str) -> tuple[int, int, bool]:
+    """A joint's id, its qpos address and whether it is a hinge (else a slide)."""
+    j = m.joint(joint).id
+    return j, int(m.jnt_qposadr[j]), bool(m.jnt_type[j] == HINGE)
+
+
 def actuate_part(ep: Episode, joint: str, goal: float, *, closed: float, tol: float = 0.02, attempts: int = 4,
                  max_steps: int = 900, max_drag: float = MAX_DRAG):
     """Hold the part by suction and lead it to ``goal``; re-grasp when it stops following."""
@@ -219,9 +225,7 @@ def actuate_part(ep: Episode, joint: str, goal: float, *, closed: float, tol: fl
 
     drv = ep.driver
     m, d = drv.model, drv.data
-    j = m.joint(joint).id
-    adr = m.jnt_qposadr[j]
-    hinge = m.jnt_type[j] == HINGE
+    j, adr, hinge = _joint_of(m, joint)
     s0 = drv.steps
     name = m.body(int(m.jnt_bodyid[j])).name
     notes = []
@@ -330,9 +334,7 @@ def _drive(ep: Episode, joint: str, goal: float, *, tol: float, max_steps: int =
 
     drv = ep.driver
     m, d = drv.model, drv.data
-    j = m.joint(joint).id
-    adr = m.jnt_qposadr[j]
-    hinge = m.jnt_type[j] == HINGE
+    j, adr, hinge = _joint_of(m, joint)
     step = 0.03 if hinge else 0.012  # rad or m the reference advances per control step at most
     # How far the reference may run ahead of the part: small first, so a light box is not dragged
     # along by its lid; it grows while the part does not follow (a heavy oven door), up to 4x.

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from anomalygen.schema import DOOR
 from anomalygen.skills.episode import Episode
 from anomalygen.skills.geometry import PRE_CONTACT, grasp_points, rim_z
 from anomalygen.skills.registry import SkillOutcome
@@ -105,7 +106,7 @@ def _swing_door_wide(ep: Episode, container: str) -> None:
     from anomalygen.skills.scripted.parts import actuate_part
 
     drv = ep.driver
-    for js in closure_joints(ep, container, ("door",)):
+    for js in closure_joints(ep, container, (DOOR,)):
         if js.name not in ep.memory.opened.get(container, []) or drv.model.joint(js.name).type[0] != HINGE:
             continue
         lo, hi = js.range

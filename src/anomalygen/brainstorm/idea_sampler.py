@@ -1,9 +1,11 @@
-"""Grounding: turn an agent's interests into a concrete, buildable Idea, and recombine others' ideas.
+"""The offline engine's idea sampler: draw a concrete, buildable Idea from an agent's interests, and
+recombine other agents' ideas.
 
+This is not name grounding. Resolving the loose names an LLM or a person writes into knowledge-base
+names is ``knowledge/grounding.py``, shared by every engine; nothing here reads a name someone wrote.
 Every choice is drawn from the knowledge base (objects that really have the class's properties,
 placements and containers the class allows), so an Idea is valid by construction: its objects are
-in the catalogue and its hazard's preconditions can be set up by the scene builder. (Resolving the
-loose names an LLM or a person writes is ``knowledge/grounding.py``, shared by every engine.)
+in the catalogue and its hazard's preconditions can be set up by the scene builder.
 """
 
 from __future__ import annotations
@@ -63,7 +65,7 @@ def secondary_variables(hc: HazardClass) -> list[str]:
     return [v for v in hc.variable_names() if v != hc.hazard_variable]
 
 
-class Grounder:
+class IdeaSampler:
     """Makes ideas for one agent (a role, or None for the plain, role-less generator)."""
 
     def __init__(self, kb: KnowledgeBase, role: RoleProfile | None, *, targets: list[str] | None = None, rich: bool = True):
@@ -128,9 +130,9 @@ class Grounder:
     def fresh(self, rng: np.random.Generator, *, agent: str | None, agent_index: int, round_: int) -> Idea:
         target = self.pick_target(rng)
         hc = self.pick_class(rng, target)
-        return self.ground(rng, hc, target, agent=agent, agent_index=agent_index, round_=round_)
+        return self.idea_for(rng, hc, target, agent=agent, agent_index=agent_index, round_=round_)
 
-    def ground(
+    def idea_for(
         self,
         rng: np.random.Generator,
         hc: HazardClass,
@@ -236,7 +238,7 @@ class Grounder:
             hc = kb.hazard_classes[mech.class_id]
             targets = [t for t in class_targets(kb, hc) if t in self.targets] or class_targets(kb, hc)
             target = weighted(rng, targets, self._w("object", targets))
-            idea = self.ground(rng, hc, target, agent=agent, agent_index=agent_index, round_=round_, avoid_hazard=mech.hazard)
+            idea = self.idea_for(rng, hc, target, agent=agent, agent_index=agent_index, round_=round_, avoid_hazard=mech.hazard)
         else:
             idea = self.fresh(rng, agent=agent, agent_index=agent_index, round_=round_)
         hc = kb.hazard_classes[idea.class_id]

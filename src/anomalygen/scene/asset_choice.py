@@ -1,4 +1,5 @@
-"""Asset selection and configuration: which catalogue assets a scene uses, how big, in which state.
+"""The choice of one asset: which catalogue entry a name means, which generated variant, how big, in
+which state. (Which objects a scene holds and the role each plays is ``casting.py``.)
 
 The paper has an LLM name objects, retrieves assets by Sentence-BERT and asks a VLM whether they fit.
 Offline we do the same with the knowledge base: target candidates are generated variants of the
@@ -18,7 +19,7 @@ from functools import lru_cache
 import numpy as np
 
 from anomalygen.errors import ItemFailed
-from anomalygen.schema import ArticulationUse, ObjectRole, TaskProposal
+from anomalygen.schema import SWITCH_LABELS, ArticulationUse, ObjectRole, TaskProposal, part_labels
 
 TARGET_CANDIDATES = 3  # generated variants ranked per target
 FIXED_SIZE = 0.55  # m: assets at least this big are furniture (welded), smaller ones are loose
@@ -65,20 +66,16 @@ _ALWAYS_FIXED = {
 
 
 @lru_cache(maxsize=1)
-def _catalogue() -> tuple[str, ...]:
+def catalogue_names() -> tuple[str, ...]:
+    """Every catalogue name the builder can instantiate."""
     from anomalygen.assets.core import available_names
 
     return tuple(available_names())
 
 
-def catalogue_names() -> tuple[str, ...]:
-    """Every catalogue name the builder can instantiate."""
-    return _catalogue()
-
-
 def resolve_name(name: str) -> str:
     """A catalogue name for ``name``: itself, a case-insensitive match, or the SBERT nearest entry."""
-    names = _catalogue()
+    names = catalogue_names()
     if name in names:
         return name
     lowered = {n.lower(): n for n in names}
@@ -169,22 +166,13 @@ def plausibility_problem(
     return None
 
 
-# Asset joint labels -> the knowledge base's vocabulary (what predicates such as
-# ``joint_open(label="window")`` look for). A kettle's on-button is its switch; a window's sash is
-# the window; a dial is a knob.
-LABEL_ALIASES = {"sash": "window", "button": "switch", "dial": "knob"}
-
-
-def kb_label(label: str) -> str:
-    return LABEL_ALIASES.get(label, label)
-
-
 def joints_with_label(asset, label: str) -> list:
-    """Joints whose (KB-normalised) label is one of ``label``'s alternatives ('door|drawer')."""
-    wanted = {kb_label(x.strip()) for x in label.split("|") if x.strip()}
-    if "knob" in wanted or "switch" in wanted:
-        wanted |= {"knob", "switch"}
-    return [j for j in asset.joints if kb_label(j.label) in wanted]
+    """Joints whose (KB-normalised) label is one of ``label``'s alternatives ('door|drawer'); any
+    on/off control stands for another (the knowledge base says knob where an asset has a switch)."""
+    wanted = {part_labels.canonical(x) for x in part_labels.alternatives(label)}
+    if any(part_labels.is_switch(x) for x in wanted):
+        wanted |= set(SWITCH_LABELS)
+    return [j for j in asset.joints if part_labels.canonical(j.label) in wanted]
 
 
 def pick_asset(
@@ -240,7 +228,7 @@ def open_value(joint, state: str, rng: np.random.Generator) -> float:
     far = far_end(joint)
     span = abs(far - closed)
     sign = 1.0 if far >= closed else -1.0
-    if state == "on" or joint.label in ("knob", "switch", "button"):
+    if state == "on" or part_labels.is_switch(joint.label):
         frac = rng.uniform(0.7, 0.95)
         return float(closed + sign * frac * span)
     if joint.type == "hinge":
@@ -258,9 +246,10 @@ def set_articulations(chosen: Chosen, uses: list[tuple[str, str]], rng: np.rando
         joints = joints_with_label(chosen.asset, label)
         if state in ("open", "on") and len(joints) > 1 and "|" in label:
             # 'door|drawer': opening one kind is enough for the hazard; prefer the first alternative found
+            canonical = part_labels.canonical
             first = next(
-                kb_label(x) for x in label.split("|") if any(kb_label(j.label) == kb_label(x) for j in joints)
+                canonical(x) for x in part_labels.alternatives(label) if any(canonical(j.label) == canonical(x) for j in joints)
             )
-            joints = [j for j in joints if kb_label(j.label) == first]
+            joints = [j for j in joints if canonical(j.label) == first]
         for joint in joints:
             chosen.joint_values[joint.name] = open_value(joint, state, rng)

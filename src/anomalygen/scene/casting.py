@@ -1,9 +1,10 @@
-"""Which objects a scene holds and which role each plays, before anything is placed.
+"""Casting the scene: which objects it holds and which role each plays, before anything is placed.
 
 ``select_objects`` chooses an asset for every role the task needs (target, hazard, the object it sits
 in or on, container, ``$support``, co-objects) and who plays ``$hazard``; ``set_initial_joints`` sets the
 joint states that make the hazard real (or safe, for a hazard-free scene); ``bind_roles`` maps the
 class's role variables to instance names once the scene is placed. Clutter names are drawn here too.
+Each asset is chosen, sized and checked in ``asset_choice.py``.
 """
 
 from __future__ import annotations
@@ -14,11 +15,11 @@ import numpy as np
 
 from anomalygen.errors import ItemFailed
 from anomalygen.knowledge import load_kb
-from anomalygen.scene import select
+from anomalygen.scene import asset_choice
 from anomalygen.scene.instances import cavity_cap, container_room, instance_name
 from anomalygen.scene.layout import Placed
 from anomalygen.scene.set_states import set_initial_states
-from anomalygen.schema import ENCLOSING_LABELS, ObjectRole, TaskProposal
+from anomalygen.schema import ObjectRole, TaskProposal, part_labels
 
 MAX_AUX = 3
 CONTAINER_REDRAWS = 4  # other container sizes drawn before a smaller hazard is tried
@@ -48,7 +49,7 @@ def is_dressing(kb, name: str) -> bool:
 
 
 def clutter_names(kb, exclude: set[str], rng, n: int) -> list[str]:
-    names = [name for name in select._catalogue() if name not in exclude and is_dressing(kb, name)]
+    names = [name for name in asset_choice.catalogue_names() if name not in exclude and is_dressing(kb, name)]
     if not names or n <= 0:
         return []
     idx = rng.choice(len(names), size=min(n, len(names)), replace=False)
@@ -66,14 +67,14 @@ class Selection:
     kind: str  # placement kind: floor, walkway, a surface, inside, on
     parent_raw: str | None
     used: set[str] = field(default_factory=set)
-    by_catalogue: dict[str, select.Chosen] = field(default_factory=dict)
-    target: select.Chosen | None = None
-    parent: select.Chosen | None = None
-    hazard: select.Chosen | None = None
-    hazard_var: select.Chosen | None = None  # the object bound to $hazard
-    container: select.Chosen | None = None
-    support_var: select.Chosen | None = None
-    aux: list[select.Chosen] = field(default_factory=list)
+    by_catalogue: dict[str, asset_choice.Chosen] = field(default_factory=dict)
+    target: asset_choice.Chosen | None = None
+    parent: asset_choice.Chosen | None = None
+    hazard: asset_choice.Chosen | None = None
+    hazard_var: asset_choice.Chosen | None = None  # the object bound to $hazard
+    container: asset_choice.Chosen | None = None
+    support_var: asset_choice.Chosen | None = None
+    aux: list[asset_choice.Chosen] = field(default_factory=list)
     hazard_is_target: bool = False
     hints: object | None = None  # scene/hints.py: sizes, positions and auxiliaries from the LLM engine
     hazard_free: bool = False  # build the task's hazard in its safe state (scene/mix.py)
@@ -82,22 +83,22 @@ class Selection:
     def variables(self) -> set[str]:
         return set(self.hc.variables) if self.hc is not None else set()
 
-    def choose(self, raw: str, role: ObjectRole, *, cap=None, rank=False) -> select.Chosen:
+    def choose(self, raw: str, role: ObjectRole, *, cap=None, rank=False) -> asset_choice.Chosen:
         """The asset for a name (one per catalogue category: a second mention reuses it)."""
-        cat = select.resolve_name(raw)
+        cat = asset_choice.resolve_name(raw)
         if cat in self.by_catalogue:
             return self.by_catalogue[cat]
         want = self.hints.size_for(cat) if self.hints is not None else None
-        asset = select.pick_asset(cat, role=role, kb=self.kb, task=self.task, hc=self.hc, rng=self.rng, cap=cap,
+        asset = asset_choice.pick_asset(cat, role=role, kb=self.kb, task=self.task, hc=self.hc, rng=self.rng, cap=cap,
                                   rank=rank, size=want)
         if want is not None and abs(asset.size - want) > 1e-3:
             self.hints.note(f"size:{cat}", f"size {want:.3f} m does not fit the generator's range or the space "
                             f"available; built at {asset.size:.3f} m", value=want, limit=round(float(asset.size), 4))
-        ch = select.Chosen(instance_name(cat, self.used), cat, role, asset)
+        ch = asset_choice.Chosen(instance_name(cat, self.used), cat, role, asset)
         self.by_catalogue[cat] = ch
         return ch
 
-    def forget(self, ch: select.Chosen) -> None:
+    def forget(self, ch: asset_choice.Chosen) -> None:
         """Drop a choice so the next ``choose`` of its category draws again."""
         self.by_catalogue.pop(ch.catalogue, None)
         self.used.discard(ch.name)
@@ -113,7 +114,7 @@ def select_objects(task: TaskProposal, rng, hints=None) -> Selection:
     kind, parent_raw = _parse_placement(sc.placement)
     sel = Selection(task, rng, kb, kb.hazard_classes.get(task.hazard_class), kind, parent_raw, hints=hints)
     hc, variables = sel.hc, sel.variables
-    sel.hazard_is_target = select.resolve_name(sc.hazard_object) == select.resolve_name(task.target_asset)
+    sel.hazard_is_target = asset_choice.resolve_name(sc.hazard_object) == asset_choice.resolve_name(task.target_asset)
     # Big things first: they bound what fits in/on them.
     target = sel.target = sel.choose(
         task.target_asset, ObjectRole.HAZARD if sel.hazard_is_target else ObjectRole.TARGET, rank=True
@@ -143,12 +144,18 @@ def select_objects(task: TaskProposal, rng, hints=None) -> Selection:
                     break
                 sel.forget(container)
                 container = sel.choose(container_name, ObjectRole.CONTAINER)
-            if hazard.size > container_room(container.asset) and container is not target:
+            # Another kind only when the task left the container open: a named bucket stays a bucket.
+            if hazard.size > container_room(container.asset) and container is not target and not sc.container:
                 container = _roomier_kind(sel, hc, container, container_name, hazard.size)
             room = container_room(container.asset)
             if hazard.size > room and hazard is not target:
                 sel.forget(hazard)
-                hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=min(cap or room, room))
+                try:
+                    hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=min(cap or room, room))
+                except ItemFailed as exc:
+                    others = [c for c in hc.default_containers if c != container_name]
+                    raise ItemFailed(f"{exc}: the task names the {container_name}"
+                                     + (f" (the class also stores it in: {', '.join(others)})" if others else "")) from exc
             if hazard.size > room:
                 raise ItemFailed(f"{hazard.catalogue} ({hazard.size:.2f} m) does not fit {container.catalogue} "
                                  f"(room for {room:.2f} m)")
@@ -163,7 +170,7 @@ def select_objects(task: TaskProposal, rng, hints=None) -> Selection:
         if len(sel.aux) >= MAX_AUX:
             break
         try:
-            cat = select.resolve_name(raw)
+            cat = asset_choice.resolve_name(raw)
         except ItemFailed:
             continue  # an unknown co-object is decoration, not the hazard: leave it out
         if cat in sel.by_catalogue:
@@ -187,21 +194,21 @@ def bind_hazard(sel: Selection) -> None:
         target.role = ObjectRole.TARGET
 
 
-def _open_as_the_fix_would(chosen: select.Chosen, label: str, hc) -> None:
+def _open_as_the_fix_would(chosen: asset_choice.Chosen, label: str, hc) -> None:
     """A part the fix opens only part way (a window opened a crack for air) is built that way in a
     hazard-free scene: wide open it would be another class's hazard."""
     step = next((st for st in hc.recipe if st.action == "open_joint" and st.args.get("fraction")), None)
     if step is None:
         return
     fraction = float(step.args["fraction"])
-    for joint in select.joints_with_label(chosen.asset, label):
+    for joint in asset_choice.joints_with_label(chosen.asset, label):
         closed = joint.closed_value
-        chosen.joint_values[joint.name] = float(closed + fraction * (select.far_end(joint) - closed))
+        chosen.joint_values[joint.name] = float(closed + fraction * (asset_choice.far_end(joint) - closed))
 
 
 def _roomier_kind(sel: Selection, hc, container, name: str, size: float):
-    """Another of the class's usual containers that the hazard fits (a plastic bag too big for any
-    bucket goes to the trash can), or the container as it was."""
+    """Another of the class's usual containers that the hazard fits, or the container as it was. Only
+    for a task that named no container (the class's first default did not fit)."""
     for alt in hc.default_containers:
         if alt == name:
             continue
@@ -224,7 +231,7 @@ def set_initial_joints(sel: Selection) -> None:
     uses: dict[str, list[tuple[str, str]]] = {}
     for a in task.articulations:
         try:
-            uses.setdefault(select.resolve_name(a.object), []).append((a.part, a.initial_state))
+            uses.setdefault(asset_choice.resolve_name(a.object), []).append((a.part, a.initial_state))
         except ItemFailed:
             continue
     class_part = None  # the part whose state is the class's hazard (a window left shut, a door left open)
@@ -238,7 +245,7 @@ def set_initial_joints(sel: Selection) -> None:
     if sel.kind == "inside" and parent is not None:
         cav = max(parent.asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
         if cav.joint is not None and not any(
-            p in ENCLOSING_LABELS and s == "closed" for p, s in uses.get(parent.catalogue, [])
+            part_labels.encloses(p) and s == "closed" for p, s in uses.get(parent.catalogue, [])
         ):
             label = parent.asset.joint(cav.joint).label
             uses.setdefault(parent.catalogue, []).append((label, "open"))
@@ -247,7 +254,7 @@ def set_initial_joints(sel: Selection) -> None:
                 for cat, pairs in uses.items()}
     for cat, pairs in uses.items():
         if cat in sel.by_catalogue:
-            select.set_articulations(sel.by_catalogue[cat], pairs, sel.rng)
+            asset_choice.set_articulations(sel.by_catalogue[cat], pairs, sel.rng)
     if sel.hazard_free and class_part is not None and class_part[0] in sel.by_catalogue:
         _open_as_the_fix_would(sel.by_catalogue[class_part[0]], class_part[1], hc)
     if not sel.hazard_free:
@@ -272,7 +279,7 @@ def bind_roles(sel: Selection, support: Placed | None) -> dict[str, str]:
     return bindings
 
 
-def _co_object_for(hc, kb, candidates) -> select.Chosen | None:
+def _co_object_for(hc, kb, candidates) -> asset_choice.Chosen | None:
     """The first candidate whose KB properties satisfy every has_property precondition on $hazard."""
     calls = [c for c in hc.preconditions if c.name == "has_property" and c.args.get("object") == "$hazard"]
     for ch in candidates:
@@ -290,7 +297,7 @@ def _co_object_for(hc, kb, candidates) -> select.Chosen | None:
 def _first_known(names: list[str]) -> str | None:
     for n in names:
         try:
-            return select.resolve_name(n)
+            return asset_choice.resolve_name(n)
         except ItemFailed:
             continue
     return None
@@ -304,5 +311,5 @@ def _check_articulations(task, hc, by_catalogue, target) -> None:
     if ch is None:
         return
     part = hc.articulation.part
-    if not select.joints_with_label(ch.asset, part):
+    if not asset_choice.joints_with_label(ch.asset, part):
         raise ItemFailed(f"{ch.catalogue} has no '{part}' joint for a {hc.id} scene")
