@@ -26,7 +26,8 @@ FORBIDDEN = ("anomalygen.referee", "anomalygen.evaluate", "anomalygen.brainstorm
              "anomalygen.scene.build", "anomalygen.scene.stage", "anomalygen.scene.casting",
              "anomalygen.scene.asset_choice", "anomalygen.scene.placement", "anomalygen.scene.instances",
              "anomalygen.scene.judgement", "anomalygen.scene.mix", "anomalygen.scene.llm_engine",
-             "anomalygen.scene.hints", "anomalygen.scene.validate", "anomalygen.scene.verify")
+             "anomalygen.scene.hints", "anomalygen.scene.validate", "anomalygen.scene.verify",
+             "anomalygen.scene.set_states")
 
 
 def _module_graph() -> dict[str, set[str]]:

@@ -135,7 +135,7 @@ def test_the_table_answers_for_labels_aliases_and_imported_compounds():
     assert not pl.encloses("slide")  # a substring is not a label (the old check found "lid" in it)
     assert pl.any_of(pl.LID_LABELS) == "lid|flap" and pl.alternatives(" lid| flap ") == ["lid", "flap"]
     assert pl.ENCLOSING_LABELS == ("lid", "flap", "drawer", "door")  # the order plans list them in
-    assert set(pl.CLOSURE_LABELS) == {"lid", "flap", "drawer", "door", "window", "sash"}
+    assert set(pl.CLOSURE_LABELS) == {"lid", "flap", "drawer", "door", "window", "sash", "gate"}
 
 
 @pytest.mark.parametrize(("label", "value", "off"), [("knob", 0.0, True), ("knob", 0.1, False), ("switch", 0.05, True)])

@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from anomalygen.assets import catalogue as catalogue_fn
+from anomalygen.assets import household_names
 from anomalygen.assets.retrieval import catalogue, catalogue_hash, embeddings, retrieve
 
 
@@ -19,7 +20,7 @@ def cache(tmp_path, monkeypatch):
 
 def test_catalogue_lists_every_name_in_variants():
     entries = catalogue_fn(2)
-    assert len(entries) == 2 * 114
+    assert len(entries) == 2 * (44 + len(household_names())) == 2 * 126
     assert {e.seed for e in entries} == {0, 1}
     pill = next(e for e in entries if e.name == "pill")
     assert "choking_size" in pill.properties and "medication" in pill.properties and pill.kind == "household"

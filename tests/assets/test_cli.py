@@ -15,7 +15,7 @@ def test_list_and_show_json():
     res = runner.invoke(app, ["list", "--json"])
     assert res.exit_code == 0
     rows = json.loads(res.stdout)
-    assert len(rows) == 114 and sum(r["kind"] == "target" for r in rows) == 44
+    assert len(rows) == 126 and sum(r["kind"] == "target" for r in rows) == 44
     res = runner.invoke(app, ["show", "Dishwasher", "--seed", "1", "--json"])
     info = json.loads(res.stdout)
     assert {j["label"] for j in info["joints"]} >= {"door", "rack"}

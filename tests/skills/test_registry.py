@@ -13,8 +13,9 @@ from anomalygen.skills import catalogue
 from anomalygen.skills.episode import LearningSettings
 from anomalygen.skills.registry import ANY, Skill, UnknownSkill, lookup, register, registered, skill_for
 
-PRIMITIVE_ACTIONS = {"approach", "close_joint", "close_lid", "grasp", "move_to", "open_joint", "open_lid", "pick",
-                     "place_inside", "place_on", "pull", "push", "push_to", "release", "switch_off", "take_out_of"}
+PRIMITIVE_ACTIONS = {"approach", "close_joint", "close_lid", "grasp", "move_away", "move_to", "open_joint", "open_lid",
+                     "pick", "place_inside", "place_on", "pull", "push", "push_to", "release", "rotate_inward",
+                     "switch_off", "take_off", "take_out_of"}
 
 
 def test_the_catalogue_registers_every_scripted_and_learned_skill():

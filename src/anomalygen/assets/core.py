@@ -18,7 +18,14 @@ from anomalygen.schema import AssetRef, AssetSource
 
 
 def _load_generators() -> None:
-    from anomalygen.assets.generators import appliances, furniture, household, small  # noqa: F401
+    from anomalygen.assets.generators import (  # noqa: F401
+        appliances,
+        devices,
+        fixtures,
+        furniture,
+        household,
+        small,
+    )
 
 
 def generate(name: str, seed: int, size: float | None = None) -> Asset:

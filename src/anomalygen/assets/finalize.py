@@ -22,6 +22,10 @@ def _joint_gains(part: Part, scale: float) -> tuple[float, float]:
     return max(2.0 * eff, 1e-5), max(0.2 * eff, 1e-6)
 
 
+LATCH_FORCE = 2.0  # N that moves a latched slide (a switch's click)
+HARD_SOLREF = [0.004, 1.0]  # s time constant (twice the 2 ms step), damping ratio
+HARD_SOLIMP = [0.999, 0.9999, 0.001, 0.5, 2.0]  # impedance near 1: the constraint hardly yields
+
 _GEOM_TYPES = {
     "box": "mjGEOM_BOX",
     "sphere": "mjGEOM_SPHERE",
@@ -86,6 +90,16 @@ def _emit(mujoco, part: Part, body, scale: float, offset: np.ndarray, joints: li
         )
         if "frictionloss" in extra:
             joint.frictionloss = extra["frictionloss"]
+            if j.type == "slide":
+                # A small slide held by friction (a push switch, a snuffer) is a latch: a weight's
+                # worth of friction let the jolt of a power strip dropped into a basin knock it off;
+                # MuJoCo's default soft friction lets it creep ~5 mm/s under gravity (left on, it
+                # switched itself off while the scene settled), and its soft end stops, scaled by its
+                # few grams, let a cup push it a centimetre through them; near-hard constraints creep
+                # ~0.02 mm/s and stop it (the friction's force is still capped by the frictionloss)
+                joint.frictionloss = max(joint.frictionloss, LATCH_FORCE)
+                joint.solref_friction = joint.solref_limit = HARD_SOLREF
+                joint.solimp_friction = joint.solimp_limit = HARD_SOLIMP
         if "stiffness" in extra:
             cur = joint.stiffness
             joint.stiffness = (
@@ -166,7 +180,7 @@ def finalize(
         for s in draft.surfaces
     ]
     cavities = [
-        Cavity(c.name, tf(c.center), tuple(h * scale for h in c.half_extents), c.opening, c.joint)
+        Cavity(c.name, tf(c.center), tuple(h * scale for h in c.half_extents), c.opening, c.joint, c.open_above)
         for c in draft.cavities
     ]
     ext = (hi - lo) * scale
@@ -187,6 +201,7 @@ def finalize(
         description="",
         params=params,
         features=list(draft.features),
+        front_access=draft.front_access,
     )
     asset.description = describe(name, asset, draft.features)
     return asset

@@ -47,6 +47,9 @@ class Cavity:
     half_extents: tuple[float, float, float]
     opening: str  # top | front
     joint: str | None = None
+    # nothing closes it and what lies in it may rise above the rim (a sink's basin, a crib): its
+    # depth does not bound what fits, only its floor does
+    open_above: bool = False
 
 
 @dataclass
@@ -58,6 +61,7 @@ class Draft:
     surfaces: list[Surface] = field(default_factory=list)
     cavities: list[Cavity] = field(default_factory=list)
     features: list[str] = field(default_factory=list)  # words for the description: "two doors", "red"
+    front_access: bool = False  # reached from its front (-y): a bookcase's shelves, a stove's knobs
 
 
 @dataclass
@@ -77,6 +81,9 @@ class Asset:
     params: dict[str, Any] = field(default_factory=dict)
     path: str | None = None
     features: list[str] = field(default_factory=list)  # the generator's words for this variant
+    # its surfaces or controls are reached from its front (-y) only, so the builder turns that side to
+    # the robot (a bookcase's shelves, a stove's knobs); doors, drawers and cavities imply it already
+    front_access: bool = False
     _keep: list = field(default_factory=list, repr=False)
 
     @property

@@ -35,6 +35,7 @@ class Chosen:
     role: ObjectRole
     asset: object  # anomalygen.assets.model.Asset
     joint_values: dict[str, float] = field(default_factory=dict)  # unprefixed joint -> value
+    states: list[str] = field(default_factory=list)  # instance states the builder sets (scene/states.py)
 
     @property
     def size(self) -> float:

@@ -41,6 +41,7 @@ from anomalygen.scene.instances import renumber_by_position
 from anomalygen.scene.judgement import check_hazard_free
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.placement import place
+from anomalygen.scene.set_states import arrange_states
 from anomalygen.schema import (
     AssetRef,
     AssetSource,
@@ -82,6 +83,7 @@ def _plan(task: TaskProposal, settings: Settings, rng, hints=None,
     sel.hazard_free = hazard_free
     set_initial_joints(sel)
     lay, placed, support = place(sel, settings)
+    arrange_states(sel, lay, placed)
     placed, bindings = renumber_by_position(lay, placed, {} if hazard_free else bind_roles(sel, support))
     return lay, bindings, placed
 
@@ -187,7 +189,7 @@ def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, mo
                 inside=p.inside,
                 joint_states=joints,
                 fixed=p.fixed,
-                states=_states(task, ref.category),
+                states=_states(ref.category, p.states),
                 cavities=cavities,
             )
         )
@@ -202,14 +204,11 @@ def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, mo
     )
 
 
-def _states(task, category: str) -> list[str]:
-    """What an instance shows: its kind's own states (a candle's flame) and those the task asks for
-    that the builder can set up (``scene/capabilities.py``)."""
-    from anomalygen.scene.capabilities import can_show
-
+def _states(category: str, built: list[str]) -> list[str]:
+    """What an instance shows beyond its joints: its kind's own states from the knowledge base and
+    those the builder set up for the task (``scene/set_states.py``: water in a basin, a wet floor)."""
     info = load_kb().objects.get(category)
-    asked = [s for s in task.scenario.states.get(category, []) if can_show(s)]
-    return list(dict.fromkeys([*(info.states if info else []), *asked]))
+    return list(dict.fromkeys([*(info.states if info else []), *built]))
 
 
 def scene_id_for(task_id: str) -> str:

@@ -7,14 +7,17 @@ in the same change, and the brainstorm engine draws it from then on without bein
 
 from __future__ import annotations
 
+from anomalygen.scene.states import KNOWN_STATES
+
 #: Placement kinds ``scene/placement.py`` implements (``inside``/``on``/``near`` take ``:<name>``).
 PLACEMENT_KINDS: tuple[str, ...] = (
     "floor", "walkway", "table", "low_table", "table_edge", "counter", "counter_edge", "shelf", "shelf_edge",
     "inside", "on", "near",
 )
-#: Instance states the builder puts into a scene when a task asks for them (``Scenario.states``).
-#: States an asset always shows (a candle's flame) come from the knowledge base (``ObjectInfo.states``).
-BUILT_STATES: tuple[str, ...] = ()
+#: Instance states the builder puts into a scene when a task or its class asks for them
+#: (``scene/set_states.py``; the words live in ``scene/states.py``). States an asset always shows come
+#: from the knowledge base (``ObjectInfo.states``).
+BUILT_STATES: tuple[str, ...] = KNOWN_STATES
 
 
 def placement_kind(placement: str) -> str:

@@ -18,6 +18,7 @@ from anomalygen.knowledge import load_kb
 from anomalygen.scene import asset_choice
 from anomalygen.scene.instances import cavity_cap, container_room, instance_name
 from anomalygen.scene.layout import Placed
+from anomalygen.scene.set_states import set_initial_states
 from anomalygen.schema import ObjectRole, TaskProposal, part_labels
 
 MAX_AUX = 3
@@ -258,6 +259,7 @@ def set_initial_joints(sel: Selection) -> None:
         _open_as_the_fix_would(sel.by_catalogue[class_part[0]], class_part[1], hc)
     if not sel.hazard_free:
         _check_articulations(task, hc, sel.by_catalogue, sel.target)
+    set_initial_states(sel)
 
 
 def bind_roles(sel: Selection, support: Placed | None) -> dict[str, str]:

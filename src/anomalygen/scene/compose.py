@@ -16,6 +16,7 @@ from anomalygen.scene import furniture, layout
 from anomalygen.scene.graph import FLOOR_GEOM
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.sensors import add_observation_sensors
+from anomalygen.scene.states import geoms_below, show_states
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
@@ -110,6 +111,7 @@ def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rn
             furniture.emit(p.support_geom, body, rng)
             continue
         root = p.asset.attach(body, f"{p.name}/")
+        show_states(root, p)
         if not p.fixed:
             body.add_freejoint(name=f"{p.name}/free")
             loose.append((p.name, root.name))
@@ -120,7 +122,7 @@ def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rn
             # contacts are stiffer than the 20 ms default (priority makes theirs win): with it a
             # needle set down in a box sank past the middle of the 8 mm bottom and was pushed out
             # underneath.
-            for geom in _geoms_below(root):
+            for geom in geoms_below(root):
                 geom.condim = 6
                 geom.friction = [max(geom.friction[0], 0.8), 0.01, 0.002]
                 geom.margin = max(geom.margin, 0.001)
@@ -180,13 +182,6 @@ def _articulated_bodies(body) -> list[str]:
         out.append(body.name)
     for child in body.bodies:
         out.extend(_articulated_bodies(child))
-    return out
-
-
-def _geoms_below(body) -> list:
-    out = list(body.geoms)
-    for child in body.bodies:
-        out.extend(_geoms_below(child))
     return out
 
 

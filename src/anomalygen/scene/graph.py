@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from anomalygen.scene.states import object_states
 from anomalygen.schema import (
     LATCHING_PROPERTY,
     GraphObject,
@@ -350,7 +351,7 @@ def scene_graph(model: mujoco.MjModel, data: mujoco.MjData, spec: SceneSpec) -> 
         inside = containers[i]
         # low inside a bin is not on the floor: only a floor contact says so then (a bin's base is thin)
         on_floor = i not in held and ("floor" in supports[i] or (height < ON_FLOOR_TOL and not inside))
-        edge = None
+        edge = surface = None
         # distance from the object's footprint to the edge of its main support's top (the widest
         # supporting geom; a laptop also touching a mug in the middle of the table is not at an
         # edge), in x/y; negative when the object overhangs.
@@ -359,6 +360,7 @@ def scene_graph(model: mujoco.MjModel, data: mujoco.MjData, spec: SceneSpec) -> 
             geom = max(below, key=lambda g: float(np.prod(geom_hi[g][:2] - geom_lo[g][:2])))
             d = np.minimum(lo[i][:2] - geom_lo[geom][:2], geom_hi[geom][:2] - hi[i][:2])
             edge = float(np.min(d))
+            surface = (geom_lo[geom], geom_hi[geom])
         objects.append(
             GraphObject(
                 name=obj.name,
@@ -371,8 +373,8 @@ def scene_graph(model: mujoco.MjModel, data: mujoco.MjData, spec: SceneSpec) -> 
                 distance_to_edge=edge,
                 child_reachable=within_child_reach(height, bool(latched[i])),
                 joints=joints[i],
-                states=list(obj.states),
                 held=i in held,
+                states=object_states(model, data, obj, joints[i], surface),
             )
         )
         if on_floor:

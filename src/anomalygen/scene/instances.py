@@ -64,8 +64,9 @@ def renumber_by_position(lay: layout.Layout, placed: dict[str, Placed],
 
 
 def _front(asset) -> np.ndarray | None:
-    """Local direction the asset's doors/drawers open to (the catalogue convention is -y)."""
-    if any(part_labels.is_closure(j.label) for j in asset.joints) or asset.cavities:
+    """Local direction the asset's doors/drawers open to (the catalogue convention is -y); an asset
+    reached from its front (a bookcase's shelves, a stove's knobs) faces the robot that way too."""
+    if any(part_labels.is_closure(j.label) for j in asset.joints) or asset.cavities or asset.front_access:
         return np.array([0.0, -1.0])
     return None
 
@@ -120,6 +121,7 @@ def placed_instance(chosen: asset_choice.Chosen) -> Placed:
         fixed=chosen.fixed,
         asset=chosen.asset,
         joint_values=dict(chosen.joint_values),
+        states=list(chosen.states),
         front=_front(chosen.asset),
     )
     p.sweep = _sweep(chosen.asset, chosen.joint_values)
@@ -183,5 +185,9 @@ def container_room(asset) -> float:
 
 
 def cavity_cap(asset) -> float:
+    """Largest thing the biggest cavity takes: a fifth less than its smallest extent, or than its
+    floor's long side when it is open above (a power strip lies flat in a sink, turned to fit)."""
     cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+    if cav.open_above:
+        return 0.8 * 2 * float(max(cav.half_extents[0], cav.half_extents[1]))
     return 0.8 * 2 * float(min(cav.half_extents))

@@ -51,6 +51,7 @@ class Placed:
     asset: object | None = None
     support_geom: Support | None = None
     joint_values: dict[str, float] = field(default_factory=dict)
+    states: list[str] = field(default_factory=list)  # instance states the builder set up (scene/states.py)
     front: np.ndarray | None = None  # local xy unit vector of the side doors/drawers open to
     pos: np.ndarray = field(default_factory=lambda: np.zeros(3))
     yaw: float = 0.0
@@ -96,6 +97,12 @@ def face_robot_yaw(front: np.ndarray | None, target_dir: np.ndarray) -> float:
     if front is None:
         return 0.0
     return math.atan2(target_dir[1], target_dir[0]) - math.atan2(front[1], front[0])
+
+
+def reached_from_front(obj: Placed) -> bool:
+    """A loose thing worked from its front (a space heater's dial): the builder turns that side to the
+    open floor where it can, as it turns furniture to the robot."""
+    return obj.front is not None and obj.asset is not None and obj.asset.front_access
 
 
 def overlaps(
@@ -210,8 +217,10 @@ class Layout:
             f = bodies[int(self.rng.integers(len(bodies)))]
             c, h = f.world_center(), f.world_half()  # the body itself, not its doors' sweep
             obj.yaw = float(self.rng.uniform(-math.pi, math.pi))
-            oh = obj.world_half()
             axis, sign = int(self.rng.integers(2)), float(self.rng.choice([-1.0, 1.0]))
+            if reached_from_front(obj):  # its controls face the open floor, away from the furniture
+                obj.yaw = face_robot_yaw(obj.front, np.eye(2)[axis] * sign)
+            oh = obj.world_half()
             xy = c[:2].copy()
             xy[axis] += sign * (h[axis] + oh[axis] + self.rng.uniform(*TUCK_GAP))
             xy[1 - axis] += self.rng.uniform(-1.0, 1.0) * max(h[1 - axis] - oh[1 - axis], 0.0)
@@ -274,6 +283,10 @@ class Layout:
                 obj.yaw = 0.0 if (obj.hi - obj.lo)[0] <= (obj.hi - obj.lo)[1] else math.pi / 2
                 half = obj.world_half()
                 slack = (hi_xy - lo_xy) / 2 - half[:2]
+                if np.any(slack < -1e-6):  # square the other way: a book across a deep shelf board
+                    obj.yaw = math.pi / 2 - obj.yaw
+                    half = obj.world_half()
+                    slack = (hi_xy - lo_xy) / 2 - half[:2]
                 if np.any(slack < -1e-6):
                     raise ItemFailed(
                         f"{obj.name} ({2 * half[0]:.2f}x{2 * half[1]:.2f} m) does not fit on {holder.name}"
@@ -308,6 +321,10 @@ class Layout:
         obj.yaw = holder.yaw
         half = obj.world_half()
         room = (hi[:2] - lo[:2]) / 2 - half[:2] - 0.01
+        if np.any(room < 0):  # long things lie along the cavity's long side
+            obj.yaw = holder.yaw + math.pi / 2
+            half = obj.world_half()
+            room = (hi[:2] - lo[:2]) / 2 - half[:2] - 0.01
         if np.any(room < 0) or (hi[2] - lo[2]) < 2 * half[2] + 0.01:
             raise ItemFailed(f"{obj.name} does not fit inside {holder.name}")
         center = (lo[:2] + hi[:2]) / 2 + self.rng.uniform(-0.5, 0.5, size=2) * room

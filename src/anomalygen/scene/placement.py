@@ -24,7 +24,7 @@ from anomalygen.scene.instances import (
     surface_of,
 )
 from anomalygen.scene.judgement import place_hazard_safely, place_judgement_items, room_fixtures
-from anomalygen.scene.layout import Layout, Placed, face_robot_yaw
+from anomalygen.scene.layout import Layout, Placed, face_robot_yaw, reached_from_front
 from anomalygen.schema import ObjectRole
 
 if TYPE_CHECKING:
@@ -168,10 +168,10 @@ def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], suppor
     kind, parent, hazard = sel.kind, sel.parent, sel.hazard
     hp = placed[hazard.name] = placed_instance(hazard)
     if kind == "floor":
-        lay.place_on_floor(hp, relevant=True, face=False)
+        lay.place_on_floor(hp, relevant=True, face=reached_from_front(hp))
     elif kind == "walkway":
         fixtures = [p for p in lay.items if p.fixed]
-        lay.place_on_floor(hp, relevant=True, face=False, clear_of=fixtures)
+        lay.place_on_floor(hp, relevant=True, face=reached_from_front(hp), clear_of=fixtures)
     elif support is not None:
         edge = support_kind.endswith("_edge")
         lay.place_on_surface(

@@ -29,6 +29,7 @@ SWITCH = "switch"
 BUTTON = "button"
 TAP = "tap"
 FAUCET = "faucet"
+GATE = "gate"  # a safety gate: bars a way, holding nothing behind it
 
 # Labels of parts that move but that no rule of the code turns on (a blade, a wheel, a seat). They
 # are listed so that every label the catalogue and the knowledge base use has a kind.
@@ -68,6 +69,7 @@ TABLE: tuple[PartLabel, ...] = (  # closures in the order the planner lists them
     PartLabel(DRAWER, PartKind.ENCLOSING),
     PartLabel(DOOR, PartKind.ENCLOSING, swings=True),
     PartLabel(WINDOW, PartKind.CLOSURE, swings=True, aliases=(SASH,)),
+    PartLabel(GATE, PartKind.CLOSURE, swings=True),
     PartLabel(KNOB, PartKind.SWITCH, aliases=(DIAL,)),
     PartLabel(SWITCH, PartKind.SWITCH, aliases=(BUTTON,)),
     PartLabel(TAP, PartKind.SWITCH),
@@ -136,6 +138,7 @@ def _words(rows) -> tuple[str, ...]:
 # canonical) unless the view says "and aliases" (asset labels, before the builder canonicalises them).
 ENCLOSING_LABELS = tuple(row.name for row in TABLE if row.kind is PartKind.ENCLOSING)  # lid, flap, drawer, door
 LID_LABELS = tuple(row.name for row in TABLE if row.lid_like)  # lid, flap
+GATE_LABELS = (GATE,)
 SWITCH_LABELS = tuple(row.name for row in TABLE if row.kind is PartKind.SWITCH)  # knob, switch, tap, faucet
 CLOSURE_LABELS = _words(row for row in TABLE if row.is_closure)  # and aliases
 SWINGING_CLOSURES = _words(row for row in TABLE if row.is_closure and row.swings)  # and aliases

@@ -149,13 +149,16 @@ def top_rect(ep: Episode, support: str) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
-def free_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2, turned: bool = True) -> np.ndarray:
+def free_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2, turned: bool = True,
+              away: tuple[np.ndarray, np.ndarray, float] | None = None) -> np.ndarray:
     """A drop point on the support's top that keeps ``edge_margin`` from its edges and misses the
     other things standing there (a book in the middle of the table would leave the object perched
     half on it), nearest the centre; the centre when the top is too small for the margin.
 
     ``turned``: the object will be turned to lie along the top's long side (``move_to`` does that
-    for objects with a long side); otherwise it keeps its present orientation."""
+    for objects with a long side); otherwise it keeps its present orientation. ``away``: (lo, hi,
+    gap) of a box the object must end at least ``gap`` from, horizontally (a candle moved away from
+    the curtains); falling short costs more than anything else."""
     drv = ep.driver
 
     lo, hi = top_rect(ep, support)
@@ -188,6 +191,8 @@ def free_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2, 
             edge = float(np.min(np.minimum(p - half - lo[:2], hi[:2] - p - half)))
             score = (hits * 10.0 + 20.0 * max(0.0, NEAR_EDGE + 0.02 - edge) + 0.3 * close
                      + 5.0 * max(0.0, edge_margin - edge) + 0.1 * float(np.linalg.norm(p - centre)))
+            if away is not None:
+                score += 100.0 * max(0.0, away[2] - box_gap((p - half, p + half), away))
             if score < best_score:
                 best, best_score = p, score
     return np.array([best[0], best[1], hi[2] - 0.01])  # set down until it touches: a dropped globe topples
@@ -307,6 +312,12 @@ def footprint(ep: Episode, obj: str) -> tuple[float, float, float]:
     minor = np.array([-major[1], major[0]])
     along, across = xy @ major, xy @ minor
     return (float(np.arctan2(major[1], major[0])), float(np.ptp(along)) / 2, float(np.ptp(across)) / 2)
+
+
+def box_gap(a, b) -> float:
+    """Horizontal gap between two boxes given as (lo, hi) with at least x and y (0 when they overlap)."""
+    gaps = [max(0.0, float(a[0][i]) - float(b[1][i]), float(b[0][i]) - float(a[1][i])) for i in (0, 1)]
+    return float(np.hypot(*gaps))
 
 
 HIT_GAP = 0.01  # m: a set-down spot nearer another object's box than this counts as landing on it

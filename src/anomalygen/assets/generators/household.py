@@ -31,10 +31,11 @@ from anomalygen.assets.generators.common import (
     pick,
     u,
 )
+from anomalygen.assets.generators.parts_lib import glow, push_switch
 from anomalygen.assets.model import Cavity, Draft, Surface
 from anomalygen.assets.parts import Part, axis_angle
 from anomalygen.assets.registry import register
-from anomalygen.schema import DOOR, LID
+from anomalygen.schema import DOOR, LID, SWITCH
 
 
 def _d(root, features=(), **params):
@@ -308,7 +309,7 @@ def frying_pan(rng):
     c = colour(rng, [DARK, METAL[2]])
     r.cyl(rad, 0.003, (0, 0, 0.003), c, D_METAL)
     r.ring(rad, 0.006, 0.045, 0.003, 14, c, D_METAL)
-    r.box((hl / 2, 0.012, 0.008), (rad + hl / 2, 0, 0.03), DARK, 1100)
+    r.box((hl / 2, 0.012, 0.008), (rad + hl / 2, 0, 0.03), DARK, 1100, name="handle")  # scene/states.py
     return Draft(
         r,
         {"radius": rad},
@@ -643,6 +644,8 @@ def backpack(rng):
 
 # ----------------------------------------------------------------------------- heat and fire
 
+SNUFFER_TRAVEL = 0.025  # m a candle's bell snuffer rises off the wick while lit (clear of the flame at 70 %)
+
 
 @register("candle")
 def candle(rng):
@@ -651,8 +654,15 @@ def candle(rng):
     c = colour(rng, [WHITE, (0.95, 0.9, 0.75, 1), (0.8, 0.2, 0.2, 1)])
     r.cyl(rad, h / 2, (0, 0, h / 2), c, 900)
     r.cyl(0.001, 0.004, (0, 0, h + 0.004), DARK, 900)
-    r.ellipsoid((0.004, 0.004, 0.01), (0, 0, h + 0.015), (1.0, 0.6, 0.1, 0.9), 1, collide=False)
-    return _d(r, ["lit flame", colour_name(c)], height=h)
+    # The flame shows only while the candle is lit, i.e. its bell snuffer is raised (label "switch":
+    # lit = on, pressed down over the wick = out). Pressed straight down, a light candle cannot tip.
+    glow(r, "snuffer", "ellipsoid", (0.004, 0.004, 0.007), (0, 0, h + 0.01))
+    # down, the bell fills the lit candle's old box (flame top h + 0.025), so the candle keeps its size
+    cap = r.child("snuffer", (0, 0, h))
+    cap.slide("snuffer_press", (0, 0, 1), (0, SNUFFER_TRAVEL), SWITCH, 0.0, hold=True)
+    cap.cyl(rad * 0.9, 0.0125, (0, 0, 0.0125), (0.75, 0.6, 0.3, 1), 1200)
+    cap.cyl(0.0015, 0.02, (0, rad * 0.8, -0.02), (0.75, 0.6, 0.3, 1), 1, collide=False)  # its guide pin
+    return _d(r, ["bell snuffer", colour_name(c)], height=h)
 
 
 @register("iron")
@@ -665,7 +675,13 @@ def iron(rng):
     r.ellipsoid((L * 0.95, w * 0.9, 0.035), (0, 0, 0.03), c, 300)
     r.segment((-L * 0.6, 0, 0.07), (L * 0.4, 0, 0.08), 0.012, c, 300)
     r.segment((-L * 0.6, 0, 0.07), (-L * 0.75, 0, 0.045), 0.012, c, 300)
-    return _d(r, [colour_name(c), "hot steel soleplate", "power cord"], length=2 * L)
+    # the power switch on the body's nose, clear of the handle by more than the cup's radius, and
+    # standing above the body all round the cup even when pressed down (off)
+    xs = L * 0.75
+    top = 0.03 + 0.035 * float(np.sqrt(max(0.0, 1.0 - ((xs - 0.02) / (L * 0.95)) ** 2)))
+    push_switch(r, "switch", (xs, 0, top - 0.001), (0.008, 0.008, 0.004), DARK)
+    glow(r, SWITCH, "sphere", (0.004,), (L * 0.25, 0, 0.095))  # the heating light
+    return _d(r, [colour_name(c), "hot steel soleplate", "power switch", "power cord"], length=2 * L)
 
 
 @register("hair_dryer")
@@ -676,7 +692,8 @@ def hair_dryer(rng):
     r.cyl(rb, lb, (0, 0, rb), c, 300, axis="x")
     r.cyl(rb * 0.7, 0.01, (lb + 0.01, 0, rb), DARK, 300, axis="x")
     r.box((0.02, 0.05, rb * 0.55), (-lb * 0.3, -rb - 0.045, rb * 0.55), c, 300)
-    return _d(r, [colour_name(c), "handle", "power cord"], length=2 * lb)
+    push_switch(r, "switch", (-lb * 0.3, -rb - 0.06, rb * 1.1 + 0.002), (0.008, 0.012, 0.004), (0.85, 0.1, 0.1, 1))
+    return _d(r, [colour_name(c), "handle", "on/off switch", "power cord"], length=2 * lb)
 
 
 @register("matches")

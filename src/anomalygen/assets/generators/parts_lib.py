@@ -12,7 +12,7 @@ from __future__ import annotations
 from anomalygen.assets.generators.common import D_METAL, METAL, open_box
 from anomalygen.assets.model import Cavity
 from anomalygen.assets.parts import Part
-from anomalygen.schema import DOOR, DRAWER, KNOB, LID
+from anomalygen.schema import DOOR, DRAWER, KNOB, LID, SWITCH, TAP
 
 
 def side_door(
@@ -130,3 +130,38 @@ def top_lid(parent: Part, name: str, hx, hy, z, rgba, density, thick=0.01, open_
     lid.hinge(f"{name}_hinge", (1, 0, 0), (-open_angle, 0), label, 0.0)
     lid.box((hx, hy, thick / 2), (0, -hy, thick / 2), rgba, density)
     return lid
+
+
+# A geom named ``<control body>_glow`` is drawn only while that control is on (a burner's flame, a
+# heater's element, a candle's flame); the scene builder shows it (``scene/states.py``). Its rgba
+# here has alpha 0, so the asset on its own, and a scene with the control off, show nothing.
+GLOW = (1.0, 0.35, 0.05, 0.0)
+
+
+def glow(parent: Part, control: str, kind: str, size, pos, *, quat=None) -> None:
+    """A hidden, massless, non-colliding glow for the control body named ``control``."""
+    parent._geom(kind, size, pos, GLOW, 0.0, quat=quat, collide=False, name=f"{control}_glow")
+
+
+PUSH_SWITCH_TRAVEL = 0.006  # m a push switch stands proud when on
+
+
+def push_switch(parent: Part, name: str, pos, half, rgba, travel: float = PUSH_SWITCH_TRAVEL):
+    """A latching on/off push switch on a top face (label "switch"): off pressed down at 0 (its box
+    centred at ``pos``), on standing ``travel`` proud. Joint friction is the latch, so a switch left on
+    stays on; pressing it down from above puts it off, which is how a suction cup meets a top face
+    (the switch-off family's buttons, ``skills/learned/part_skill.py``)."""
+    s = parent.child(name, pos)
+    s.slide(f"{name}_press", (0, 0, 1), (0, travel), SWITCH, 0.0, hold=True)
+    s.box(half, (0, 0, 0), rgba, D_METAL)  # as heavy as its latch: a 3 g cap rang against the cup's hold
+    return s
+
+
+def tap_lever(parent: Part, name: str, pos, length: float, rgba, lift: float = 0.6):
+    """A single-lever tap handle on a horizontal hinge (x), pointing to the front (-y): off rests
+    down on its limit (gravity keeps it there), on is lifted up to ``lift`` rad. Label "tap"."""
+    lv = parent.child(name, pos)
+    lv.hinge(f"{name}_hinge", (1, 0, 0), (-lift, 0), TAP, 0.0)
+    lv.box((0.008, length / 2, 0.006), (0, -length / 2, 0.006), rgba, D_METAL)
+    lv.cyl(0.014, 0.012, (0, 0, 0.0), rgba, D_METAL)
+    return lv

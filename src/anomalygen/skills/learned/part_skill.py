@@ -42,6 +42,7 @@ POS_SCALE = 10.0  # positions in dm (~unit scale for the networks)
 OBS_DIM = 17
 OFF_AXIS = 0.6  # grasp this fraction of the knob radius away from its axis: a lever for the hold
 PRE_CONTACT = 0.04  # m in front of the face before the final approach
+BACK_OFF = 0.08  # m the cup retreats along the face normal after letting go
 
 
 def part_geometry(model, data, joint: str) -> dict:
@@ -128,6 +129,36 @@ def grasp_part(ep: Episode, joint: str) -> tuple[bool, str]:
     return False, why
 
 
+def lead_held_part(ep: Episode, readout: PartReadout, act, *, horizon: int, tol: float = CLOSED_TOL) -> tuple[bool, int]:
+    """Drive the held part with ``act(observation) -> 7-D action`` on the Driver, at the env's frameskip,
+    until it is within ``tol`` of its travel from off or ``horizon`` control steps pass: the learned
+    skill's replay (a policy) and the scripted primitive (:func:`reference_action`) alike.
+    Returns (off, control steps taken)."""
+    from anomalygen.skills.learned.subtask_env import FRAMESKIP
+
+    drv = ep.driver
+    fs, drv.frameskip = drv.frameskip, FRAMESKIP
+    t, ok = 0, abs(readout.fraction(drv.data)) <= tol
+    try:
+        while t < horizon and not ok:
+            readout.agent.apply_action(drv.data, act(readout.observation(drv.model, drv.data, t, horizon)))
+            t += 1
+            drv.step()
+            ok = abs(readout.fraction(drv.data)) <= tol
+    finally:
+        drv.frameskip = fs
+    return ok, t
+
+
+def let_go(ep: Episode, joint: str) -> None:
+    """Switch suction off and back the cup away from the part's face, wrist straightened."""
+    drv = ep.driver
+    drv.agent.release(drv.data)
+    normal = part_geometry(drv.model, drv.data, joint)["normal"]
+    drv.goto(drv.site + BACK_OFF * normal, max_steps=40)
+    drv.straighten_wrist(lift=0.1, lift_steps=30)
+
+
 class PartReadout:
     """The family's observation and success for one joint, on any (model, data) of the scene.
 
@@ -184,12 +215,16 @@ class PartReadout:
         return abs(self.fraction(data)) <= CLOSED_TOL
 
 
-def reference_action(obs: np.ndarray) -> np.ndarray:
+REFERENCE_MOVE = 0.6  # the reference's action along the part's path (0.6 * 3 cm a step)
+
+
+def reference_action(obs: np.ndarray, move: float = REFERENCE_MOVE) -> np.ndarray:
     """A scripted turn from the observation alone: move the held point along its towards-off direction
-    and pull the cup back onto it, suction on. Used for demonstrations that seed the warm start's
-    training (``benchmarks/train_warm_start.py --demos``); on the built scenes it turns a held knob to
+    (``move`` of a full action step) and pull the cup back onto it, suction on. Used for demonstrations
+    that seed the warm start's training (``benchmarks/train_warm_start.py --demos``) and, paced, by the
+    scripted primitive (``skills/scripted/controls.py``); on the built scenes it turns a held knob to
     off in 15-26 steps, but it has no notion of a hold that slips or a part that jams."""
     a = np.zeros(7)
-    a[:3] = np.clip(0.6 * obs[3:6] + 0.5 * obs[0:3], -1.0, 1.0)
+    a[:3] = np.clip(move * obs[3:6] + 0.5 * obs[0:3], -1.0, 1.0)
     a[6] = 1.0
     return a

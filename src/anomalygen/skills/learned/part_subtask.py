@@ -39,7 +39,6 @@ EVAL_EPISODES = 5
 # Fine-tuning budget per part, at most: an oven has up to five knobs on and `make demo` runs 20 tasks
 # in < 15 min on 2 cores; ~1000 steps of a 64x64 SAC take 20-40 s there (figures in docs/learn.md).
 FINETUNE_MAX = 1000
-BACK_OFF = 0.08  # m the cup retreats along the face normal after letting go
 
 
 def warm_start_path(family: str = FAMILY) -> Path | None:
@@ -72,25 +71,12 @@ def far_value(js) -> float:
     return float(hi if abs(hi - js.closed_value) >= abs(lo - js.closed_value) else lo)
 
 
-class _OnDriver:
-    """The env's per-start readouts on the Driver's own model and data (for the replay)."""
-
-    def __init__(self, ep: Episode, st: SubTask, plan: Plan, joint: str, closed: float, far: float):
-        from anomalygen.skills.learned.part_skill import PartReadout
-        from anomalygen.skills.learned.subtask_env import SubTaskReadout
-
-        self.model, self.data = ep.model, ep.data
-        self.part = PartReadout(ep.model, joint, closed, far)
-        self.task = SubTaskReadout(ep.model, ep.spec, st, plan.bindings)
-
-
 def run_part_subtask(ep: Episode, st: SubTask, plan: Plan, *, steps: int, seed: int, n_envs: int = 1, threads: int = 1,
                      warm_start: Path | None | str = "shipped", log=None) -> SkillOutcome:
     """Grasp the part, fine-tune the family policy on this scene (if needed), execute it on the Driver."""
-    from anomalygen.skills.learned.part_env import HORIZON, PartStart, make_part_env, part_control_step
-    from anomalygen.skills.learned.part_skill import grasp_part, part_geometry
+    from anomalygen.skills.learned.part_env import HORIZON, PartStart, make_part_env
+    from anomalygen.skills.learned.part_skill import PartReadout, grasp_part, lead_held_part, let_go
     from anomalygen.skills.learned.sac import train_sac
-    from anomalygen.skills.learned.subtask_env import FRAMESKIP
 
     drv = ep.driver
     joint = str(st.params.get("joint", ""))
@@ -129,22 +115,10 @@ def run_part_subtask(ep: Episode, st: SubTask, plan: Plan, *, steps: int, seed: 
 
     mujoco.mj_setState(drv.model, drv.data, snap, kind)
     mujoco.mj_forward(drv.model, drv.data)
-    view = _OnDriver(ep, st, plan, joint, closed, far)
-    fs, drv.frameskip = drv.frameskip, FRAMESKIP
-    ok, t = False, 0
-    try:
-        while t < HORIZON and not ok:
-            act, _ = policy.predict(view.part.observation(drv.model, drv.data, t, HORIZON), deterministic=True)
-            t += 1
-            _, ok = part_control_step(view, act, t, drv.step)
-    finally:
-        drv.frameskip = fs
-        view.task.close()
+    readout = PartReadout(drv.model, joint, closed, far)
+    ok, t = lead_held_part(ep, readout, lambda obs: policy.predict(obs, deterministic=True)[0], horizon=HORIZON)
     q = float(drv.data.joint(joint).qpos[0])
-    drv.agent.release(drv.data)
-    normal = part_geometry(drv.model, drv.data, joint)["normal"]
-    drv.goto(drv.site + BACK_OFF * normal, max_steps=40)
-    drv.straighten_wrist(lift=0.1, lift_steps=30)
+    let_go(ep, joint)
     after = float(drv.data.joint(joint).qpos[0])
     ok = ok and js.open_fraction_at(after) <= 0.05
     detail = (f"{why}; {tuned}; rollout {'turned' if ok else 'did not turn'} {joint} to off in {t} steps "

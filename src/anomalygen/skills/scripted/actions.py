@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 from anomalygen.schema import DOOR, LID, LID_LABELS, SubTask, part_labels
 from anomalygen.skills import geometry
 from anomalygen.skills.registry import Skill, SkillOutcome, register
-from anomalygen.skills.scripted import access, primitives, push, transfer
+from anomalygen.skills.scripted import access, primitives, push, relocate, transfer
 from anomalygen.skills.scripted.joints import closed_parts, drive_joints
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -24,7 +24,15 @@ GRASP_LIFT = 0.12  # m a grasped object is lifted unless the step says (``lift``
 
 def _object(episode: Episode, subtask: SubTask) -> str:
     """The object the step acts on: its ``object`` param, else the plan's ``$hazard``."""
-    return str(subtask.params.get("object", episode.bindings.get("$hazard", "")))
+    return _resolve(episode, subtask.params.get("object")) or episode.bindings.get("$hazard", "")
+
+
+def _resolve(episode: Episode, value) -> str | None:
+    """A param naming an object: a role variable (``$fuel``) through the plan's bindings, else as written."""
+    if value is None:
+        return None
+    value = str(value)
+    return episode.bindings.get(value, value) if value.startswith("$") else value
 
 
 @register(PRIMITIVE, "grasp", "pick")
@@ -127,3 +135,32 @@ class DriveJoint(Skill):
 
     def run(self, episode: Episode, subtask: SubTask) -> SkillOutcome:
         return drive_joints(episode, subtask, _object(episode, subtask), subtask.primitive or "", dict(subtask.params))
+
+
+@register(PRIMITIVE, "move_away")
+class MoveAway(Skill):
+    """Carry the object onto a safe support at least ``distance`` m from the ``from`` object."""
+
+    def run(self, episode: Episode, subtask: SubTask) -> SkillOutcome:
+        prm = subtask.params
+        frm = _resolve(episode, prm.get("from"))
+        if not frm or prm.get("distance") is None:
+            return SkillOutcome(False, 0, "move_away needs 'from' (an object) and 'distance' (metres)")
+        return relocate.move_away(episode, _object(episode, subtask), frm, float(prm["distance"]))
+
+
+@register(PRIMITIVE, "take_off")
+class TakeOff(Skill):
+    """Lift the object off what it lies on onto ``support`` (else the nearest safe support)."""
+
+    def run(self, episode: Episode, subtask: SubTask) -> SkillOutcome:
+        support = _resolve(episode, subtask.params.get("support") or subtask.params.get("region"))
+        return relocate.take_off(episode, _object(episode, subtask), support or None)
+
+
+@register(PRIMITIVE, "rotate_inward")
+class RotateInward(Skill):
+    """Turn a pan so that its handle points back over the hob or counter it stands on."""
+
+    def run(self, episode: Episode, subtask: SubTask) -> SkillOutcome:
+        return relocate.rotate_inward(episode, _object(episode, subtask))

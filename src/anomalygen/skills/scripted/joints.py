@@ -9,8 +9,9 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from anomalygen.schema import ENCLOSING_LABELS, SubTask, part_labels
+from anomalygen.schema import CLOSED_TOL, ENCLOSING_LABELS, SubTask, part_labels
 from anomalygen.skills.registry import SkillOutcome
+from anomalygen.skills.scripted.controls import CONTROL_LABELS, switch_off_control
 from anomalygen.skills.scripted.parts import actuate_part
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -18,6 +19,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 ACCESS_LABELS = ENCLOSING_LABELS  # parts that open a way into a container
 NEARLY_CLOSED_TOL = 0.1  # open fraction under which a part still blocks the way in
+PART_TOL = 0.025  # fraction of its travel within which a door, lid or drawer counts as where it was led
 OPEN_FRACTION = 0.6  # how far an opened part goes unless the recipe says (a window for air: a crack)
 
 
@@ -32,11 +34,12 @@ def label_of(st: SubTask, prm: dict) -> str | None:
 
 
 def drive_joints(ep: Episode, st: SubTask, obj: str, prim: str, prm: dict) -> SkillOutcome:
-    """Close (or open) every part of ``obj`` with the step's label, most open first."""
+    """Close (or open) every part of ``obj`` with the step's label, most open first; a control (knob,
+    switch) driven to off is held and led there as the switch-off family does (``controls.py``)."""
     drv = ep.driver
     label = label_of(st, prm)
     opening = prim in ("pull", "open_joint")
-    cands = []
+    cands, controls = [], {}
     for o in ep.spec.objects:
         if o.name != obj:
             continue
@@ -47,10 +50,12 @@ def drive_joints(ep: Episode, st: SubTask, obj: str, prim: str, prm: dict) -> Sk
             closed = js.closed_value
             far = hi if abs(hi - closed) > abs(lo - closed) else lo
             goal = far if opening else closed
+            if js.label in CONTROL_LABELS and not opening:
+                controls[js.name] = far
             gap = abs(float(drv.data.joint(js.name).qpos[0]) - goal) / max(abs(hi - lo), 1e-6)
             fraction = float(prm.get("open_fraction", OPEN_FRACTION))
-            cands.append((gap, js.name, closed + fraction * (far - closed) if opening else goal, closed,
-                          0.025 * abs(hi - lo)))
+            tol = (CLOSED_TOL if js.name in controls else PART_TOL) * abs(hi - lo)
+            cands.append((gap, js.name, closed + fraction * (far - closed) if opening else goal, closed, tol))
     if not cands and prm.get("joint") is not None:
         cands = [(1.0, str(prm["joint"]), float(prm.get("target", 0.0)), 0.0, 0.02)]
     if not cands:
@@ -61,7 +66,8 @@ def drive_joints(ep: Episode, st: SubTask, obj: str, prim: str, prm: dict) -> Sk
         for _, joint, goal, closed, tol in cands:
             if abs(float(drv.data.joint(joint).qpos[0]) - goal) <= tol:  # done already (pushed along by another)
                 continue
-            r = actuate_part(ep, joint, goal, closed=closed, tol=tol)
+            r = (switch_off_control(ep, joint, closed, controls[joint]) if joint in controls
+                 else actuate_part(ep, joint, goal, closed=closed, tol=tol))
             steps += r.steps
             details[joint] = r.detail
     ok = all(abs(float(drv.data.joint(j).qpos[0]) - g) <= t for _, j, g, _, t in cands)

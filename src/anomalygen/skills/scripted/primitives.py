@@ -163,9 +163,12 @@ def _yawed(quat: np.ndarray, yaw: float) -> np.ndarray:
     return out
 
 
-def move_to(ep: Episode, obj: str, region: str, *, release_after: bool = True, into: bool = True) -> SkillOutcome:
+def move_to(ep: Episode, obj: str, region: str, *, release_after: bool = True, into: bool = True,
+            away: tuple | None = None, pose: tuple[np.ndarray, float] | None = None) -> SkillOutcome:
     """Carry the held ``obj`` above ``region`` and lower it: into a container's opening (``into``) or
-    onto a free spot of a support's top; then release."""
+    onto a free spot of a support's top (``away``: at least a gap from a box, see ``free_spot``);
+    then release. ``pose`` = (spot, turn) sets it down with its box centred over ``spot`` after
+    turning it ``turn`` rad about the vertical (a pan turned with its handle inward)."""
     from anomalygen.robot.ik import quat_z_to
 
     drv = ep.driver
@@ -180,7 +183,10 @@ def move_to(ep: Episode, obj: str, region: str, *, release_after: bool = True, i
     # but only when it hangs below a face-down cup and, on a table, has a long side: a turn swings a
     # side-held globe so that it lands tilted, and gains nothing for a square camera.
     turning = face_down and (into or a > SQUARE_RATIO * b)
-    goal = drop_point(ep, region, obj) if into else free_spot(ep, region, obj, turned=turning)
+    if pose is not None:
+        goal = np.asarray(pose[0], dtype=float)
+    else:
+        goal = drop_point(ep, region, obj) if into else free_spot(ep, region, obj, turned=turning, away=away)
     aim, short = goal.copy(), np.zeros(2)
     if not into and ep.memory.set_down_error.get(obj, ("", None))[0] == region:
         # a second try at the same set-down: the last one came to rest off the spot (a tall clock
@@ -199,6 +205,8 @@ def move_to(ep: Episode, obj: str, region: str, *, release_after: bool = True, i
     drv.goto(np.array([*drv.site[:2], carry_z]), quat, max_steps=150)
     want = 0.0 if hi[0] - lo[0] >= hi[1] - lo[1] else np.pi / 2
     turn = (want - yaw + np.pi / 2) % np.pi - np.pi / 2 if turning else 0.0
+    if pose is not None:
+        turn = float(pose[1])
     final = _yawed(quat, turn)
     # Aim the object, not the cup: held by its side (or off-centre), the object's centre is well away
     # from the cup, so the base is placed for the cup poses that put the object's centre on the goal.

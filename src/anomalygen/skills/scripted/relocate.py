@@ -1,0 +1,207 @@
+"""Moving a whole object somewhere safer: away from another by a distance, off what it lies on, or
+turned so its handle no longer sticks out over the edge.
+
+All three are a suction pick and a set-down with the motion primitives (``primitives.grasp``,
+``primitives.move_to``); what is new here is where to: a *safe support* is a surface made for
+setting things down (a table, counter, shelf or cabinet top, ``SAFE_SUPPORTS``) that is not switched
+on, lit, wet or full of water as the robot sees it (the scene graph's states): a stove, a sink's rim,
+a stair or a crib's rail is never one. The spot on it comes from ``free_spot`` (clear of the edges
+and of what stands there), with the distance to keep as its first concern.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from anomalygen.skills.geometry import box_gap, top_rect
+from anomalygen.skills.registry import SkillOutcome
+from anomalygen.skills.scripted import primitives
+
+if TYPE_CHECKING:  # pragma: no cover
+    from anomalygen.skills.episode import Episode
+
+SAFE_SUPPORTS = ("Table", "counter", "shelf", "StorageFurniture")  # categories made to set things on
+UNSAFE_STATES = ("on", "lit", "running", "contains_water", "wet")  # a support showing one is no place to put things
+REACH_TOP = (0.3, 1.3)  # m: tops the arm sets things on (a low table to a shelf)
+LIFT = 0.05  # m a pan is lifted off its hob to be turned
+HANDLE_GEOM = "handle"  # the geom of a pan's long handle (the catalogue's name, scene/states.py reads it too)
+EDGE_CLEAR = 0.03  # m the turned handle's tip keeps inside the edge of the surface
+TURNS = (0.0, np.pi / 4, -np.pi / 4, np.pi / 2, -np.pi / 2)  # tried around the inward direction, nearest first
+
+
+def safe_supports(ep: Episode, obj: str, *, avoid: tuple[str, ...] = ()) -> list[str]:
+    """Supports ``obj`` may be set on, nearest it first: safe ones (see the module docstring) within
+    the arm's reach in height, never ``obj`` itself nor those in ``avoid``."""
+    drv = ep.driver
+    graph = {o.name: o for o in ep.graph().objects}
+    here = (lambda lo, hi: (lo + hi) / 2)(*drv.aabb(obj))
+    out = []
+    for o in ep.spec.objects:
+        g = graph.get(o.name)
+        if o.name == obj or o.name in avoid or o.asset.category not in SAFE_SUPPORTS or g is None:
+            continue
+        if set(UNSAFE_STATES) & set(g.states):
+            continue
+        lo, hi = top_rect(ep, o.name)
+        if not REACH_TOP[0] <= hi[2] <= REACH_TOP[1]:
+            continue
+        out.append((float(np.linalg.norm((lo[:2] + hi[:2]) / 2 - here[:2])), o.name))
+    return [name for _, name in sorted(out)]
+
+
+def _holder(ep: Episode, obj: str) -> str | None:
+    """What ``obj`` is in or on now (the scene graph's relations), None on the floor."""
+    rel = {r.predicate: r.object for r in ep.graph().relations if r.subject == obj and r.object}
+    found = rel.get("inside") or rel.get("on")
+    return found.split(":")[0] if found else None
+
+
+def _pick(ep: Episode, obj: str) -> SkillOutcome | None:
+    """Grasp ``obj`` unless it is held already; the failed outcome, or None when it is held."""
+    if ep.driver.held == obj:
+        return None
+    g = primitives.grasp(ep, obj)
+    return None if g.success else g
+
+
+def move_away(ep: Episode, obj: str, frm: str, distance: float) -> SkillOutcome:
+    """Pick ``obj`` and set it on a free spot of a safe support at least ``distance`` m (horizontal
+    box gap) from ``frm``: its own support when that has such a spot, else the nearest that does."""
+    from anomalygen.skills.geometry import footprint, free_spot
+
+    drv = ep.driver
+    flo, fhi = drv.aabb(frm)
+    away = (flo, fhi, float(distance))
+    gap0 = box_gap(drv.aabb(obj), away)
+    if gap0 >= distance:
+        return SkillOutcome(True, 0, f"{obj} is already {gap0:.2f} m from {frm}")
+    _, a, b = footprint(ep, obj)
+    half = np.array([a, a])  # either way round: move_to may turn it to lie along the top
+    chosen = None
+    for support in safe_supports(ep, obj, avoid=(frm,)):
+        spot = free_spot(ep, support, obj, away=away)
+        if box_gap((spot[:2] - half, spot[:2] + half), away) >= distance:
+            chosen = support
+            break
+    if chosen is None:
+        return SkillOutcome(False, 0, f"no safe support has a spot for {obj} at least {distance:.2f} m from {frm}")
+    failed = _pick(ep, obj)
+    if failed is not None:
+        return failed
+    s0 = drv.steps
+    res = primitives.move_to(ep, obj, chosen, into=False, away=away)
+    gap = box_gap(drv.aabb(obj), away)
+    return SkillOutcome(res.success and gap >= distance, drv.steps - s0,
+                        f"{res.detail}; {obj} {gap:.2f} m from {frm} (was {gap0:.2f}, asked {distance:.2f})")
+
+
+def take_off(ep: Episode, obj: str, support: str | None = None) -> SkillOutcome:
+    """Pick ``obj`` off what it lies on (a towel off a hob, a blanket off a heater) and set it on
+    ``support``, or on the nearest safe support when none is named."""
+    holder = _holder(ep, obj)
+    if not support:
+        cands = safe_supports(ep, obj, avoid=tuple(h for h in (holder,) if h))
+        if not cands:
+            return SkillOutcome(False, 0, f"no safe support to put {obj} on")
+        support = cands[0]
+    if support == holder:
+        return SkillOutcome(False, 0, f"{obj} already lies on {support}: nothing to take it off onto")
+    failed = _pick(ep, obj)
+    if failed is not None:
+        return failed
+    res = primitives.move_to(ep, obj, support, into=False)
+    return SkillOutcome(res.success, res.steps, f"{res.detail} (taken off {holder or 'the floor'})")
+
+
+def _handle(ep: Episode, obj: str) -> tuple[np.ndarray, np.ndarray] | None:
+    """(centre of the body without its handle, handle tip) in world x, y; None without a handle."""
+    import mujoco
+
+    from anomalygen.robot.frames import subtree_geoms
+    from anomalygen.scene.graph import geom_world_aabbs
+
+    drv = ep.driver
+    m, d = drv.model, drv.data
+    gid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, f"{obj}/{HANDLE_GEOM}")
+    if gid < 0:
+        return None
+    mask = subtree_geoms(m, drv.body_id(obj)) & (m.geom_contype | m.geom_conaffinity).astype(bool)
+    mask[gid] = False
+    glo, ghi = geom_world_aabbs(m, d)
+    body = (glo[mask].min(axis=0)[:2] + ghi[mask].max(axis=0)[:2]) / 2
+    rot = d.geom_xmat[gid].reshape(3, 3)
+    axis = int(np.argmax(m.geom_size[gid]))
+    ends = [d.geom_xpos[gid] + s * m.geom_size[gid][axis] * rot[:, axis] for s in (-1.0, 1.0)]
+    tip = max(ends, key=lambda p: float(np.linalg.norm(p[:2] - body)))[:2]
+    return body, tip
+
+
+def _rot(theta: float) -> np.ndarray:
+    c, s = np.cos(theta), np.sin(theta)
+    return np.array([[c, -s], [s, c]])
+
+
+def inward_turn(ep: Episode, obj: str, support: str) -> tuple[float, np.ndarray] | None:
+    """(turn about the vertical, box centre after it) that brings the handle's tip back over the
+    support, pointing into it; the body stays where it is. Turns near the straight-inward one are
+    tried in order and the first whose tip keeps ``EDGE_CLEAR`` inside the top and whose box misses
+    what else stands there is taken; None when none does."""
+    drv = ep.driver
+    found = _handle(ep, obj)
+    if found is None:
+        return None
+    body, tip = found
+    lo, hi = top_rect(ep, support)
+    centre = (lo[:2] + hi[:2]) / 2
+    # inward: away from the edges the tip is past, else towards the middle of the top
+    out = np.array([float(tip[i] > hi[i]) - float(tip[i] < lo[i]) for i in (0, 1)])
+    inward = -out if np.any(out) else centre - body
+    h = tip - body
+    base = float(np.arctan2(inward[1], inward[0]) - np.arctan2(h[1], h[0]))
+    olo, ohi = drv.aabb(obj)
+    box_c, half = (olo[:2] + ohi[:2]) / 2, (ohi[:2] - olo[:2]) / 2
+    others = [drv.aabb(o.name) for o in ep.spec.objects if o.name not in (obj, support)]
+    others = [(a[:2], b[:2]) for a, b in others if b[2] > hi[2] - 0.01 and a[2] < hi[2] + 0.3]
+    for extra in TURNS:
+        theta = (base + extra + np.pi) % (2 * np.pi) - np.pi
+        r = _rot(theta)
+        new_tip = body + r @ h
+        new_c = body + r @ (box_c - body)
+        # the box of the turned object: its corners turned about the body's centre
+        corners = np.array([[sx, sy] for sx in (-1, 1) for sy in (-1, 1)]) * half + box_c
+        pts = (corners - body) @ r.T + body
+        nlo, nhi = pts.min(axis=0), pts.max(axis=0)
+        inside = np.all(new_tip > lo[:2] + EDGE_CLEAR) and np.all(new_tip < hi[:2] - EDGE_CLEAR)
+        if inside and all(box_gap((nlo, nhi), o) > 0.0 for o in others):
+            return theta, new_c
+    return None
+
+
+def rotate_inward(ep: Episode, obj: str) -> SkillOutcome:
+    """Turn a pan on its hob so its handle points back over the hob: pick it up a little, turn it
+    about its body's centre (``inward_turn``) and set it down where it stood."""
+    support = _holder(ep, obj)
+    if support is None:
+        return SkillOutcome(False, 0, f"{obj} stands on no surface to turn its handle in over")
+    if _handle(ep, obj) is None:
+        return SkillOutcome(False, 0, f"{obj} has no long handle to turn inward")
+    plan = inward_turn(ep, obj, support)
+    if plan is None:
+        return SkillOutcome(False, 0, f"no turn of {obj} keeps its handle over {support} and clear of the rest")
+    theta, spot_xy = plan
+    drv = ep.driver
+    s0 = drv.steps
+    if drv.held != obj:
+        g = primitives.grasp(ep, obj, lift=LIFT)
+        if not g.success:
+            return g
+    spot = np.array([*spot_xy, top_rect(ep, support)[1][2] - 0.01])
+    res = primitives.move_to(ep, obj, support, into=False, pose=(spot, theta))
+    found = _handle(ep, obj)
+    lo, hi = top_rect(ep, support)
+    over = found is not None and bool(np.all(found[1] > lo[:2]) and np.all(found[1] < hi[:2]))
+    return SkillOutcome(res.success and over, drv.steps - s0,
+                        f"{res.detail}; turned {np.degrees(theta):.0f} deg, handle tip "
+                        f"{'over' if over else 'still past the edge of'} {support}")
