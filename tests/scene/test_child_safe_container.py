@@ -46,3 +46,18 @@ def test_a_lighter_for_the_storage_box_gets_a_safe_beside_the_box(tmp_path):
 def test_a_class_with_no_child_at_risk_gets_no_extra_container(tmp_path, cls):
     task = make_task("t-knife-box", cls, "Table", "kitchen_knife", "table", container="storage_box")
     assert _latching(_build(task, tmp_path)) == []
+
+
+def test_the_offered_container_is_a_kind_the_class_stores_the_object_in(tmp_path):
+    """A knife goes in a safe (drawn until it fits), never a medicine cabinet: the planner only looks
+    for the kinds ``containers_for`` names, so a cabinet it would never use is no fix on offer."""
+    from anomalygen.knowledge import load_kb
+
+    kb = load_kb()
+    task = make_task("t-knife-toddler", "keep_sharp_away_from_children", "Table", "Knife", "low_table",
+                     container="storage_box")
+    spec = _build(task, tmp_path)
+    knife = next(o for o in spec.objects if o.name == spec.bindings["$hazard"])
+    (extra,) = _latching(spec)
+    assert extra.asset.category in kb.containers_for(kb.hazard_classes[task.hazard_class], "Knife")
+    assert knife.size <= 2 * max(extra.cavities[0].half_extents)

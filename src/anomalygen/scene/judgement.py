@@ -14,7 +14,7 @@ from anomalygen.knowledge import load_kb
 from anomalygen.knowledge.predicates import ROOM_FIXTURES
 from anomalygen.referee.truth import Intent
 from anomalygen.scene import asset_choice, mix
-from anomalygen.scene.casting import Selection
+from anomalygen.scene.casting import CONTAINER_REDRAWS, Selection
 from anomalygen.scene.instances import (
     HAZARD_NEAR_SIDE,
     INWARD,
@@ -163,16 +163,21 @@ def _latches(kb, catalogue: str) -> bool:
 
 
 def _latching_container(sel: Selection, hazard) -> asset_choice.Chosen | None:
-    """A container of a kind that latches (the knowledge base's ``lockable`` objects) the object fits in."""
-    for name in sorted(n for n in sel.kb.objects if _latches(sel.kb, n)):
+    """A container of a kind that latches (the knowledge base's ``lockable`` objects) and that the
+    class stores this object in (``containers_for``: what the robot's planner will look for), drawn
+    again in other sizes until the object fits."""
+    kinds = [n for n in sel.kb.containers_for(sel.hc, hazard.catalogue) if _latches(sel.kb, n)]
+    for name in kinds:
         chosen_before = [id(c) for c in sel.by_catalogue.values()]
-        try:
-            cand = sel.choose(name, ObjectRole.CONTAINER)
-        except (ItemFailed, KeyError):
-            continue
-        if cand.asset.cavities and hazard.size <= container_room(cand.asset):
-            return cand
-        if id(cand) not in chosen_before:  # the scene's own safe (the task's target) stays chosen
+        for _ in range(CONTAINER_REDRAWS + 1):
+            try:
+                cand = sel.choose(name, ObjectRole.CONTAINER)
+            except (ItemFailed, KeyError):
+                break
+            if cand.asset.cavities and hazard.size <= container_room(cand.asset):
+                return cand
+            if id(cand) in chosen_before:  # the scene's own safe (the task's target) keeps its size
+                break
             sel.forget(cand)
     return None
 
