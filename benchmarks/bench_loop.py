@@ -10,11 +10,13 @@ present, detected, planned, resolved — no class firing on the object and no ne
 runs that created a hazard or acted on a safe object), then one JSON line.
 
     .venv/bin/python benchmarks/bench_loop.py [--n 111] [--seed 0] [--seeds 1] [--workers 2] [--out DIR]
-        [--compare-detectors N] [--skip-learn]
+        [--compare-detectors N] [--noise] [--skip-learn]
 
 ``--compare-detectors N`` also runs the LLM and hybrid detectors (the configured LLM backend; by
 default the bundled tiny GGUF, which measures the mechanics, not judgement) on the first N scenes
-and scores all three detectors on those same N scenes.
+and scores all three detectors on those same N scenes. ``--noise`` also detects with perception noise
+(``detect --noise``, the ``detect.noise`` settings) on a copy of the run and scores that too; plans and
+skills stay on the noise-free detections.
 """
 
 from __future__ import annotations
@@ -76,6 +78,7 @@ def main() -> int:
     ap.add_argument("--out", default=None, help="folder for the runs (default: a temporary one)")
     ap.add_argument("--compare-detectors", type=int, default=0, metavar="N",
                     help="score rules, llm and hybrid detection on the first N scenes")
+    ap.add_argument("--noise", action="store_true", help="also score rule detection with perception noise")
     ap.add_argument("--skip-learn", action="store_true", help="stop after detection")
     a = ap.parse_args()
     root = Path(a.out or tempfile.mkdtemp(prefix="bench_loop_"))
@@ -92,6 +95,12 @@ def main() -> int:
     scores = _detection_scores(base)
     print(f"detection (rules) against truth.json: {scores.model_dump_json()}")
     out["detection"] = _summary(scores)
+    if a.noise:
+        noisy = root / "detect_noise"
+        _copy_run(base, noisy)
+        _cli("detect", "--run", str(noisy), "--detector", "rules", "--noise", "--force", env=env)
+        out["detection_noise"] = _summary(_detection_scores(noisy))
+        print(f"detection (rules, perception noise) against truth.json: {json.dumps(out['detection_noise'])}")
     if a.compare_detectors:
         out["detectors"] = _compare_detectors(root, base, ids, a.compare_detectors, env)
     for mode, folder in (() if a.skip_learn else (("detected", base), ("ground_truth", root / "oracle"))):

@@ -16,6 +16,8 @@ CATALOGUES = {"assets/generators/household.py", "assets/generators/furniture.py"
 # The robot's side: it perceives the scene (scene graph, renders, simulator state, the spec without the
 # answer key) and acts on it.
 ROBOT_SIDE = ("anomalygen.detect", "anomalygen.plan", "anomalygen.learn", "anomalygen.robot", "anomalygen.skills")
+# The doors through which it (and a researcher's own policy) reads a built scene: held to the same rule.
+ROBOT_READS = ("anomalygen.perception", "anomalygen.scene.env")
 # What the robot's side may not reach: the referee (truth manifests, matching, scoring, judging), the
 # evaluation and report built on it, the task generator (task words), and the builder's internals
 # (what it chose, why, and how it checked it). The builder's shared products stay allowed: the scene
@@ -140,7 +142,8 @@ def test_the_robot_side_reaches_neither_the_referee_nor_the_builders_internals()
     assert "anomalygen.learn.stage" in robot and "anomalygen.detect.stage" in robot
     # the answer-key side is real and reaches what it must: the builder writes truth.json through the referee
     assert _forbidden_paths(edges, ("anomalygen.scene.build",), ("anomalygen.referee",))
-    paths = _forbidden_paths(edges, ROBOT_SIDE, FORBIDDEN)
+    assert "anomalygen.perception" in edges and "anomalygen.scene.env" in edges
+    paths = _forbidden_paths(edges, ROBOT_SIDE + ROBOT_READS, FORBIDDEN)
     assert paths == [], "robot side reaches the answer key: " + "; ".join(" -> ".join(p) for p in paths)
 
 

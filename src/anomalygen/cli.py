@@ -208,6 +208,8 @@ def detect(
     run: RunOpt = Path("runs/default"),
     detector: Annotated[str | None, typer.Option(help="rules, llm or hybrid.")] = None,
     k: Annotated[int | None, typer.Option("--k", help="Hypotheses per scene.")] = None,
+    noise: Annotated[bool | None, typer.Option(
+        "--noise/--no-noise", help="Perception noise on the detectors' scene graph (settings: detect.noise).")] = None,
     only: OnlyOpt = None,
     config: ConfigOpt = None,
     force: ForceOpt = False,
@@ -219,7 +221,7 @@ def detect(
 ):
     """Stage 3: find the hazard in each scene without being told the task (writes detections.jsonl)."""
     settings = _common(config, None, quiet, backend=backend, model=model, no_cache=no_cache,
-                       **{"detect.detector": detector, "detect.k": k})
+                       **{"detect.detector": detector, "detect.k": k, "detect.noise.enabled": noise})
     folder = _open_run(run)
     _stage("detect", folder, settings, as_json, force=force, only=only)
 

@@ -80,11 +80,30 @@ class BuildConfig(Section):
     render_height: int = Field(240, ge=32)
     repair_attempts: int = Field(3, ge=0)
     relevant_in_unit_cube: bool = Field(True, description="task assets inside (0..1)^3, unrelated ones outside")
+    start: Literal["dock", "reach"] = Field(
+        "dock", description="where the robot starts: 'dock', the same pose in every scene (says nothing about the "
+        "hazard); 'reach', the free pose nearest the dock with the hazard within reach, facing it (the answer "
+        "key as a start pose: for tests and ablations of the skills alone)"
+    )
+
+
+class NoiseConfig(Section):
+    """Perception noise on the scene graph the detectors read, so they are measured off the perfect
+    graph too (``detect/noise.py``). Off by default; plan and learn always see the simulator."""
+
+    enabled: bool = False
+    pose_jitter: float = Field(0.02, ge=0, le=0.5, description="m: each object's position error bound, per axis (uniform)")
+    miss_rate: float = Field(0.1, ge=0, le=1, description="chance that a small object is not seen at all")
+    small_size: float = Field(0.06, gt=0, description="m: an object whose largest extent is at most this counts as small")
+    confusion_rate: float = Field(
+        0.1, ge=0, le=1, description="chance that an object with look-alikes (knowledge base) is seen as one of them"
+    )
 
 
 class DetectConfig(Section):
     detector: Literal["rules", "llm", "hybrid"] = "rules"
     k: int = Field(3, ge=1, le=10)
+    noise: NoiseConfig = Field(default_factory=NoiseConfig)
 
 
 class PlanConfig(Section):

@@ -103,3 +103,20 @@ def test_a_fixed_hazard_with_a_new_hazard_beside_it_is_an_unresolved_run(kb):
     fixed = moved(fixed, "mug_0", position=[0.6, 1.2, 0.05], height_above_floor=0.0, on_floor=True, distance_to_edge=None)
     v = verdict_on(knife_manifest(kb), start, fixed, kb, task_id="t")
     assert v.hazards[0].resolved and v.new_hazards and v.status == "unresolved" and not v.resolved
+
+
+def test_the_container_a_hazard_was_stored_in_is_used_for_the_fix_not_an_intervention_on_a_safe_object(kb):
+    """The cabinet is a state near-miss (shut); the robot opens it, shuts the knife in and leaves its
+    door 0.3 rad open: that is no needless intervention, but the open door is a new hazard."""
+    manifest = knife_manifest(kb).model_copy(update={"near_misses": [
+        NearMiss(object="storage_0", category="StorageFurniture", looks_like="close_open_furniture",
+                 why_safe="shut", kind="state")]})
+    start = g.knife_on_counter_edge()
+    stored = _without_knife(start)
+    ajar = [j.model_copy(update={"value": 0.3}) for j in next(o for o in stored.objects if o.name == "storage_0").joints]
+    final = moved(stored, "storage_0", joints=ajar)
+    verdict = verdict_on(manifest, start, final, kb, task_id="t")
+    assert verdict.interventions_on_safe == []
+    # the same door moved with nothing stored in the cabinet is an intervention on a safe object
+    emptied = final.model_copy(update={"relations": [r for r in final.relations if r.subject != "kitchen_knife_0"]})
+    assert verdict_on(manifest, start, emptied, kb, task_id="t").interventions_on_safe == ["storage_0"]

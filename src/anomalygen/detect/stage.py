@@ -1,7 +1,8 @@
 """Stage 3 entry point: detect the hazards in every built scene and collate the detections.
 
-Per scene (one runner item): read ``scene_graph.json`` (the only input a detector sees), run the
-configured detector and write ``detections/<task_id>.json``. A detector failure (an LLM that never
+Per scene (one runner item): read ``scene_graph.json`` through ``anomalygen.perception`` (the only
+input a detector sees; with ``detect.noise`` on, a noisy copy of it, ``detect/noise.py``), run the
+configured detector and write ``detections/<task_id>.json`` (which records the noise it ran under). A detector failure (an LLM that never
 produced a valid reply) is recorded in that scene's ``Detection.error`` and counts as a miss; it
 never ends the batch. After the items: collate ``detections.jsonl`` atomically in task order and
 print what was claimed.
@@ -63,22 +64,27 @@ def _detector_name(detector, settings: Settings) -> str:
 
 def detect_scene(task_id: str, graph: SceneGraph, settings: Settings, *, detector=None) -> Detection:
     """Detect on one scene graph (pure apart from LLM calls): what the item function writes. The
-    task id only names the record; the detector is given the graph alone."""
+    task id only names the record; the detector is given the graph alone, through the configured
+    perception noise (``detect.noise``; off: the graph itself), which the record keeps."""
+    from anomalygen.detect.noise import detector_graph
     from anomalygen.llm import LLMItemError
 
     detector = detector or make_detector(settings)
+    seen, noise = detector_graph(graph, settings)
     error = None
     try:
-        hyps = detector.detect(graph, settings.detect.k)
+        hyps = detector.detect(seen, settings.detect.k)
     except LLMItemError as exc:
         hyps, error = [], str(exc)
     return Detection(task_id=task_id, scene_id=graph.scene_id, detector=_detector_name(detector, settings),
-                     hypotheses=hyps, error=error)
+                     hypotheses=hyps, error=error, noise=noise)
 
 
 def _item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str, Any]:
+    from anomalygen.perception import load_scene_graph
+
     run, settings = ctx.run, ctx.settings
-    graph = try_read_model(_graph_path(run, task_id), SceneGraph)
+    graph = load_scene_graph(run.scene_dir(task_id))
     if graph is None:
         raise ItemFailed(f"no valid scene_graph.json in {run.scene_dir(task_id)} (build the scene first)")
     detector = make_detector(settings)
@@ -93,7 +99,9 @@ def _item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str,
 
 
 def _graph_path(run: RunFolder, task_id: str):
-    return run.scene_dir(task_id) / "scene_graph.json"
+    from anomalygen.perception import GRAPH_FILE
+
+    return run.scene_dir(task_id) / GRAPH_FILE
 
 
 def _is_done_for(run: RunFolder, settings: Settings):

@@ -52,10 +52,13 @@ def vocabulary() -> dict[str, Any]:
 class KnowledgeBase:
     """Hazard classes, object knowledge and role profiles, validated and indexed."""
 
-    def __init__(self, hazard_classes: list[HazardClass], objects: list[ObjectInfo], roles: list[RoleProfile]):
+    def __init__(self, hazard_classes: list[HazardClass], objects: list[ObjectInfo], roles: list[RoleProfile],
+                 lookalike_groups: list[list[str]] | None = None):
         self.hazard_classes: dict[str, HazardClass] = {hc.id: hc for hc in hazard_classes}
         self.objects: dict[str, ObjectInfo] = {o.name: o for o in objects}
         self.roles: dict[str, RoleProfile] = {r.id: r for r in roles}
+        #: groups of objects a perceiver can mistake for one another (``lookalikes.json``)
+        self.lookalike_groups: list[list[str]] = [list(g) for g in lookalike_groups or []]
         self._candidates: dict[tuple[str, str], list[str]] = {}
 
     # ------------------------------------------------------------------ simple views
@@ -77,6 +80,11 @@ class KnowledgeBase:
         """Perceived properties of a catalogue object (what the scene builder puts in GraphObject.properties)."""
         info = self.objects.get(name)
         return list(info.properties) if info else []
+
+    def lookalikes(self, name: str) -> list[str]:
+        """The other members of ``name``'s look-alike group (empty when it has none)."""
+        group = next((g for g in self.lookalike_groups if name in g), [])
+        return [n for n in group if n != name]
 
     def benign_objects(self) -> list[str]:
         """Household objects with no hazard-relevant property: safe clutter that triggers no class."""
@@ -193,6 +201,9 @@ class KnowledgeBase:
                 out.append(f"{where}: hazard_objects {bad} do not meet the class's intrinsic preconditions")
             if not self.hazard_candidates(hc):
                 out.append(f"{where}: no catalogue object can be its hazard")
+        grouped = [n for g in self.lookalike_groups for n in g]
+        out += [f"look-alikes: unknown object {n}" for n in grouped if n not in names]
+        out += [f"look-alikes: {n} is in more than one group" for n in sorted({n for n in grouped if grouped.count(n) > 1})]
         for r in self.roles.values():
             out += [f"role {r.id}: unknown class {c}" for c in r.class_interests if c not in self.hazard_classes]
             out += [f"role {r.id}: unknown object {o}" for o in r.object_interests if o not in names]
@@ -235,4 +246,4 @@ def load_kb() -> KnowledgeBase:
     classes = [HazardClass.model_validate(c) for c in _data("hazard_classes.json")["classes"]]
     objects = [ObjectInfo.model_validate({"name": n, **o}) for n, o in _data("objects.json")["objects"].items()]
     roles = [RoleProfile.model_validate(r) for r in _data("roles.json")["roles"]]
-    return KnowledgeBase(classes, objects, roles)
+    return KnowledgeBase(classes, objects, roles, _data("lookalikes.json")["groups"])

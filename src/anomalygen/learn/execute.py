@@ -38,7 +38,7 @@ def _evaluate(calls, ep: Episode, bindings) -> list[PredicateResult]:
 
 
 def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: str | Path | None = None,
-                 max_wall_s: float = 600.0, sac_steps: int = 0, isolate: bool = True,
+                 max_wall_s: float | None = None, sac_steps: int = 0, isolate: bool = True,
                  retries: int = 1, reward_mode: str = "spec",
                  final_graph_path: str | Path | None = None, n_envs: int = 1, recheck_fixes: int = 0,
                  final_state_path: str | Path | None = None) -> SkillResult:
@@ -52,7 +52,10 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
     With ``isolate`` (default) the execution runs in a fresh process: OMPL's random generator is
     process-global and seeded once, so a path planned in a process that has planned before depends on
     that history. In a fresh process the first seed is the item's, and the result is a function of
-    (scene, plan, seed) alone, whichever worker or test runs it. Costs about a second.
+    (scene, plan, seed) alone, whichever worker or test runs it. Costs about a second. No decision
+    depends on wall time: the episode stops starting sub-tasks after
+    :data:`~anomalygen.skills.episode.EPISODE_MAX_STEPS` control steps; ``max_wall_s`` (default
+    :data:`~anomalygen.skills.episode.EPISODE_WALL_CAP_S`) is only a safety net against a hung item.
 
     ``reward_mode`` is ``learn.reward_mode``: "code" trains SAC sub-tasks on sandboxed reward code
     (:func:`~anomalygen.skills.learned.sac_subtask.run_sac_subtask`).
@@ -134,8 +137,8 @@ def run_subtasks(ep: Episode, plan: Plan, retries: int = 1) -> list[SubTaskResul
         if st.method == SkillMethod.CEM:
             results.append(SubTaskResult(id=st.id, method=st.method, success=False, detail=CEM_NOT_EXECUTED))
             continue
-        if ep.budget.spent():
-            results.append(SubTaskResult(id=st.id, method=st.method, success=False, detail="not executed: time budget spent"))
+        if why := ep.budget.spent(ep.steps):
+            results.append(SubTaskResult(id=st.id, method=st.method, success=False, detail=f"not executed: {why}"))
             continue
         s0 = ep.steps
         details: list[str] = []
@@ -149,7 +152,7 @@ def run_subtasks(ep: Episode, plan: Plan, retries: int = 1) -> list[SubTaskResul
                 ok = all(p.holds for p in preds)
                 detail += "; " + "; ".join(f"{p.call.name}: {'yes' if p.holds else 'no'}" for p in preds)
             details.append(detail if attempt == 1 else f"attempt {attempt}: {detail}")
-            if ok or ep.budget.spent():
+            if ok or ep.budget.spent(ep.steps):
                 break
         executed = None if by is None or res.detail.startswith("not executed") else by
         results.append(SubTaskResult(id=st.id, method=st.method, success=ok, steps=ep.steps - s0,
@@ -158,17 +161,15 @@ def run_subtasks(ep: Episode, plan: Plan, retries: int = 1) -> list[SubTaskResul
     return results
 
 
-def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float, sac_steps: int,
+def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float | None, sac_steps: int,
                   retries: int = 1, reward_mode: str = "spec", final_graph_path=None, n_envs: int = 1,
                   recheck_fixes: int = 0, final_state_path=None) -> SkillResult:
-    from anomalygen.perception import perceived_spec
+    from anomalygen.perception import load_perceived_scene
     from anomalygen.rng import item_rng
-    from anomalygen.scene.graph import load_scene
-    from anomalygen.skills.episode import Episode, LearningSettings, TimeBudget
+    from anomalygen.skills.episode import Episode, EpisodeBudget, LearningSettings
 
-    budget = TimeBudget(max_wall_s)
-    model, data, spec = load_scene(scene_dir)
-    spec = perceived_spec(spec)  # the robot acts on what it perceives: no bindings, no roles
+    budget = EpisodeBudget() if max_wall_s is None else EpisodeBudget(seconds=max_wall_s)
+    model, data, spec = load_perceived_scene(scene_dir)  # what it perceives: no bindings, roles or task
     timings = {"load_s": round(budget.elapsed(), 3)}
     rec = None
     if video_path is not None:

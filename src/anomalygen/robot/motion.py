@@ -4,8 +4,15 @@ Why joint space and MuJoCo collisions: the primitives (approach, move_to) need a
 the furniture of a generated scene, and the scene *is* a MuJoCo model; asking MuJoCo whether a
 configuration has robot-vs-world contacts (with a small safety margin on the robot's geoms) needs no
 second geometry model. Why BIT* with a cost threshold: BIT* is the paper's planner; left alone it
-keeps improving until its time budget is spent, so the objective's cost threshold is set very high
-and it returns the first solution it finds (then shortcut-simplified and interpolated).
+keeps improving until its budget is spent, so the objective's cost threshold is set very high and it
+returns the first solution it finds (then shortcut-simplified and interpolated).
+
+Why the budget counts validity checks, not seconds: a wall-clock limit lets the machine's load decide
+whether a hard query finds its path before giving up, so the same item on the same code took another
+path, or fell back to a straight move, and ran a different number of control steps when the machine
+was busy. A query now ends after ``max_checks`` state-validity checks (each one ``mj_collision`` of
+the scene, where nearly all of its time goes); a wall-clock cap a hundred times longer than that
+budget takes on an idle core stays only as a safety net that normal runs never reach.
 
 Self-collisions between arm links are not checked (MuJoCo's panda model excludes most link pairs and
 joint limits keep the rest apart in practice); contacts between the robot and bodies named in
@@ -14,9 +21,25 @@ joint limits keep the rest apart in practice); contacts between the robot and bo
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 
 _SEEDED = False
+log = logging.getLogger(__name__)
+
+#: Validity checks BIT* makes per second of one idle core on built household scenes: measured on the
+#: development machine (an AMD EPYC vCPU) by thread CPU time over unsolvable arm queries in ten built
+#: scenes, 2,400-7,300 per CPU second (docs/learn.md); so a budget converted from seconds gives about
+#: what the old wall-clock limit allowed on an idle core (twice that in the heaviest scenes, 0.7x in the
+#: lightest).
+CHECKS_PER_IDLE_S = 5000
+#: A query's default budget, in validity checks: what the old 2 s limit allowed on an idle core.
+PLAN_MAX_CHECKS = 2 * CHECKS_PER_IDLE_S
+#: The wall-clock safety net as a multiple of the time the check budget takes on an idle core. The
+#: shared 2-core development machine, under its usual load, runs a query 6-8 times slower than its
+#: CPU time; 100 leaves another tenfold margin, so only a pathologically slow checker reaches it.
+WALL_CAP_FACTOR = 100.0
 
 
 class CollisionChecker:
@@ -98,21 +121,39 @@ def path_is_valid(checker: CollisionChecker, path, max_step: float = 0.02) -> bo
     return all(checker.valid(q) for q in interpolate(path, max_step))
 
 
-def plan_path(model, data, joint_names, q_goal, *, time_limit: float = 2.0, seed: int = 0, margin: float = 0.01,
-              allowed_bodies=(), max_step: float = 0.05, checker: CollisionChecker | None = None
-              ) -> list[np.ndarray] | None:
+def wall_cap_s(max_checks: int) -> float:
+    """Seconds after which a query of ``max_checks`` checks is stopped anyway (the safety net)."""
+    return WALL_CAP_FACTOR * max_checks / CHECKS_PER_IDLE_S
+
+
+def check_budget(count, max_checks: int, wall_s: float):
+    """OMPL termination condition: ``count()`` (validity checks so far) reached ``max_checks``, or
+    ``wall_s`` seconds passed. The planner evaluates it itself between iterations (no polling thread),
+    so the check budget ends a query at the same iteration on any machine (the edge being checked when
+    the count passes ``max_checks`` is finished first: up to some tens of checks more)."""
+    from ompl import base as ob
+
+    spent = ob.PlannerTerminationCondition(lambda: count() >= max_checks)
+    return ob.plannerOrTerminationCondition(spent, ob.timedPlannerTerminationCondition(float(wall_s)))
+
+
+def plan_path(model, data, joint_names, q_goal, *, max_checks: int = PLAN_MAX_CHECKS, seed: int = 0,
+              margin: float = 0.01, allowed_bodies=(), max_step: float = 0.05,
+              checker: CollisionChecker | None = None) -> list[np.ndarray] | None:
     """Collision-free joint path from the joints' values in ``data`` to ``q_goal``, or None.
 
     The path is simplified (shortcutting) and interpolated to steps of at most ``max_step`` rad;
     its first waypoint is the start and its last the goal. None when start or goal is in collision
-    or BIT* finds no exact solution within ``time_limit`` seconds.
+    or BIT* finds no exact solution within ``max_checks`` state-validity checks (or, as a safety net
+    that logs a warning, within :func:`wall_cap_s` seconds). Given the OMPL seed and the calls before
+    it in the process, the result does not depend on the machine's speed or load.
     """
     from ompl import base as ob
     from ompl import geometric as og
     from ompl import util as ou
 
     global _SEEDED
-    ou.setLogLevel(ou.LogLevel.LOG_ERROR)  # BIT* warns on every query that ends at the time limit
+    ou.setLogLevel(ou.LogLevel.LOG_ERROR)  # BIT* warns on every query that ends at its budget
     if not _SEEDED:  # OMPL's seed is process-global and can only be set before its first sample
         ou.RNG.setSeed(int(seed) + 1)
         _SEEDED = True
@@ -135,7 +176,13 @@ def plan_path(model, data, joint_names, q_goal, *, time_limit: float = 2.0, seed
         bounds.setHigh(i, float(hi))
     space.setBounds(bounds)
     si = ob.SpaceInformation(space)
-    si.setStateValidityChecker(lambda s: checker.valid([s[i] for i in range(n)]))
+    checks = [0]
+
+    def valid(s) -> bool:
+        checks[0] += 1
+        return checker.valid([s[i] for i in range(n)])
+
+    si.setStateValidityChecker(valid)
     # 1 % of the space's extent between motion checks (~0.1 rad on the arm)
     si.setStateValidityCheckingResolution(0.01)
     si.setup()
@@ -150,12 +197,15 @@ def plan_path(model, data, joint_names, q_goal, *, time_limit: float = 2.0, seed
     planner = og.BITstar(si)
     planner.setProblemDefinition(pdef)
     planner.setup()
-    status = planner.solve(float(time_limit))
+    cap = wall_cap_s(max_checks)
+    planner.solve(check_budget(lambda: checks[0], int(max_checks), cap))
     if not pdef.hasExactSolution():
+        if checks[0] < max_checks:
+            log.warning("BIT* stopped by the %.0f s safety net after %d of %d checks: this result depends on "
+                        "the machine's speed", cap, checks[0], max_checks)
         return None
-    del status
     path = pdef.getSolutionPath()
-    og.PathSimplifier(si).simplifyMax(path)
+    og.PathSimplifier(si).simplifyMax(path)  # no time limit: it stops when shortcutting no longer helps
     way = [np.array([path.getState(k)[i] for i in range(n)]) for k in range(path.getStateCount())]
     way[0], way[-1] = q_start, q_goal
     return interpolate(way, max_step)

@@ -37,6 +37,7 @@ from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_mo
 from anomalygen.scene.casting import bind_roles, select_objects, set_initial_joints
 from anomalygen.scene.cavities import placed_cavities
 from anomalygen.scene.compose import compose_scene, hold_gravity_hinges, latch_switched_on, set_joints
+from anomalygen.scene.instances import renumber_by_position
 from anomalygen.scene.judgement import check_hazard_free
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.placement import place
@@ -81,7 +82,8 @@ def _plan(task: TaskProposal, settings: Settings, rng, hints=None,
     sel.hazard_free = hazard_free
     set_initial_joints(sel)
     lay, placed, support = place(sel, settings)
-    return lay, ({} if hazard_free else bind_roles(sel, support)), placed
+    placed, bindings = renumber_by_position(lay, placed, {} if hazard_free else bind_roles(sel, support))
+    return lay, bindings, placed
 
 
 # ============================================================================ attempt

@@ -9,9 +9,19 @@ inside the physics step), so a step costs almost exactly ``frameskip`` raw ``mj_
 Python IK loop. Arm actuators go limp in this mode (gravity compensation keeps the arm up); the base
 actuators hold the mobile base where the scene put it.
 
-Observation: a flat float64 vector of robot joint positions and velocities, end-effector position and
-quaternion, the suction state, and each task object's position and quaternion and articulated joint
-values (clutter left out). ``obs_layout`` names the slices.
+Observation: a flat float64 vector, the same groups in the same order for every scene (their sizes
+follow the scene's objects), named by ``obs_layout``:
+``robot_qpos`` and ``robot_qvel`` (the robot's joints, ``Agent.ROBOT_JOINTS`` order), ``ee_pos`` (3)
+and ``ee_quat`` (4, w x y z) of the end effector, then every object alike, in ``object_names`` order
+(instance names sorted; the scene builder numbers instances by where they stand, so neither the
+names nor their order say which object matters): ``object_pos`` (3 per object, its body origin),
+``object_quat`` (4 per object), ``object_joints`` (the value of every articulated joint, object by
+object, in the asset's joint order), and last ``suction`` (1.0 while something is held).
+
+The env perceives only (``anomalygen.perception``): ``env.scene`` is the scene spec with no bindings,
+roles, validation report or task id, and ``info`` carries no task words. ``info["is_success"]`` is
+there only when a ``success_fn`` is given (the caller's own check, as the skills pass theirs): the env
+itself cannot know success without the answer key. The referee's verdict comes from outside.
 
 Suction follows the agent's one grab rule (:meth:`~anomalygen.robot.agent.Agent.grab`): the nearest
 graspable body within ``Agent.SUCTION_RANGE`` of the cup is welded at its current relative pose
@@ -19,7 +29,7 @@ graspable body within ``Agent.SUCTION_RANGE`` of the cup is welded at its curren
 
 Hooks: ``reward_fn(env) -> float`` and ``success_fn(env) -> bool`` let the skills stage plug in
 RewardSpec/SuccessSpec evaluation (``info["is_success"]`` carries the latter, as SB3 reads it);
-``env.graph()`` gives the current SceneGraph. The loaded SceneSpec is ``env.scene``.
+``env.graph()`` gives the current SceneGraph. The perceived SceneSpec is ``env.scene``.
 
 Episode length: ``gym.make(ENV_ID, scene_dir=...)`` wraps the env in Gymnasium's ``TimeLimit``
 (``max_episode_steps=HORIZON``, set at registration); ``make_env`` returns the bare env, which
@@ -62,12 +72,12 @@ class SceneEnv(gym.Env):
     ):
         import mujoco
 
-        from anomalygen.scene.graph import load_scene
+        from anomalygen.perception import load_perceived_scene
 
         self._mj = mujoco
         self.scene_dir = Path(scene_dir)
         # ``scene``, not ``spec``: Gymnasium keeps its EnvSpec in ``env.spec`` and ``gym.make`` sets it.
-        self.model, self.data, self.scene = load_scene(self.scene_dir)
+        self.model, self.data, self.scene = load_perceived_scene(self.scene_dir)
         self.frameskip = int(frameskip)
         self.horizon = None if horizon is None else int(horizon)  # None: TimeLimit ends episodes
         self.render_mode, self.camera = render_mode, camera
@@ -85,12 +95,12 @@ class SceneEnv(gym.Env):
         jids = [name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in Agent.ROBOT_JOINTS]
         self._robot_qpos = np.array([m.jnt_qposadr[j] for j in jids])
         self._robot_qvel = np.array([m.jnt_dofadr[j] for j in jids])
-        task_objects = [o for o in self.scene.objects if o.role.value != "clutter"]
-        self.task_objects = [o.name for o in task_objects]
+        objects = self.scene.objects  # every object alike, in name order (perception sorts them)
+        self.object_names = [o.name for o in objects]
         self._obj_bodies = np.array(
-            [name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in self.task_objects], dtype=int
+            [name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in self.object_names], dtype=int
         )
-        joint_names = [j.name for o in task_objects for j in o.joint_states]
+        joint_names = [j.name for o in objects for j in o.joint_states]
         self._obj_qpos = np.array(
             [m.jnt_qposadr[name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j)] for j in joint_names], dtype=int
         )
@@ -100,10 +110,10 @@ class SceneEnv(gym.Env):
             "robot_qvel": len(self._robot_qvel),
             "ee_pos": 3,
             "ee_quat": 4,
-            "suction": 1,
             "object_pos": 3 * len(self._obj_bodies),
             "object_quat": 4 * len(self._obj_bodies),
             "object_joints": len(self._obj_qpos),
+            "suction": 1,
         }
         self.obs_layout: dict[str, slice] = {}
         start = 0
@@ -112,12 +122,15 @@ class SceneEnv(gym.Env):
             start += n
         self._obs = np.zeros(start)
         # Fast path: the scene compiled observation sensors (scene/sensors.py), read in one copy.
-        from anomalygen.scene.sensors import GROUPS, sensor_layout
+        from anomalygen.scene.sensors import GROUPS, sensor_items, sensor_layout
 
         layout = sensor_layout(m)
-        self._use_sensors = set(layout) == set(GROUPS) and all(
-            layout[g].stop - layout[g].start == sizes[g] for g in GROUPS
-        )
+        self._use_sensors = (
+            set(layout) == set(GROUPS)
+            and all(layout[g].stop - layout[g].start == sizes[g] for g in GROUPS)
+            and sensor_items(m, "object_pos") == self.object_names
+            and sensor_items(m, "object_joints") == joint_names
+        )  # scenes built before every object had sensors take the slow path
         if self._use_sensors:
             nsens = int(m.nsensordata)
             self.obs_layout = {**layout, "suction": slice(nsens, nsens + 1)}
@@ -143,7 +156,7 @@ class SceneEnv(gym.Env):
         # Start the mocap target at the cup's pose and switch on tracking (base held in place).
         self.agent.set_control_mode(d, "ee_delta_pose")
         self.t = 0
-        return self._observe(), {"is_success": False}
+        return self._observe(), self._info(False)
 
     def step(self, action):
         d = self.data
@@ -159,7 +172,11 @@ class SceneEnv(gym.Env):
         reward = float(self.reward_fn(self)) if self.reward_fn is not None else 0.0
         success = bool(self.success_fn(self)) if self.success_fn is not None else False
         truncated = self.horizon is not None and self.t >= self.horizon
-        return obs, reward, success, truncated, {"is_success": success}
+        return obs, reward, success, truncated, self._info(success)
+
+    def _info(self, success: bool) -> dict:
+        """``is_success`` only from the caller's own check: without one the env cannot know it."""
+        return {"is_success": success} if self.success_fn is not None else {}
 
     def render(self):
         if self.render_mode != "rgb_array":

@@ -30,6 +30,39 @@ def instance_name(catalogue: str, used: set[str]) -> str:
     return name
 
 
+def renumber_by_position(lay: layout.Layout, placed: dict[str, Placed],
+                         bindings: dict[str, str]) -> tuple[dict[str, Placed], dict[str, str]]:
+    """Number each category's instances by where they stand (x, then y, then z), not in the order the
+    builder chose them; returns the instances in name order and the bindings renamed.
+
+    Why: names are handed out as objects are chosen, the hazard first, so ``kitchen_knife_0`` beside a
+    near-miss ``kitchen_knife_1`` told the robot which knife was at fault, and the order of the objects
+    (in scene.json, the scene graph, the model's bodies and sensors) told it which was the support.
+    """
+    groups: dict[str, list[Placed]] = {}
+    for p in placed.values():
+        groups.setdefault(p.name.rsplit("_", 1)[0], []).append(p)
+    rename: dict[str, str] = {}
+    for base, members in groups.items():
+        members.sort(key=lambda p: tuple(np.round(p.world_center(), 4)))
+        rename.update({p.name: f"{base}_{i}" for i, p in enumerate(members)})
+
+    def new(ref: str | None) -> str | None:
+        if ref is None:
+            return None
+        name, colon, rest = ref.partition(":")
+        return rename.get(name, name) + colon + rest
+
+    for p in placed.values():
+        p.name, p.support, p.inside = rename[p.name], new(p.support), new(p.inside)
+    lay.preferred = {rename.get(k, k): v for k, v in lay.preferred.items()}
+    for check in lay.corrections:
+        kind, _, name = check.name.partition(":")
+        check.name = f"{kind}:{rename.get(name, name)}"
+    return {p.name: p for p in sorted(placed.values(), key=lambda p: p.name)}, {
+        var: rename.get(name, name) for var, name in bindings.items()}
+
+
 def _front(asset) -> np.ndarray | None:
     """Local direction the asset's doors/drawers open to (the catalogue convention is -y)."""
     if any(part_labels.is_closure(j.label) for j in asset.joints) or asset.cavities:

@@ -1,12 +1,13 @@
 """Placement: proposals in a unit cube, then a solver for support, non-overlap and reach.
 
 As in the paper, task-relevant objects are proposed at (x, y, z) inside the cube (0..1)^3 and
-unrelated clutter outside it. The cube is mapped onto the floor area in front of the robot
+unrelated clutter outside it. The cube is mapped onto the floor area in front of the robot's home
 (``REGION_ORIGIN`` .. + ``REGION_SIZE``). The solver then snaps each proposal onto its support (the
 floor, a support's top surface, a container's cavity, an edge band for ``*_edge`` placements),
 rejects proposals whose footprints overlap already placed objects (oriented boxes in the plane plus a
-height test), and moves the robot base so the hazard is within the arm's reach. MuJoCo contacts
-re-check the result after compiling (build.py), so this solver only has to be conservative.
+height test), checks that some free base pose has the hazard within the arm's reach, and starts the
+robot at its dock, the same pose in every scene. MuJoCo contacts re-check the result after compiling (build.py), so
+this solver only has to be conservative.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ TRIES = 60
 BASE_CLEAR_TOP = 0.35  # m: a box whose bottom is lower than this (the base's 0.30 m top, plus 5 cm) can hit the base
 BASE_CLEAR_SIDE = 0.08  # m kept between such a box and the base disc
 ARM_CLEAR = 0.03  # m kept between any box and the arm's boxes at the home pose
+DOCK_YAW = math.pi / 2  # rad: the docked robot faces along the room's open front (+y), not into the room
 
 
 @dataclass
@@ -365,13 +367,31 @@ class Layout:
         self.base = np.array([xy[0], xy[1], math.atan2(aim[1] - xy[1], aim[0] - xy[0])])
 
     def _base_ok(self, xy: np.ndarray, aim: np.ndarray) -> bool:
+        return self._pose_free(xy, math.atan2(aim[1] - xy[1], aim[0] - xy[0]))
+
+    def _pose_free(self, xy: np.ndarray, yaw: float, *, swing: bool = False) -> bool:
+        """Would the robot at (xy, yaw) clear every placed footprint (``swing``: and the room kept
+        in front of shut doors and drawers)?"""
         old = self.base.copy()
-        self.base = np.array([xy[0], xy[1], math.atan2(aim[1] - xy[1], aim[0] - xy[0])])
+        self.base = np.array([xy[0], xy[1], yaw])
         try:
-            return not any(self._hits_base(o.footprint()) for o in self.items)
+            return not any(self._hits_base(o.footprint(swing=swing)) for o in self.items)
         finally:
             self.base = old
 
+    def dock_pose(self) -> np.ndarray:
+        """Where the robot starts (x, y, yaw): its dock at the room's home (the origin), the same in
+        every scene, turned along the room's open front (``DOCK_YAW``) rather than into it.
+
+        Why: the base used to start 0.35-0.85 m from the hazard and facing it, which told the robot
+        what to look at. The dock aims at no object, so it cannot depend on which one is the hazard;
+        the skills move the base to each target themselves, choosing among the poses around it the
+        one nearest the dock, as the old start pose was the one nearest it. Every object was placed
+        clear of the robot standing there facing into the room (yaw 0), which is used when the arm
+        turned along the front would touch something."""
+        if self._pose_free(np.zeros(2), DOCK_YAW, swing=True):
+            return np.array([0.0, 0.0, DOCK_YAW])
+        return np.zeros(3)
 
 def _h_gap(a, b) -> float:
     gap = np.maximum(0.0, np.maximum(a[0][:2] - b[1][:2], b[0][:2] - a[1][:2]))

@@ -3,7 +3,8 @@
 MuJoCo evaluates sensors in C inside ``mj_step``; reading ``data.sensordata`` replaces a dozen numpy
 gathers per step in Python, which is what keeps the Gymnasium env's step overhead near raw physics.
 Sensor names are ``obs:<group>:<item>``; groups appear in ``GROUPS`` order, so the env can slice the
-vector by group. Sensors are computed at the start of the last physics substep, i.e. they lag the
+vector by group. Every object of the scene has its sensors, in name order: a list of only the task's
+objects would tell the robot which ones matter. Sensors are computed at the start of the last physics substep, i.e. they lag the
 returned state by one timestep (2 ms).
 """
 
@@ -37,6 +38,15 @@ def add_observation_sensors(
         add("object_quat", o, S.mjSENS_FRAMEQUAT, Obj.mjOBJ_XBODY, o)
     for j in object_joints:
         add("object_joints", j, S.mjSENS_JOINTPOS, Obj.mjOBJ_JOINT, j)
+
+
+def sensor_items(model, group: str) -> list[str]:
+    """The items (joint or body names) of one sensor group, in the order they appear in the vector."""
+    import mujoco
+
+    prefix = f"obs:{group}:"
+    names = (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SENSOR, i) or "" for i in range(model.nsensor))
+    return [n[len(prefix):] for n in names if n.startswith(prefix)]
 
 
 def sensor_layout(model) -> dict[str, slice]:

@@ -25,6 +25,7 @@ from anomalygen.schema.detection import (
     Detection,
     Hypothesis,
     Judgement,
+    PerceptionNoise,
 )
 from anomalygen.schema.part_labels import (
     BUTTON,
@@ -187,6 +188,7 @@ __all__ = [
     "Hypothesis",
     "Judgement",
     "Detection",
+    "PerceptionNoise",
     "RewardTerm",
     "RewardSpec",
     "SuccessSpec",

@@ -60,7 +60,7 @@ class SubTaskResult(Strict):
     skill that actually executed it, as ``method:action`` of the skill registry (``*``: the method's
     skill for any action, as SAC learns whatever the reward asks). They differ when a SAC sub-task
     failed and the primitive of its action ran in its place (``method`` "sac", ``executed_by``
-    "primitive:push"). None when no skill executed it: CEM on a wheeled robot, the time budget
+    "primitive:push"). None when no skill executed it: CEM on a wheeled robot, the episode budget
     spent, no skill registered for its action, or a skill that reported "not executed"."""
 
     id: str
