@@ -25,7 +25,7 @@ from anomalygen.scene.instances import (
     surface_of,
 )
 from anomalygen.scene.layout import Layout, Placed
-from anomalygen.schema import LATCHING_PROPERTY, ObjectRole, ValidationCheck, ValidationReport, part_labels
+from anomalygen.schema import ObjectRole, ValidationCheck, ValidationReport, part_labels
 
 
 def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed], surfaces: list[Placed],
@@ -131,9 +131,9 @@ def child_safe_container(sel: Selection) -> asset_choice.Chosen | None:
     """For a class whose danger is a child reaching the object, a container that latches and that the
     object fits: the task's own when it latches, else one of the knowledge base's ``lockable`` kinds.
     None for any other class, or when no latching kind fits."""
-    if not _guards_a_child(sel.hc) or sel.hazard.fixed:  # a window the child leans out of is shut, not stored
+    if sel.hc is None or not sel.kb.guards_a_child(sel.hc) or sel.hazard.fixed:  # a window the child leans out of is shut, not stored
         return None
-    if sel.container is not None and _latches(sel.kb, sel.container.catalogue):
+    if sel.container is not None and sel.kb.latches(sel.container.catalogue):
         return sel.container
     return _latching_container(sel, sel.hazard)
 
@@ -154,19 +154,11 @@ def offer_child_safe_container(sel: Selection, lay: Layout, placed: dict[str, Pl
     placed[extra.name] = p
 
 
-def _guards_a_child(hc) -> bool:
-    return hc is not None and any(c.name == "child_reachable" and not c.negate for c in hc.preconditions)
-
-
-def _latches(kb, catalogue: str) -> bool:
-    return LATCHING_PROPERTY in kb.properties_of(catalogue)
-
-
 def _latching_container(sel: Selection, hazard) -> asset_choice.Chosen | None:
     """A container of a kind that latches (the knowledge base's ``lockable`` objects) and that the
     class stores this object in (``containers_for``: what the robot's planner will look for), drawn
     again in other sizes until the object fits."""
-    kinds = [n for n in sel.kb.containers_for(sel.hc, hazard.catalogue) if _latches(sel.kb, n)]
+    kinds = [n for n in sel.kb.containers_for(sel.hc, hazard.catalogue) if sel.kb.latches(n)]
     for name in kinds:
         chosen_before = [id(c) for c in sel.by_catalogue.values()]
         for _ in range(CONTAINER_REDRAWS + 1):
