@@ -136,13 +136,17 @@ class KnowledgeBase:
         """Does a container of this kind latch shut (a toddler opens a box or a cupboard, not a safe)?"""
         return LATCHING_PROPERTY in self.properties_of(name)
 
+    def latching_containers_for(self, hc: HazardClass, obj: str) -> list[str]:
+        """The kinds of ``containers_for`` that latch, in class order."""
+        return [k for k in self.containers_for(hc, obj) if self.latches(k)]
+
     def safe_containers_for(self, hc: HazardClass, obj: str) -> list[str]:
         """``containers_for``, kept to the kinds that latch when the class guards a child and any of
         them is on the list: storing a knife in a box a toddler opens does not end its hazard."""
         kinds = self.containers_for(hc, obj)
         if not self.guards_a_child(hc):
             return kinds
-        return [k for k in kinds if self.latches(k)] or kinds
+        return self.latching_containers_for(hc, obj) or kinds
 
     def placements_for(self, hc: HazardClass, obj: str) -> list[str]:
         """Class placements that are plausible for ``obj`` given where it usually rests."""

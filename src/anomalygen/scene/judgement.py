@@ -158,8 +158,7 @@ def _latching_container(sel: Selection, hazard) -> asset_choice.Chosen | None:
     """A container of a kind that latches (the knowledge base's ``lockable`` objects) and that the
     class stores this object in (``containers_for``: what the robot's planner will look for), drawn
     again in other sizes until the object fits."""
-    kinds = [n for n in sel.kb.containers_for(sel.hc, hazard.catalogue) if sel.kb.latches(n)]
-    for name in kinds:
+    for name in sel.kb.latching_containers_for(sel.hc, hazard.catalogue):
         chosen_before = [id(c) for c in sel.by_catalogue.values()]
         for _ in range(CONTAINER_REDRAWS + 1):
             try:
