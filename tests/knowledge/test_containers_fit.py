@@ -41,3 +41,14 @@ def test_each_objects_containers_can_hold_it_at_its_smallest():
 def test_the_check_sees_a_containers_real_opening(container):
     kb = load_kb()
     assert 0.1 < _roomiest(kb, container) < kb.objects[container].size_range[1]
+
+
+def test_a_class_that_guards_a_child_offers_only_containers_that_latch():
+    """The brainstormed fix must end the hazard: a knife "locked in the storage box" is still a
+    toddler's; the litter class, which guards no child, keeps its open bins."""
+    kb = load_kb()
+    sharp, litter = kb.hazard_classes["keep_sharp_away_from_children"], kb.hazard_classes["pick_up_floor_litter"]
+    assert kb.guards_a_child(sharp) and not kb.guards_a_child(litter)
+    assert "storage_box" in kb.containers_for(sharp, "Knife")
+    assert kb.safe_containers_for(sharp, "Knife") == ["Safe"] and kb.latches("Safe")
+    assert kb.safe_containers_for(litter, "wrapper") == kb.containers_for(litter, "wrapper")

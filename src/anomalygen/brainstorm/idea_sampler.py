@@ -159,7 +159,7 @@ class IdeaSampler:
         placement = weighted(rng, placements, self._w("placement", placements))
         rooms = [r for r in hc.rooms if r in kb.objects[hazard].rooms] or list(hc.rooms)
         room = weighted(rng, rooms, self._w("room", rooms))
-        containers = kb.containers_for(hc, hazard)
+        containers = kb.safe_containers_for(hc, hazard)  # the fix the text promises must end the hazard
         container = (target if target in containers else weighted(rng, containers)) if containers else None
         support = None
         if hc.default_supports:

@@ -24,7 +24,7 @@ from anomalygen.knowledge.models import (
     ObjectInfo,
     RoleProfile,
 )
-from anomalygen.schema import HazardCategory, PredicateCall
+from anomalygen.schema import LATCHING_PROPERTY, HazardCategory, PredicateCall
 
 #: Placement -> the support kind an object must usually rest on for it to be plausible.
 PLACEMENT_SUPPORT: dict[str, str] = {
@@ -152,6 +152,26 @@ class KnowledgeBase:
         own = self.objects[obj].containers if obj in self.objects else []
         both = [c for c in hc.default_containers if c in own]
         return both or list(hc.default_containers)
+
+    def guards_a_child(self, hc: HazardClass) -> bool:
+        """Is the class's danger a small child reaching the object (a ``child_reachable`` precondition)?"""
+        return any(c.name == "child_reachable" and not c.negate for c in hc.preconditions)
+
+    def latches(self, name: str) -> bool:
+        """Does a container of this kind latch shut (a toddler opens a box or a cupboard, not a safe)?"""
+        return LATCHING_PROPERTY in self.properties_of(name)
+
+    def latching_containers_for(self, hc: HazardClass, obj: str) -> list[str]:
+        """The kinds of ``containers_for`` that latch, in class order."""
+        return [k for k in self.containers_for(hc, obj) if self.latches(k)]
+
+    def safe_containers_for(self, hc: HazardClass, obj: str) -> list[str]:
+        """``containers_for``, kept to the kinds that latch when the class guards a child and any of
+        them is on the list: storing a knife in a box a toddler opens does not end its hazard."""
+        kinds = self.containers_for(hc, obj)
+        if not self.guards_a_child(hc):
+            return kinds
+        return self.latching_containers_for(hc, obj) or kinds
 
     def placements_for(self, hc: HazardClass, obj: str) -> list[str]:
         """Class placements that are plausible for ``obj`` given where it usually rests."""

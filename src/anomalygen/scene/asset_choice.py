@@ -62,6 +62,9 @@ _ALWAYS_FIXED = {
     "counter",
     "shelf",
     "medicine_cabinet",
+    # a home safe is bolted to the floor (its makers ship the anchors): loose, an 18 kg safe of 37 cm
+    # tipped onto its back when the arm brushed its door, open against its stop
+    "Safe",
 }
 
 

@@ -155,7 +155,7 @@ def select_objects(task: TaskProposal, rng, hints=None) -> Selection:
                 except ItemFailed as exc:
                     others = [c for c in hc.default_containers if c != container_name]
                     raise ItemFailed(f"{exc}: the task names the {container_name}"
-                                     + (f" (the class also stores it in: {', '.join(others)})" if others else "")) from exc
+                                     + (f" (the class's other containers: {', '.join(others)})" if others else "")) from exc
             if hazard.size > room:
                 raise ItemFailed(f"{hazard.catalogue} ({hazard.size:.2f} m) does not fit {container.catalogue} "
                                  f"(room for {room:.2f} m)")

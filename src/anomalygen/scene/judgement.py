@@ -14,7 +14,7 @@ from anomalygen.knowledge import load_kb
 from anomalygen.knowledge.predicates import ROOM_FIXTURES
 from anomalygen.referee.truth import Intent
 from anomalygen.scene import asset_choice, mix
-from anomalygen.scene.casting import Selection
+from anomalygen.scene.casting import CONTAINER_REDRAWS, Selection
 from anomalygen.scene.instances import (
     HAZARD_NEAR_SIDE,
     INWARD,
@@ -25,7 +25,7 @@ from anomalygen.scene.instances import (
     surface_of,
 )
 from anomalygen.scene.layout import Layout, Placed
-from anomalygen.schema import LATCHING_PROPERTY, ObjectRole, ValidationCheck, ValidationReport, part_labels
+from anomalygen.schema import ObjectRole, ValidationCheck, ValidationReport, part_labels
 
 
 def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed], surfaces: list[Placed],
@@ -107,9 +107,7 @@ def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], 
     surface, else on the floor beside a piece of furniture, out of the walkway. For a class whose
     danger is a child reaching it, only a container that latches keeps it safe (a toddler opens a
     cupboard or a box): such a container is added when the task's own does not latch."""
-    hazard, container = sel.hazard, sel.container
-    if _guards_a_child(sel.hc) and (container is None or not _latches(sel.kb, container.catalogue)):
-        container = _latching_container(sel, hazard) or container
+    hazard, container = sel.hazard, child_safe_container(sel) or sel.container
     hp = placed[hazard.name] = placed_instance(hazard)
     if container is not None and container is not hazard and container.asset.cavities:
         holder = placed.get(container.name)
@@ -129,24 +127,49 @@ def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], 
     lay.place_beside(hp, room_fixtures(sel.kb, lay))
 
 
-def _guards_a_child(hc) -> bool:
-    return hc is not None and any(c.name == "child_reachable" and not c.negate for c in hc.preconditions)
+def child_safe_container(sel: Selection) -> asset_choice.Chosen | None:
+    """For a class whose danger is a child reaching the object, a container that latches and that the
+    object fits: the task's own when it latches, else one of the knowledge base's ``lockable`` kinds.
+    None for any other class, or when no latching kind fits."""
+    if sel.hc is None or not sel.kb.guards_a_child(sel.hc) or sel.hazard.fixed:  # a window the child leans out of is shut, not stored
+        return None
+    if sel.container is not None and sel.kb.latches(sel.container.catalogue):
+        return sel.container
+    return _latching_container(sel, sel.hazard)
 
 
-def _latches(kb, catalogue: str) -> bool:
-    return LATCHING_PROPERTY in kb.properties_of(catalogue)
+def offer_child_safe_container(sel: Selection, lay: Layout, placed: dict[str, Placed]) -> None:
+    """Stand a latching container on the floor, facing the robot, in a scene whose hazard endangers a
+    child and whose task names no container that latches (a toddler opens a box or a cupboard): an
+    extra object, the task's own container stays. Left out, with the scene as it was, when none fits."""
+    extra = child_safe_container(sel)
+    if extra is None or extra is sel.container or extra.name in placed:
+        return
+    p = placed_instance(extra)
+    try:
+        lay.place_on_floor(p, relevant=True, face=True)
+    except ItemFailed:
+        sel.forget(extra)
+        return
+    placed[extra.name] = p
 
 
 def _latching_container(sel: Selection, hazard) -> asset_choice.Chosen | None:
-    """A container of a kind that latches (the knowledge base's ``lockable`` objects) the object fits in."""
-    for name in sorted(n for n in sel.kb.objects if _latches(sel.kb, n)):
-        try:
-            cand = sel.choose(name, ObjectRole.CONTAINER)
-        except (ItemFailed, KeyError):
-            continue
-        if cand.asset.cavities and hazard.size <= container_room(cand.asset):
-            return cand
-        sel.forget(cand)
+    """A container of a kind that latches (the knowledge base's ``lockable`` objects) and that the
+    class stores this object in (``containers_for``: what the robot's planner will look for), drawn
+    again in other sizes until the object fits."""
+    for name in sel.kb.latching_containers_for(sel.hc, hazard.catalogue):
+        chosen_before = [id(c) for c in sel.by_catalogue.values()]
+        for _ in range(CONTAINER_REDRAWS + 1):
+            try:
+                cand = sel.choose(name, ObjectRole.CONTAINER)
+            except (ItemFailed, KeyError):
+                break
+            if cand.asset.cavities and hazard.size <= container_room(cand.asset):
+                return cand
+            if id(cand) in chosen_before:  # the scene's own safe (the task's target) keeps its size
+                break
+            sel.forget(cand)
     return None
 
 

@@ -23,7 +23,12 @@ from anomalygen.scene.instances import (
     placed_support,
     surface_of,
 )
-from anomalygen.scene.judgement import place_hazard_safely, place_judgement_items, room_fixtures
+from anomalygen.scene.judgement import (
+    offer_child_safe_container,
+    place_hazard_safely,
+    place_judgement_items,
+    room_fixtures,
+)
 from anomalygen.scene.layout import Layout, Placed, face_robot_yaw, reached_from_front
 from anomalygen.schema import ObjectRole
 
@@ -93,6 +98,9 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
     if hazard.fixed and hazard.name not in placed:
         p = placed[hazard.name] = placed_instance(hazard)
         lay.place_on_floor(p, relevant=True, face=True)
+
+    if not sel.hazard_free:
+        offer_child_safe_container(sel, lay, placed)
 
     if hazard.name not in placed:
         if sel.hazard_free:
