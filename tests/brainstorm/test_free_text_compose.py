@@ -58,16 +58,14 @@ def test_a_line_no_mechanism_covers_is_refused_with_a_reason(reader, line, reaso
         reader.compose(line)
 
 
-def test_one_bad_line_fails_alone_and_an_object_without_an_asset_says_so():
+def test_one_bad_line_fails_alone_and_the_power_strip_in_a_full_sink_is_built_as_stated():
     lines = ["A chef's knife was left at the edge of the kitchen counter.",
              "Shards of a broken glass are scattered on the kitchen floor.",
              "A power strip is lying in the bathroom sink, which is full of water.",
              "Grandma's pill bottle was left on the low coffee table."]
     tasks, errors = tasks_from_lines(lines, load_kb())
-    assert [t.scenario.hazard_object for t in tasks] == ["kitchen_knife", "pill_bottle"]
-    assert set(errors) == {"line2", "line3"}
-    assert "broken" in errors["line2"]
-    from anomalygen.brainstorm.drawable import catalogue
-
-    if "PowerStrip" not in catalogue():  # until the asset lands, the line cannot be built and says so
-        assert "no asset" in errors["line3"] and "PowerStrip" in errors["line3"]
+    assert [t.scenario.hazard_object for t in tasks] == ["kitchen_knife", "PowerStrip", "pill_bottle"]
+    assert set(errors) == {"line2"} and "broken" in errors["line2"]
+    strip = tasks[1]
+    assert (strip.scenario.placement, strip.scenario.room) == ("inside:Sink", "bathroom")
+    assert strip.scenario.states == {"Sink": ["contains_water"]}

@@ -177,13 +177,31 @@ def test_offline_planner_picks_sac_for_switch_off_per_knob_that_is_on():
         "t", "close_open_refrigerator", {"$target": "fridge_0"}).subtasks)
 
 
-def test_take_off_is_a_pick_and_a_place_and_unbound_variables_fail():
+def test_relocations_are_their_registered_skills_and_unbound_variables_fail():
+    """take_off, move_away and rotate_inward are one scripted skill each (``skills/scripted/relocate.py``),
+    their arguments resolved to instances; standing an iron upright has no skill yet and says so."""
     plan = plan_from_kb("t", "clear_burning_risk_off_heat_source",
                         {"$hazard": "towel_0", "$source": "stove_0", "$support": "counter_0"})
-    assert [(s.primitive, s.params.get("object")) for s in plan.subtasks] == [
-        ("push", "stove_0"), ("grasp", "towel_0"), ("move_to", "towel_0")]
-    assert plan.subtasks[-1].params["region"] == "counter_0"
+    assert [(s.primitive, s.params.get("object")) for s in plan.subtasks] == [("push", "stove_0"), ("take_off", "towel_0")]
+    assert plan.subtasks[-1].params["support"] == "counter_0"
+    assert [c.name for c in plan.subtasks[-1].success.predicates] == ["on"]  # the class's check on this step's objects
+    away = plan_from_kb("t", "move_candle_away_from_fabric", {"$hazard": "candle_0", "$fuel": "curtains_0"}).subtasks
+    assert [(s.primitive, s.params) for s in away] == [
+        ("move_away", {"object": "candle_0", "from": "curtains_0", "distance": 0.9})]
+    turn = plan_from_kb("t", "turn_pan_handle_inward", {"$hazard": "pot_0"}).subtasks
+    assert [(s.primitive, s.params) for s in turn] == [("rotate_inward", {"object": "pot_0"})]
     with pytest.raises(ItemFailed, match=r"\$source is not bound"):
         plan_from_kb("t", "clear_burning_risk_off_heat_source", {"$hazard": "towel_0", "$support": "counter_0"})
-    with pytest.raises(ItemFailed, match="no skill for rotate_inward yet"):
-        plan_from_kb("t", "turn_pan_handle_inward", {"$hazard": "pot_0"})
+    with pytest.raises(ItemFailed, match="no skill for stand_upright yet"):
+        plan_from_kb("t", "stand_iron_upright", {"$hazard": "iron_0"})
+
+
+def test_brainstorm_draws_the_relocation_classes_and_says_why_not_the_upright_iron():
+    from anomalygen.brainstorm.drawable import drawable, why_not_drawable
+
+    kb = load_kb()
+    for cid in ("turn_pan_handle_inward", "move_candle_away_from_fabric", "clear_item_from_stairs",
+                "clear_burning_risk_off_heat_source", "close_baby_gate"):
+        assert drawable(kb, kb.hazard_classes[cid]), why_not_drawable(kb, kb.hazard_classes[cid])
+    assert why_not_drawable(kb, kb.hazard_classes["stand_iron_upright"]) == (
+        "no skill for stand_upright yet: stand_iron_upright's fix needs it")

@@ -103,8 +103,8 @@ def test_a_users_own_line_is_never_hazard_free_nor_given_a_second_hazard():
 
 
 def test_near_placements_build_the_composed_hazard_and_bind_its_other_object(tmp_path):
-    """'near:<name>': a cleaner on the bread's counter within reach of it, and a candle's flame as a
-    state; the composed class's other variable is bound in the scene's bindings."""
+    """'near:<name>': a cleaner on the bread's counter within reach of it, and a candle's flame read
+    from its control; the composed class's other variable is bound in the scene's bindings."""
     from anomalygen.knowledge.predicates import match_class
     from anomalygen.runfolder import read_model
     from anomalygen.scene.build import build_scene
@@ -122,5 +122,6 @@ def test_near_placements_build_the_composed_hazard_and_bind_its_other_object(tmp
         {"$hazard": spec.bindings["$hazard"], "$food": food}]
     candle = make_task("t-candle", "move_hot_item_from_edge", "Table", "candle", "table_edge")
     build_scene(candle, seed=0, settings=settings, out_dir=tmp_path / "c")
-    lit = read_model(tmp_path / "c" / "scene_graph.json", SceneGraph)
-    assert next(o for o in lit.objects if o.category == "candle").states == ["lit"]
+    snuffed = read_model(tmp_path / "c" / "scene_graph.json", SceneGraph)
+    # a candle's flame is its snuffer control: off unless the class asks for it lit (is_on / has_state lit)
+    assert next(o for o in snuffed.objects if o.category == "candle").states == ["off"]

@@ -91,13 +91,6 @@ def has_interior(obj: str) -> bool:
     return bool(generate(obj, 0).cavities)
 
 
-@functools.cache
-def _plannable(actions: tuple[str, ...]) -> bool:
-    from anomalygen.plan.planner import plannable
-
-    return all(plannable(a) for a in actions)
-
-
 def hazards_for(kb: KnowledgeBase, hc: HazardClass) -> list[str]:
     """The class's hazard candidates that have an asset and can show the states asked of them."""
     states = needed_states(kb, hc).get(hc.hazard_variable, [])
@@ -121,28 +114,38 @@ def placements_for(kb: KnowledgeBase, hc: HazardClass, hazard: str) -> list[str]
     return out
 
 
-_DRAWABLE: dict[tuple[int, str], bool] = {}
+_WHY_NOT: dict[tuple[int, str], str | None] = {}
 
 
 def drawable(kb: KnowledgeBase, hc: HazardClass) -> bool:
     """Can a proposal of ``hc`` be built and its fix planned with today's assets, builder and skills?"""
+    return why_not_drawable(kb, hc) is None
+
+
+def why_not_drawable(kb: KnowledgeBase, hc: HazardClass) -> str | None:
+    """None when ``hc`` can be drawn, else what is missing (a skill, an asset, a placement)."""
     key = (id(kb), hc.id)
-    if key not in _DRAWABLE:
-        _DRAWABLE[key] = _drawable(kb, hc)
-    return _DRAWABLE[key]
+    if key not in _WHY_NOT:
+        _WHY_NOT[key] = _why_not(kb, hc)
+    return _WHY_NOT[key]
 
 
-def _drawable(kb: KnowledgeBase, hc: HazardClass) -> bool:
-    if not _plannable(tuple(step.action for step in hc.recipe)):
-        return False
+def _why_not(kb: KnowledgeBase, hc: HazardClass) -> str | None:
+    from anomalygen.plan.planner import plannable
+
+    missing = [step.action for step in hc.recipe if not plannable(step.action)]
+    if missing:
+        return f"no skill for {missing[0]} yet: {hc.id}'s fix needs it"
     cat = catalogue()
     if hc.default_containers and not any(c in cat for c in hc.default_containers):
-        return False
+        return f"no asset for any of {hc.id}'s containers ({', '.join(hc.default_containers)})"
     if hc.default_supports and not any(s in cat for s in hc.default_supports):
-        return False
+        return f"no asset for any of {hc.id}'s supports ({', '.join(hc.default_supports)})"
     var = relation_variable(hc)
     others = [v for v in hc.variable_names() if v not in (hc.hazard_variable, var)]
     for v in others:  # a co-object plays it (the fume source of a stuffy room)
         if v != "$target" and not [o for o in kb.static_candidates(hc, v) if o in cat]:
-            return False
-    return any(placements_for(kb, hc, h) for h in hazards_for(kb, hc))
+            return f"no asset can play {hc.id}'s {v}"
+    if not any(placements_for(kb, hc, h) for h in hazards_for(kb, hc)):
+        return f"no object of {hc.id} with an asset has a placement (and states) the builder can set up"
+    return None

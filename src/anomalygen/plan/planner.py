@@ -31,7 +31,10 @@ from anomalygen.schema import (
 LIFT_HEIGHT = 0.12  # metres above the start height for a pick
 #: Recipe actions the knowledge base knows but no skill performs yet: a plan with one fails with that
 #: reason rather than doing something else (the skills come with the robot's skill library).
-NO_SKILL_YET = ("move_away", "rotate_inward", "stand_upright")
+NO_SKILL_YET = ("stand_upright",)
+#: Recipe actions that are one registered scripted skill of the same name (``skills/scripted/relocate.py``),
+#: with the step's arguments passed through (variables resolved to instances).
+RELOCATIONS = ("move_away", "take_off", "rotate_inward")
 ROLE_VARIABLES = ("$hazard", "$target", "$container", "$support")  # what the builder binds in SceneSpec.bindings
 CLOSURES = ENCLOSING_LABELS  # part labels that can shut a container, in the order a plan lists them
 LID_PARTS = part_labels.any_of(LID_LABELS)  # the parts close_lid / open_lid act on (a cardboard box has flaps)
@@ -117,7 +120,31 @@ def step_to_subtask(index: int, action: str, args: dict[str, str], bindings: dic
                        success=SuccessSpec(predicates=own))
     if action in ("push_to", "take_out_of", "close_lid", "open_lid"):
         return _handling_subtask(sid, action, obj, args, bindings, own)
+    if action in RELOCATIONS:
+        return _relocation_subtask(sid, action, obj, args, bindings, own)
     raise ItemFailed(f"recipe action {action!r} has no sub-task mapping")
+
+
+def _relocation_subtask(sid: str, action: str, obj: str, args: dict[str, str], bindings: dict[str, str],
+                        own: list[PredicateCall]) -> SubTask:
+    """move_away (from an object, by a distance), take_off (onto a support; the skill picks the nearest
+    safe one when the recipe names none) and rotate_inward (a pan's handle back over its hob)."""
+    params: dict = {"object": obj}
+    terms = [RewardTerm(kind="action_penalty", weight=0.01)]
+    if action == "move_away":
+        params["from"] = _resolve(args["from"], bindings)
+        params["distance"] = float(args["distance"])
+        what = f"move {obj} at least {params['distance']:.2f} m away from {params['from']}"
+    elif action == "take_off":
+        support = _resolve(args.get("support", ""), bindings)
+        if support and not support.startswith("$"):
+            params["support"] = support
+            terms.insert(0, RewardTerm(kind="distance", a=obj, b=support, weight=2.0))
+        what = f"take {obj} off what it lies on and set it on {params.get('support', 'a safe surface')}"
+    else:
+        what = f"turn {obj} so its handle points back over its hob"
+    return SubTask(id=sid, description=what, method=SkillMethod.PRIMITIVE, primitive=action, params=params,
+                   reward=RewardSpec(terms=terms), success=SuccessSpec(predicates=own))
 
 
 def switch_off_subtasks(index: int, args: dict[str, str], bindings: dict[str, str], spec: SceneSpec | None,
@@ -243,12 +270,6 @@ def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, s
     subtasks = []
     for i, step in enumerate(cls.recipe):
         method = SkillMethod.SAC if step.method == "sac" or step.action in sac_actions else SkillMethod.PRIMITIVE
-        if step.action == "take_off":  # off a hob or a stair onto a safe surface: a pick and a place
-            pick = step_to_subtask(i, "pick", {"object": step.args["object"]}, bindings, spec, list(cls.success))
-            place = step_to_subtask(i, "place_on", dict(step.args), bindings, spec, list(cls.success))
-            subtasks += [pick.model_copy(update={"id": f"s{i + 1}_take_off_pick"}),
-                         place.model_copy(update={"id": f"s{i + 1}_take_off_place"})]
-            continue
         if step.action == "switch_off":
             subtasks += switch_off_subtasks(i, dict(step.args), bindings, spec, list(cls.success), method)
             continue
