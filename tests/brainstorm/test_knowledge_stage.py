@@ -1,9 +1,11 @@
-"""The offline engine through the CLI: 111 unique, buildable proposals, reproducible, with provenance."""
+"""The offline engine through the CLI: 111 unique, buildable proposals, reproducible, with provenance.
+
+Its speed is a benchmark figure (docs/benchmarks.md), not a timed assertion: a wall-clock limit fails
+under load on shared machines and says nothing about behaviour."""
 
 from __future__ import annotations
 
 import json
-import time
 
 import pytest
 from typer.testing import CliRunner
@@ -24,15 +26,13 @@ def _brainstorm(out, *extra):
 @pytest.fixture(scope="module")
 def run111(tmp_path_factory):
     out = tmp_path_factory.mktemp("bs") / "x"
-    started = time.perf_counter()
     result = _brainstorm(out, "--n", "111")
-    wall = time.perf_counter() - started
     assert result.exit_code == 0, result.output
-    return out, wall
+    return out
 
 
 def test_111_unique_valid_covering_proposals(run111):
-    out, wall = run111
+    out = run111
     tasks = read_jsonl(out / "tasks.jsonl", TaskProposal)
     kb = load_kb()
     assert len(tasks) == 111
@@ -50,7 +50,6 @@ def test_111_unique_valid_covering_proposals(run111):
         hc = kb.hazard_classes[t.hazard_class]
         assert t.scenario.hazard_object in kb.hazard_candidates(hc)
         assert t.scenario.placement in hc.placements
-    assert wall < 180  # the acceptance target is < 60 s on a quiet 2-core box; CI boxes here are shared
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["stages"]["brainstorm"]["done"] == 111
 
@@ -65,7 +64,7 @@ def test_same_seed_gives_identical_file(tmp_path):
 
 
 def test_later_rounds_cite_other_agents_previous_round(run111):
-    out, _ = run111
+    out = run111
     tasks = {t.id: t for t in read_jsonl(out / "tasks.jsonl", TaskProposal)}
     later = [t for t in tasks.values() if t.provenance.round >= 2]
     assert len(later) >= 60
@@ -85,7 +84,7 @@ def test_later_rounds_cite_other_agents_previous_round(run111):
 
 
 def test_existing_tasks_are_kept_unless_forced(run111, tmp_path):
-    out, _ = run111
+    out = run111
     before = (out / "tasks.jsonl").read_bytes()
     result = _brainstorm(out, "--n", "111", "--json")
     assert result.exit_code == 0
@@ -94,7 +93,7 @@ def test_existing_tasks_are_kept_unless_forced(run111, tmp_path):
 
 
 def test_texts_vary(run111):
-    out, _ = run111
+    out = run111
     tasks = read_jsonl(out / "tasks.jsonl", TaskProposal)
     openings = {" ".join(t.description.split()[:3]) for t in tasks}
     name_shapes = {t.name.split()[0] for t in tasks}
@@ -102,7 +101,7 @@ def test_texts_vary(run111):
 
 
 def test_bring_your_own_tasks(run111, tmp_path):
-    out, _ = run111
+    out = run111
     lines = (out / "tasks.jsonl").read_text().splitlines()[:3]
     good = tmp_path / "mine.jsonl"
     good.write_text("\n".join(lines) + "\n")
@@ -136,7 +135,7 @@ def test_texts_are_diverse_and_well_formed(run111):
     def room_names(room: str) -> list[str]:
         return bank()["room_synonyms"].get(room, [room_words(room)])
 
-    out, _ = run111
+    out = run111
     tasks = read_jsonl(out / "tasks.jsonl", TaskProposal)
     assert self_bleu([f"{t.name} {t.description}" for t in tasks]) < 0.55  # 0.493 at seed 0, 0.48-0.49 at seeds 1-3
     for t in tasks:
