@@ -52,3 +52,24 @@ def test_a_class_that_guards_a_child_offers_only_containers_that_latch():
     assert "storage_box" in kb.containers_for(sharp, "Knife")
     assert kb.safe_containers_for(sharp, "Knife") == ["Safe"] and kb.latches("Safe")
     assert kb.safe_containers_for(litter, "wrapper") == kb.containers_for(litter, "wrapper")
+
+
+@pytest.mark.parametrize(("cls", "obj", "child_cls"), [
+    ("store_sharp_objects", "kitchen_knife", "keep_sharp_away_from_children"),
+    ("manage_chemical_risks", "bleach_bottle", "keep_chemicals_from_children"),
+    ("separate_chemical_from_food", "cleaning_spray", "keep_chemicals_from_children"),
+])
+def test_a_class_that_stores_a_childs_hazard_for_an_adult_adds_the_childs_latching_kinds(cls, obj, child_cls):
+    """Issue 23's leftover: a knife or a bleach bottle put away low in a box a toddler opens fires the
+    child's class, so the referee rejects the fix. The class keeps its own kinds and gains the latching
+    ones of the child's class, which the builder offers and the brainstormed text promises."""
+    kb = load_kb()
+    hc, child = kb.hazard_classes[cls], kb.hazard_classes[child_cls]
+    assert not kb.guards_a_child(hc) and kb.stores_a_child_hazard(hc, obj)
+    own = [c for c in hc.default_containers if c in kb.objects[obj].containers] or hc.default_containers
+    latching = [k for k in kb.containers_for(child, obj) if kb.latches(k)]
+    assert latching and kb.containers_for(hc, obj) == [*own, *latching]
+    assert kb.safe_containers_for(hc, obj) == kb.latching_containers_for(hc, obj) == latching
+    tripping = kb.hazard_classes["reduce_tripping_hazards"]  # a shoe is nobody's toddler hazard
+    assert not kb.stores_a_child_hazard(tripping, "shoe")
+    assert kb.safe_containers_for(tripping, "shoe") == kb.containers_for(tripping, "shoe")

@@ -65,9 +65,10 @@ def test_stored_shears_go_where_no_other_class_fires_on_them():
     by = {o.name: o for o in g.objects}
     store = kb.hazard_classes["store_sharp_objects"]
     assert {"Box", "StorageFurniture"} <= set(kb.containers_for(store, "Scissors"))
-    # the class's own containers (boxes, cabinets) all leave them within reach: the nearest that stores them
-    assert "Safe" not in kb.containers_for(store, "Scissors")
-    assert choose_container(store, shears, g, kb) == "box_0"
+    # the class's own containers (boxes, cabinets) all leave them within a child's reach, so the child's
+    # class's latching kind joins them (KnowledgeBase.containers_for) and the safe is chosen
+    assert kb.containers_for(store, "Scissors")[-1] == "Safe"
+    assert choose_container(store, shears, g, kb) == "safe_0"
     assert not ends_hazard(list(kb.hazard_classes.values()), shears, by["box_0"], g)
     assert not ends_hazard(list(kb.hazard_classes.values()), shears, by["storagefurniture_0"], g)
     assert ends_hazard(list(kb.hazard_classes.values()), shears, by["safe_0"], g)

@@ -42,9 +42,11 @@ def test_a_lighter_for_the_storage_box_gets_a_safe_beside_the_box(tmp_path):
     assert lighter.size <= 2 * max(safe.cavities[0].half_extents)
 
 
-@pytest.mark.parametrize("cls", ["store_sharp_objects"])
-def test_a_class_with_no_child_at_risk_gets_no_extra_container(tmp_path, cls):
-    task = make_task("t-knife-box", cls, "Table", "kitchen_knife", "table", container="storage_box")
+def test_a_class_storing_no_childs_hazard_gets_no_extra_container(tmp_path):
+    """A shoe put away in a basket is no toddler's hazard; a knife stored for an adult's sake is (its
+    scene gets a safe too: tests/referee/test_open_world_combos.py)."""
+    task = make_task("t-shoe-basket", "reduce_tripping_hazards", "Table", "shoe", "walkway", container="basket",
+                     room="hallway")
     assert _latching(_build(task, tmp_path)) == []
 
 

@@ -61,11 +61,13 @@ class KnowledgeBase:
         #: groups of objects a perceiver can mistake for one another (``lookalikes.json``)
         self.lookalike_groups: list[list[str]] = [list(g) for g in lookalike_groups or []]
         self._candidates: dict[tuple[str, str], list[str]] = {}
+        self._child_classes: dict[str, list[HazardClass]] = {}
 
     def add_composed(self, composed: list[HazardClass]) -> None:
         """Add the classes composed from mechanisms: a legacy row only tags its hand-written class with
         its composition; every other row is a class of its own, with ``near:{other}``-style placements
         spelled out over the objects that can fill the related variable."""
+        self._child_classes.clear()
         for hc in composed:
             own = self.hazard_classes.get(hc.id)
             if hc.composition is not None and hc.composition.legacy and own is not None:
@@ -146,12 +148,36 @@ class KnowledgeBase:
         return able
 
     def containers_for(self, hc: HazardClass, obj: str) -> list[str]:
-        """Where ``obj`` can be put away for class ``hc``: class defaults the object fits, in class order."""
+        """Where ``obj`` can be put away for class ``hc``: class defaults the object fits, in class order.
+
+        When the stored object is a small child's hazard as well (a knife, a cleaner: ``stores_a_child_hazard``)
+        and the class names no kind that latches, the latching kinds the child's classes store it in
+        follow: a knife put away low in a box a toddler opens fires the child's class, so the referee
+        rightly rejects that fix, and the builder and planner must have a latching one to use."""
+        kinds = self._own_containers(hc, obj)
+        if not kinds or any(self.latches(k) for k in kinds) or not self.stores_a_child_hazard(hc, obj):
+            return kinds
+        extra = [k for g in self._child_classes_of(obj) for k in self._own_containers(g, obj) if self.latches(k)]
+        return [*kinds, *dict.fromkeys(k for k in extra if k not in kinds)]
+
+    def _own_containers(self, hc: HazardClass, obj: str) -> list[str]:
         if not hc.default_containers:
             return []
         own = self.objects[obj].containers if obj in self.objects else []
         both = [c for c in hc.default_containers if c in own]
         return both or list(hc.default_containers)
+
+    def _child_classes_of(self, obj: str) -> list[HazardClass]:
+        """The classes guarding a small child that ``obj`` can be the hazard of."""
+        if obj not in self._child_classes:
+            self._child_classes[obj] = [g for g in self.hazard_classes.values()
+                                        if self.guards_a_child(g) and obj in self.hazard_candidates(g)]
+        return self._child_classes[obj]
+
+    def stores_a_child_hazard(self, hc: HazardClass, obj: str) -> bool:
+        """Must ``hc``'s fix shut ``obj`` away from a toddler: the class guards a child, or ``obj`` is the
+        hazard of a class that does (then a box or cupboard the child opens is no place for it)."""
+        return self.guards_a_child(hc) or bool(self._child_classes_of(obj))
 
     def guards_a_child(self, hc: HazardClass) -> bool:
         """Is the class's danger a small child reaching the object (a ``child_reachable`` precondition)?"""
@@ -166,10 +192,10 @@ class KnowledgeBase:
         return [k for k in self.containers_for(hc, obj) if self.latches(k)]
 
     def safe_containers_for(self, hc: HazardClass, obj: str) -> list[str]:
-        """``containers_for``, kept to the kinds that latch when the class guards a child and any of
-        them is on the list: storing a knife in a box a toddler opens does not end its hazard."""
+        """``containers_for``, kept to the kinds that latch when the stored object is a child's hazard
+        and any of them is on the list: storing a knife in a box a toddler opens does not end its hazard."""
         kinds = self.containers_for(hc, obj)
-        if not self.guards_a_child(hc):
+        if not self.stores_a_child_hazard(hc, obj):
             return kinds
         return self.latching_containers_for(hc, obj) or kinds
 

@@ -128,10 +128,11 @@ def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], 
 
 
 def child_safe_container(sel: Selection) -> asset_choice.Chosen | None:
-    """For a class whose danger is a child reaching the object, a container that latches and that the
-    object fits: the task's own when it latches, else one of the knowledge base's ``lockable`` kinds.
-    None for any other class, or when no latching kind fits."""
-    if sel.hc is None or not sel.kb.guards_a_child(sel.hc) or sel.hazard.fixed:  # a window the child leans out of is shut, not stored
+    """For a class whose fix must shut the object away from a child (``KnowledgeBase.stores_a_child_hazard``:
+    the class guards a child, or it stores a knife or a cleaner a child's class guards against), a
+    container that latches and that the object fits: the task's own when it latches, else one of the
+    knowledge base's ``lockable`` kinds. None for any other class, or when no latching kind fits."""
+    if sel.hc is None or not sel.kb.stores_a_child_hazard(sel.hc, sel.hazard.catalogue) or sel.hazard.fixed:  # a window the child leans out of is shut, not stored
         return None
     if sel.container is not None and sel.kb.latches(sel.container.catalogue):
         return sel.container
