@@ -29,23 +29,20 @@ COMBOS = [
     ("A towel is lying on the lit stove burner in the kitchen.", "clear_burning_risk_off_heat_source", "towel"),
     ("Paper towels are lying on the lit stove burner.", "clear_burning_risk_off_heat_source", "PaperTowels"),
     ("A towel lies right next to the lit stove in the kitchen.", "clear_burning_risk_near_heat_source", "towel"),
-    ("A power strip is lying in the kitchen sink, which is full of water.", "take_electrical_out_of_water",
-     "PowerStrip"),
-    ("An iron was left switched on on the bedroom floor.", "switch_off_tool_on_floor", "iron"),
     ("The space heater is on right next to the curtains in the bedroom.", "switch_off_heater_near_fabric",
      "SpaceHeater"),
     ("A ball was left on the stairs in the hallway.", "clear_item_from_stairs", "ball"),
-    ("A frying pan is on the stove with its handle sticking out over the edge.", "turn_pan_handle_inward",
-     "frying_pan"),
     ("A hair dryer that is on sits next to the full bathtub.", "move_electrical_away_from_water", "hair_dryer"),
-    ("A ball is lying in the crib in the nursery.", "clear_soft_things_from_crib", "ball"),
-    ("A dumbbell sits on a high shelf in the living room.", "take_heavy_item_down", "dumbbell"),
+    ("A power strip lies right next to the full kitchen sink.", "move_electrical_away_from_water", "PowerStrip"),
     ("The baby gate at the stairs was left open in the hallway.", "close_baby_gate", "BabyGate"),
     ("A lit candle stands next to the curtains in the living room.", "move_candle_away_from_fabric", "candle"),
-    ("A toy car lies next to the crib in the nursery.", "choking_near_crib", "toy_car"),
+    ("A lit candle stands next to the paper towels in the kitchen.", "move_candle_away_from_fabric", "candle"),
     ("A hair dryer was left on on the bathroom counter.", "switch_off_heat_tool", "hair_dryer"),
     ("A cleaning spray stands next to the bread loaf on the kitchen counter.", "separate_chemical_from_food",
      "cleaning_spray"),
+    ("The tap of the kitchen sink was left running.", "turn_off_running_tap", "Sink"),
+    ("The bathtub tap was left running.", "turn_off_running_tap", "Bathtub"),
+    ("A bottle of cleaning spray was put in the fridge.", "remove_chemical_from_fridge", "cleaning_spray"),
 ]
 
 
@@ -70,10 +67,10 @@ def tasks():
     from anomalygen.brainstorm.free_text import tasks_from_lines
     from anomalygen.knowledge import load_kb
 
-    lines = [line for line, _, _ in COMBOS]
-    read, errors = tasks_from_lines(lines, load_kb())
-    assert errors == {}
-    out = dict(zip(lines, read, strict=True))
+    out = {}
+    for line, _, _ in COMBOS:  # one file per line: a task's id (and so its scene) does not move with the list
+        (out[line],), errors = tasks_from_lines([line], load_kb())
+        assert errors == {}
     for cls, obj, placement, container in STORED:
         out[cls] = make_task(f"t-{cls}", cls, "Table", obj, placement, container=container)
     return out
@@ -104,7 +101,7 @@ def _plan_from_detection(task_id, scene_dir, detection, settings):
     return plan.model_copy(update={"subtasks": scripted})
 
 
-@pytest.mark.parametrize(("line", "hazard_class", "category"), COMBOS, ids=[c[1] + "-" + c[2] for c in COMBOS])
+@pytest.mark.parametrize(("line", "hazard_class", "category"), COMBOS, ids=[f"{c[1]}-{c[2]}-{i}" for i, c in enumerate(COMBOS)])
 def test_built_detected_and_resolved(tasks, scenes, tmp_path, line, hazard_class, category):
     task, scene_dir = _built(tasks, scenes, line)
     assert task.hazard_class == hazard_class and task.source == "user_text"
