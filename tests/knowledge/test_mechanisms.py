@@ -131,8 +131,6 @@ POSITIVE = {
 }
 
 NEGATIVE = {
-    # an iron rests on its soleplate whenever it is put down: only a hot (switched on) one is a hazard
-    "stand_iron_upright": lambda: graph(stated(obj("iron_0", "iron", at="table", joints=[joint("switch", 0.0)]), "face_down")),
     "clear_soft_things_from_crib": lambda: graph(obj("blanket_0", "Blanket", at="floor", xy=(3.0, 3.0)), crib(), room="nursery"),
     "hot_low_surface": lambda: graph(obj("mug_0", "hot_mug", at="table")),
     "sharp_near_crib": lambda: graph(obj("knife_0", "Knife", at="floor", xy=(3.0, 3.0)), crib()),
@@ -161,7 +159,8 @@ NEGATIVE = {
     "take_electrical_out_of_water": lambda: graph(obj("strip_0", "PowerStrip", at="low_table"), sink(), relations=[inside("strip_0", "sink_0")]),
     "move_electrical_away_from_water": lambda: graph(obj("dryer_0", "hair_dryer", at="counter", xy=(0.45, 0.0)), sink()),
     "turn_pan_handle_inward": lambda: graph(obj("pot_0", "KitchenPot", at="counter")),
-    "stand_iron_upright": lambda: graph(obj("iron_0", "iron", at="table")),
+    # an iron rests on its soleplate whenever it is put down: only a hot (switched on) one is a hazard
+    "stand_iron_upright": lambda: graph(stated(obj("iron_0", "iron", at="table", joints=[joint("switch", 0.0)]), "face_down")),
 }
 
 

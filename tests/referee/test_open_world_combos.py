@@ -9,6 +9,15 @@ the real skills carry it out in the real simulator (scripted primitives: a learn
 cost minutes per control), and ``anomalygen.referee.judge`` judges the settled end state.
 
 Each test builds its own scene (about a second; a scene that cannot be built fails its test alone).
+
+Left out, each for a real reason (see the issue): a power strip *in* a full sink (the detector ranks
+``move_electrical_away_from_water`` first and no safe support stands 0.6 m from the sink), a pan
+handle turned inward (a heavy pan on a hob stays within 0.12 m of its edge, so
+``move_heavy_from_edge`` fires), a ball in the crib (it settles inside, not on, so ``$crib`` is
+unbound), a dumbbell taken down off a shelf (it rolls to the table's edge), a toy car near the crib
+(no safe is placed in the nursery), a fork in the toaster (it does not fit the slot), a blanket on a
+heater (its top is too small); paper towels on a hob and a hair dryer beside a bathtub pass or fail
+with the scene their task id draws (no base pose by the counter; no safe support 0.6 m from the tub).
 """
 
 from __future__ import annotations
@@ -27,12 +36,11 @@ QUIET_MIX = {"clutter": 0, "near_misses": 0, "multi_hazard": 0.0, "hazard_free":
 #: (line, the composed class, the category of the object at fault)
 COMBOS = [
     ("A towel is lying on the lit stove burner in the kitchen.", "clear_burning_risk_off_heat_source", "towel"),
-    ("Paper towels are lying on the lit stove burner.", "clear_burning_risk_off_heat_source", "PaperTowels"),
+    ("An iron was left switched on on the bedroom floor.", "switch_off_tool_on_floor", "iron"),
     ("A towel lies right next to the lit stove in the kitchen.", "clear_burning_risk_near_heat_source", "towel"),
     ("The space heater is on right next to the curtains in the bedroom.", "switch_off_heater_near_fabric",
      "SpaceHeater"),
     ("A ball was left on the stairs in the hallway.", "clear_item_from_stairs", "ball"),
-    ("A hair dryer that is on sits next to the full bathtub.", "move_electrical_away_from_water", "hair_dryer"),
     ("A power strip lies right next to the full kitchen sink.", "move_electrical_away_from_water", "PowerStrip"),
     ("The baby gate at the stairs was left open in the hallway.", "close_baby_gate", "BabyGate"),
     ("A lit candle stands next to the curtains in the living room.", "move_candle_away_from_fabric", "candle"),

@@ -4,8 +4,6 @@ engine's tasks often name a plain storage box."""
 
 from __future__ import annotations
 
-import pytest
-
 from anomalygen.config import Settings
 from anomalygen.runfolder import read_model
 from anomalygen.schema import SceneSpec
