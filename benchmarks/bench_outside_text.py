@@ -19,7 +19,7 @@ was developed on dev only) and per source.
 ``--build`` also runs the composed, buildable lines through the pipeline (build, detect with rules,
 plan from perception, learn) and counts built, detected and resolved by the referee's verdict.
 
-    .venv/bin/python benchmarks/bench_outside_text.py [--half dev|held_out|all] [--build --out DIR] [--json]
+    .venv/bin/python benchmarks/bench_outside_text.py [--half dev|held_out|all] [--build --out DIR --workers N] [--json]
 """
 
 from __future__ import annotations
@@ -98,21 +98,23 @@ def table(results: list[dict]) -> dict:
 
 
 def verdicts(run_dir: Path) -> dict[str, bool]:
-    """The referee's verdict per task (resolved or not), read from the learn stage's results.
-
-    The one place that knows where verdicts live: point it at ``anomalygen.referee`` once that lands."""
-    from anomalygen.evaluate.run_metrics import load_skill_results
+    """The referee's verdict per task (resolved on any seed), from the judge stage's verdict files."""
+    from anomalygen.referee import load_verdict
     from anomalygen.runfolder import RunFolder
 
+    folder = RunFolder(run_dir)
     out: dict[str, bool] = {}
-    for r in load_skill_results(RunFolder(run_dir)):
-        if r.outcome is not None:
-            out[r.task_id] = out.get(r.task_id, False) or r.outcome.resolved
+    for t in folder.load_tasks():
+        seeds = sorted(int(p.name.removeprefix("seed")) for p in (folder.skills_dir / t.id).glob("seed*"))
+        found = [v for v in (load_verdict(folder, t.id, k) for k in seeds) if v is not None]
+        if found:
+            out[t.id] = any(v.resolved for v in found)
     return out
 
 
-def run_pipeline(lines: list[str], out: Path) -> dict:
-    """brainstorm --tasks-text, build, detect (rules), plan and learn from perception; counts per stage."""
+def run_pipeline(lines: list[str], out: Path, workers: int = 1) -> dict:
+    """brainstorm --tasks-text, build, detect (rules), plan and learn from perception, then the referee's
+    judge stage; counts per stage."""
     from anomalygen.evaluate.run_metrics import load_detections, load_manifests
     from anomalygen.runfolder import RunFolder
 
@@ -121,9 +123,10 @@ def run_pipeline(lines: list[str], out: Path) -> dict:
     text.write_text("\n".join(lines) + "\n", encoding="utf-8")
     exe = str(Path(sys.executable).with_name("anomalygen"))
     run = out / "run"
+    par = ["--workers", str(workers)]
     steps = [["brainstorm", "--engine", "knowledge", "--out", str(run), "--tasks-text", str(text)],
-             ["build", "--run", str(run)], ["detect", "--run", str(run), "--detector", "rules"],
-             ["plan", "--run", str(run)], ["learn", "--run", str(run)]]
+             ["build", "--run", str(run), *par], ["detect", "--run", str(run), "--detector", "rules"],
+             ["plan", "--run", str(run)], ["learn", "--run", str(run), *par], ["judge", "--run", str(run), *par]]
     for args in steps:
         subprocess.run([exe, *args, "--quiet"], check=False)
     folder = RunFolder(run)
@@ -148,6 +151,7 @@ def main() -> None:
     ap.add_argument("--half", choices=["dev", "held_out", "all"], default="all")
     ap.add_argument("--build", action="store_true", help="also build, detect, plan and learn the composed lines")
     ap.add_argument("--out", type=Path, default=Path("runs/outside_text"))
+    ap.add_argument("--workers", type=int, default=1, help="worker processes of each pipeline stage (--build)")
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--lines", action="store_true", help="print every line's outcome")
     args = ap.parse_args()
@@ -174,7 +178,7 @@ def main() -> None:
     if args.build:
         buildable = [r["line"] for r in results if r["verdict"] == "faithful" and r["outcome"] == "composed"
                      and not r.get("needs_assets")]
-        report["pipeline"] = run_pipeline(buildable, args.out)
+        report["pipeline"] = run_pipeline(buildable, args.out, args.workers)
     if args.lines:
         for r in results:
             what = r.get("reason") or f"{r['object']} / {r['mechanism']} / {r['hazard_class']}"
