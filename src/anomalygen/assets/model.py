@@ -77,6 +77,10 @@ class Asset:
     params: dict[str, Any] = field(default_factory=dict)
     path: str | None = None
     features: list[str] = field(default_factory=list)  # the generator's words for this variant
+    package: str | None = None  # the installed package a real model comes from (None: procedural)
+    licence: str | None = None  # SPDX licence of that model's files
+    # the side it is worked from, when no door, drawer or cavity says so (a stove's knobs): (0, -1)
+    front: tuple[float, float] | None = None
     _keep: list = field(default_factory=list, repr=False)
 
     @property
@@ -93,6 +97,8 @@ class Asset:
             seed=self.seed,
             params=dict(self.params),
             path=self.path,
+            package=self.package,
+            licence=self.licence,
         )
 
     def root_body(self):

@@ -24,6 +24,8 @@ class AssetRef(Artefact):
     seed: int | None = None
     params: dict[str, Any] = Field(default_factory=dict)
     path: str | None = Field(None, description="file path for imported assets")
+    package: str | None = Field(None, description="installed package a real (packaged) model comes from")
+    licence: str | None = Field(None, description="SPDX licence of a packaged model's files")
 
 
 # One definition of the closure concepts, shared by the scene builder, the scene graph, the
