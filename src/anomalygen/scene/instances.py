@@ -31,7 +31,10 @@ def instance_name(catalogue: str, used: set[str]) -> str:
 
 
 def _front(asset) -> np.ndarray | None:
-    """Local direction the asset's doors/drawers open to (the catalogue convention is -y)."""
+    """Local direction the asset's doors/drawers open to (the catalogue convention is -y), or the
+    side the asset declares it is worked from (a stove's control knobs)."""
+    if getattr(asset, "front", None) is not None:
+        return np.asarray(asset.front, float)
     if any(j.label in CLOSURE_LABELS for j in asset.joints) or asset.cavities:
         return np.array([0.0, -1.0])
     return None

@@ -29,7 +29,8 @@ def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed]
     on the floor, with its bin when the scene has none."""
     rng = items.rng
     for cat in items.near_misses if surfaces else []:
-        asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng)
+        asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng,
+                                  real=sel.real_assets)
         p = placed_instance(select.Chosen(instance_name(cat, sel.used), cat, ObjectRole.CLUTTER, asset))
         holder = surfaces[int(rng.integers(len(surfaces)))]
         try:
@@ -40,7 +41,7 @@ def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed]
     for cat, role, face in ((items.second_hazard, ObjectRole.HAZARD, False), (items.bin, ObjectRole.CONTAINER, True)):
         if cat is None:
             continue
-        asset = select.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng)
+        asset = select.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng, real=sel.real_assets)
         p = placed_instance(select.Chosen(instance_name(cat, sel.used), cat, role, asset))
         lay.place_on_floor(p, relevant=True, face=face)
         placed[p.name] = p

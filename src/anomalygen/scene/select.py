@@ -197,17 +197,27 @@ def pick_asset(
     cap: float | None = None,
     rank: bool = False,
     size: float | None = None,
+    real: bool = True,
 ):
-    """Generate candidates, verify them, rank the target ones by SBERT; the first plausible one wins."""
-    from anomalygen.assets.core import generate
+    """Generate candidates, verify them, rank the target ones by SBERT; the first plausible one wins.
+
+    A category with real (packaged) models draws those (``real``: ``build.real_assets``); a real
+    candidate that does not fit here (too big for the space, without the part the task needs) gives
+    way to the procedural one drawn with the same seed and size."""
+    from anomalygen.assets.core import draw, generate
 
     parts = needed_parts(task, catalogue, hc)
     n = TARGET_CANDIDATES if rank else 2
     seeds = [int(s) for s in rng.integers(0, 2**31 - 1, size=n)]
     candidates, problems = [], []
     for s in seeds:
-        asset = generate(catalogue, s, size=choose_size(kb, catalogue, rng, cap=cap, preferred=size))
+        want = choose_size(kb, catalogue, rng, cap=cap, preferred=size)
+        asset = draw(catalogue, s, size=want, real=real)
         problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap)
+        if problem is not None and asset.package is not None:
+            problems.append(f"real model {asset.asset_id}: {problem}")
+            asset = generate(catalogue, s, size=want)
+            problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap)
         if problem is None:
             candidates.append(asset)
         else:

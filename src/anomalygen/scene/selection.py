@@ -76,6 +76,7 @@ class Selection:
     hazard_is_target: bool = False
     hints: object | None = None  # scene/hints.py: sizes, positions and auxiliaries from the LLM engine
     hazard_free: bool = False  # build the task's hazard in its safe state (scene/mix.py)
+    real_assets: bool = True  # draw a category's real (packaged) models where it has any (build.real_assets)
 
     @property
     def variables(self) -> set[str]:
@@ -88,7 +89,7 @@ class Selection:
             return self.by_catalogue[cat]
         want = self.hints.size_for(cat) if self.hints is not None else None
         asset = select.pick_asset(cat, role=role, kb=self.kb, task=self.task, hc=self.hc, rng=self.rng, cap=cap,
-                                  rank=rank, size=want)
+                                  rank=rank, size=want, real=self.real_assets)
         if want is not None and abs(asset.size - want) > 1e-3:
             self.hints.note(f"size:{cat}", f"size {want:.3f} m does not fit the generator's range or the space "
                             f"available; built at {asset.size:.3f} m", value=want, limit=round(float(asset.size), 4))
@@ -102,15 +103,17 @@ class Selection:
         self.used.discard(ch.name)
 
 
-def select_objects(task: TaskProposal, rng, hints=None) -> Selection:
+def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = True) -> Selection:
     """Choose an asset for every role the task needs (target, hazard, container, supports, co-objects).
 
     ``hints`` (scene/hints.py, from the LLM engine) supply sizes, floor positions and the auxiliary
-    objects instead of the random draws; every correction is noted in them or in the layout."""
+    objects instead of the random draws; every correction is noted in them or in the layout.
+    ``real_assets`` False builds every object from the procedural generators (a comparison run)."""
     kb = load_kb()
     sc = task.scenario
     kind, parent_raw = _parse_placement(sc.placement)
-    sel = Selection(task, rng, kb, kb.hazard_classes.get(task.hazard_class), kind, parent_raw, hints=hints)
+    sel = Selection(task, rng, kb, kb.hazard_classes.get(task.hazard_class), kind, parent_raw, hints=hints,
+                    real_assets=real_assets)
     hc, variables = sel.hc, sel.variables
     sel.hazard_is_target = select.resolve_name(sc.hazard_object) == select.resolve_name(task.target_asset)
     # Big things first: they bound what fits in/on them.
