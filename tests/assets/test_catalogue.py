@@ -19,7 +19,7 @@ def cache(tmp_path, monkeypatch):
 
 def test_catalogue_lists_every_name_in_variants():
     entries = catalogue_fn(2)
-    assert len(entries) == 2 * 114
+    assert len(entries) == 2 * 115  # 44 targets, 70 household objects and the Stove
     assert {e.seed for e in entries} == {0, 1}
     pill = next(e for e in entries if e.name == "pill")
     assert "choking_size" in pill.properties and "medication" in pill.properties and pill.kind == "household"

@@ -51,6 +51,8 @@ class Raw:
     parts: dict[str, list[str]] = field(default_factory=dict)  # handle/burner -> geom names
     features: list[str] = field(default_factory=list)  # words for the description
     front: tuple[float, float] | None = None  # the side it is worked from, if no door says so
+    # joint -> (damping, dry friction) replacing the inertia-scaled defaults (N m s/rad and N m)
+    resistance: dict[str, tuple[float, float]] = field(default_factory=dict)
 
 
 def _aabb(model, data) -> tuple[np.ndarray, np.ndarray]:
@@ -178,8 +180,9 @@ def _normalise_geoms(spec, collision_group: int) -> None:
         g.density, g.mass = 0.0, 0.0
 
 
-def _tune_joints(spec) -> None:
-    """Damping and armature from each joint's own inertia; no dry friction (as procedural parts)."""
+def _tune_joints(spec, resistance: dict[str, tuple[float, float]]) -> None:
+    """Damping and armature from each joint's own inertia, no dry friction (as procedural parts),
+    unless the loader declares the part's own resistance."""
     import mujoco
 
     model = spec.compile()
@@ -192,9 +195,10 @@ def _tune_joints(spec) -> None:
         mujoco.mj_mulM(model, data, out, unit)
         inertia = max(float(out[dof]) - float(model.dof_armature[dof]), 0.0)
         joint = spec.joint(model.joint(j).name)
-        joint.damping = [max(DAMPING_PER_INERTIA * inertia, 1e-5), 0.0, 0.0]
+        damping, friction = resistance.get(joint.name, (DAMPING_PER_INERTIA * inertia, 0.0))
+        joint.damping = [max(damping, 1e-5), 0.0, 0.0]
         joint.armature = max(ARMATURE_PER_INERTIA * inertia, 1e-6)
-        joint.frictionloss = 0.0
+        joint.frictionloss = float(friction)
         joint.stiffness = [0.0, 0.0, 0.0]
 
 
@@ -257,7 +261,7 @@ def to_asset(raw: Raw, *, key: str, category: str, real_size: float, real_mass: 
     spec.compiler.autolimits = True
     spec.compiler.inertiagrouprange = defaults.inertiagrouprange
     _exclude_self_contacts(spec)
-    _tune_joints(spec)
+    _tune_joints(spec, raw.resistance)
     model = spec.compile()
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
