@@ -1,0 +1,96 @@
+"""The skills on real geometry: scenes built with the real models (the default catalogue), plans from
+the knowledge base, run through the learn stage's public entry point (``execute_plan``); physical
+outcomes on the settled final state."""
+
+from __future__ import annotations
+
+import pytest
+
+from support.kb_scenes import build_with_kb_plans
+
+pytestmark = pytest.mark.slow
+
+
+def make_task(task_id, hazard_class, target, hazard, placement, *, articulations=(), container=None):
+    from anomalygen.schema import TaskProposal
+
+    return TaskProposal(
+        id=task_id, name=f"task {task_id}", explanation="test", description=f"A {hazard} at {placement}.",
+        category="household_hazard", hazard_class=hazard_class, target_asset=target,
+        scenario=dict(hazard_object=hazard, room="kitchen", placement=placement, container=container, co_objects=[]),
+        articulations=[dict(object=o, part=p, initial_state=s) for o, p, s in articulations],
+        provenance=dict(engine="knowledge", mode="brainstorm"))
+
+
+TASKS = {
+    "stove": make_task("t-stove", "switch_off_appliance", "Stove", "Stove", "floor",
+                       articulations=[("Stove", "knob", "on")]),
+    "microwave": make_task("t-microwave", "remove_item_from_appliance", "Microwave", "fork", "inside:Microwave"),
+    "cabinet": make_task("t-cabinet-0", "close_open_furniture", "StorageFurniture", "StorageFurniture", "floor",
+                         articulations=[("StorageFurniture", "door", "open")]),
+    "knife": make_task("t-knife", "store_sharp_objects", "Knife", "Knife", "counter", container="storage_box"),
+}
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    return build_with_kb_plans(TASKS, tmp_path_factory.mktemp("real_scenes"), clutter=1)
+
+
+def _real(spec, category):
+    obj = next(o for o in spec.objects if o.asset.category == category)
+    assert obj.asset.source == "packaged" and obj.asset.package and obj.asset.licence == "Apache-2.0"
+    return obj
+
+
+def _final_joints(tmp_path, scene_dir, plan):
+    from anomalygen.learn.execute import execute_plan
+    from anomalygen.runfolder import read_model
+    from anomalygen.schema import SceneGraph
+
+    res = execute_plan(scene_dir, plan, seed=0, sac_steps=0, final_graph_path=tmp_path / "final.json")
+    graph = read_model(tmp_path / "final.json", SceneGraph)
+    return res, {j.name: j for o in graph.objects for j in o.joints}
+
+
+def test_all_four_stove_knobs_are_switched_off(built, tmp_path):
+    scene_dir, spec, plan = built["stove"]
+    stove = _real(spec, "Stove")
+    knobs = [j for j in stove.joint_states if j.label == "knob"]
+    assert len(knobs) == 4 and all(j.open_fraction > 0.5 for j in knobs)  # every burner on at the start
+    res, joints = _final_joints(tmp_path, scene_dir, plan)
+    assert res.success, [s.detail for s in res.subtasks]
+    for j in knobs:  # physically at off (the hazard class's own 5 % of the travel)
+        assert joints[j.name].open_fraction <= 0.05, (j.name, joints[j.name].value)
+
+
+def test_fork_comes_out_of_the_real_microwave_and_its_door_is_shut(built, tmp_path):
+    scene_dir, spec, plan = built["microwave"]
+    mw = _real(spec, "Microwave")
+    assert spec.objects[[o.name for o in spec.objects].index(spec.bindings["$hazard"])].inside == mw.name
+    res, joints = _final_joints(tmp_path, scene_dir, plan)
+    assert res.success, [s.detail for s in res.subtasks]
+    steps = {s.id.split("_", 1)[1]: s for s in res.subtasks}
+    assert steps["take_out_of"].success and "taken out" in steps["take_out_of"].detail  # through the opened door
+    assert joints[f"{mw.name}/door_hinge"].open_fraction <= 0.05
+
+
+def test_both_doors_of_the_real_cabinet_are_closed(built, tmp_path):
+    scene_dir, spec, plan = built["cabinet"]
+    cab = _real(spec, "StorageFurniture")
+    assert cab.asset.params["model"] == "franka_kitchen/hinge_cabinet"
+    doors = [j for j in cab.joint_states if j.label == "door"]
+    assert len(doors) == 2 and all(j.open_fraction > 0.5 for j in doors)
+    res, joints = _final_joints(tmp_path, scene_dir, plan)
+    assert res.success, [s.detail for s in res.subtasks]
+    assert all(joints[j.name].open_fraction <= 0.05 for j in doors)
+
+
+def test_a_real_knife_is_picked_and_put_in_a_box(built, tmp_path):
+    scene_dir, spec, plan = built["knife"]
+    knife = _real(spec, "Knife")
+    res, _ = _final_joints(tmp_path, scene_dir, plan)
+    assert res.success, [s.detail for s in res.subtasks]
+    assert any(s.id.endswith("pick") and "holding" in s.detail for s in res.subtasks)  # suction held it
+    inside = next(p for p in res.final_predicates if p.call.name == "inside")
+    assert inside.holds and inside.call.args["object"] in ("$hazard", knife.name)
