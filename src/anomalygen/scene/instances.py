@@ -150,8 +150,3 @@ def container_room(asset) -> float:
     """Longest thing that lies flat in the container's biggest cavity (along its long side)."""
     cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
     return 0.95 * 2 * float(max(cav.half_extents[0], cav.half_extents[1]))
-
-
-def cavity_cap(asset) -> float:
-    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
-    return 0.8 * 2 * float(min(cav.half_extents))

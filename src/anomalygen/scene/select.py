@@ -109,12 +109,8 @@ def kb_size_range(kb, catalogue: str) -> tuple[float, float] | None:
     return tuple(info.size_range) if info is not None else None
 
 
-def choose_size(
-    kb, catalogue: str, rng: np.random.Generator, *, cap: float | None = None, preferred: float | None = None
-) -> float:
-    """Largest dimension: uniform in the knowledge base's range (intersected with the generator's),
-    clamped by ``cap`` (the spatial rule of a container opening or a support surface). A
-    ``preferred`` size (an engine's, e.g. the LLM's) is used instead of the draw, clamped the same way."""
+def size_bounds(kb, catalogue: str) -> tuple[float, float]:
+    """The sizes a name is drawn in: the knowledge base's range intersected with the generator's."""
     from anomalygen.assets.names import size_range
 
     lo, hi = size_range(catalogue)
@@ -123,6 +119,22 @@ def choose_size(
         lo, hi = max(lo, kb_range[0]), min(hi, kb_range[1])
         if lo > hi:  # ranges disagree: trust the generator's own plausible range
             lo, hi = size_range(catalogue)
+    return lo, hi
+
+
+def cavity_cap(asset) -> float:
+    """The largest thing its biggest cavity takes: 80 % of that cavity's smallest dimension."""
+    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+    return 0.8 * 2 * float(min(cav.half_extents))
+
+
+def choose_size(
+    kb, catalogue: str, rng: np.random.Generator, *, cap: float | None = None, preferred: float | None = None
+) -> float:
+    """Largest dimension: uniform in the knowledge base's range (intersected with the generator's),
+    clamped by ``cap`` (the spatial rule of a container opening or a support surface). A
+    ``preferred`` size (an engine's, e.g. the LLM's) is used instead of the draw, clamped the same way."""
+    lo, hi = size_bounds(kb, catalogue)
     if cap is not None:
         if cap < lo:
             raise ItemFailed(f"{catalogue} (at least {lo:.2f} m) does not fit a {cap:.2f} m space")
@@ -198,12 +210,14 @@ def pick_asset(
     rank: bool = False,
     size: float | None = None,
     real: bool = True,
+    room_for: float | None = None,
 ):
     """Generate candidates, verify them, rank the target ones by SBERT; the first plausible one wins.
 
     A category with real (packaged) models draws those (``real``: ``build.real_assets``); a real
-    candidate that does not fit here (too big for the space, without the part the task needs) gives
-    way to the procedural one drawn with the same seed and size."""
+    candidate that does not fit here (too big for the space, without the part the task needs, an
+    interior too small for the ``room_for`` m thing to go in it) gives way to the procedural one
+    drawn with the same seed and size."""
     from anomalygen.assets.core import draw, generate
 
     parts = needed_parts(task, catalogue, hc)
@@ -214,6 +228,9 @@ def pick_asset(
         want = choose_size(kb, catalogue, rng, cap=cap, preferred=size)
         asset = draw(catalogue, s, size=want, real=real)
         problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap)
+        if problem is None and asset.package is not None and room_for and asset.cavities \
+                and cavity_cap(asset) < room_for:
+            problem = f"its interior takes {cavity_cap(asset):.2f} m, less than the {room_for:.2f} m to go in"
         if problem is not None and asset.package is not None:
             problems.append(f"real model {asset.asset_id}: {problem}")
             asset = generate(catalogue, s, size=want)

@@ -15,7 +15,7 @@ import numpy as np
 from anomalygen.errors import ItemFailed
 from anomalygen.knowledge import load_kb
 from anomalygen.scene import select
-from anomalygen.scene.instances import cavity_cap, container_room, instance_name
+from anomalygen.scene.instances import container_room, instance_name
 from anomalygen.scene.layout import Placed
 from anomalygen.schema import ENCLOSING_LABELS, ObjectRole, TaskProposal
 
@@ -82,14 +82,17 @@ class Selection:
     def variables(self) -> set[str]:
         return set(self.hc.variables) if self.hc is not None else set()
 
-    def choose(self, raw: str, role: ObjectRole, *, cap=None, rank=False) -> select.Chosen:
-        """The asset for a name (one per catalogue category: a second mention reuses it)."""
+    def choose(self, raw: str, role: ObjectRole, *, cap=None, rank=False, room_for=None) -> select.Chosen:
+        """The asset for a name (one per catalogue category: a second mention reuses it).
+
+        ``room_for``: the least size of what will be put inside it (a real model with too small an
+        interior gives way to the procedural one)."""
         cat = select.resolve_name(raw)
         if cat in self.by_catalogue:
             return self.by_catalogue[cat]
         want = self.hints.size_for(cat) if self.hints is not None else None
         asset = select.pick_asset(cat, role=role, kb=self.kb, task=self.task, hc=self.hc, rng=self.rng, cap=cap,
-                                  rank=rank, size=want, real=self.real_assets)
+                                  rank=rank, size=want, real=self.real_assets, room_for=room_for)
         if want is not None and abs(asset.size - want) > 1e-3:
             self.hints.note(f"size:{cat}", f"size {want:.3f} m does not fit the generator's range or the space "
                             f"available; built at {asset.size:.3f} m", value=want, limit=round(float(asset.size), 4))
@@ -116,16 +119,20 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
                     real_assets=real_assets)
     hc, variables = sel.hc, sel.variables
     sel.hazard_is_target = select.resolve_name(sc.hazard_object) == select.resolve_name(task.target_asset)
+    # what goes inside the parent needs room there (only a real model is turned down for lacking it)
+    holder = select.resolve_name(parent_raw) if kind == "inside" and parent_raw else None
+    room_for = select.size_bounds(kb, select.resolve_name(sc.hazard_object))[0] if holder else None
     # Big things first: they bound what fits in/on them.
     target = sel.target = sel.choose(
-        task.target_asset, ObjectRole.HAZARD if sel.hazard_is_target else ObjectRole.TARGET, rank=True
+        task.target_asset, ObjectRole.HAZARD if sel.hazard_is_target else ObjectRole.TARGET, rank=True,
+        room_for=room_for if select.resolve_name(task.target_asset) == holder else None,
     )
-    parent = sel.parent = sel.choose(parent_raw, ObjectRole.AUXILIARY) if parent_raw else None
+    parent = sel.parent = sel.choose(parent_raw, ObjectRole.AUXILIARY, room_for=room_for) if parent_raw else None
     cap = None
     if kind == "inside" and parent is not None:
         if not parent.asset.cavities:
             raise ItemFailed(f"placement inside:{parent_raw} but {parent.catalogue} has no interior")
-        cap = cavity_cap(parent.asset)
+        cap = select.cavity_cap(parent.asset)
     hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=cap)
     if hazard is target:
         target.role = ObjectRole.HAZARD

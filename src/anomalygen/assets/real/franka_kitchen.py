@@ -69,12 +69,12 @@ def microwave() -> Raw:
 
     spec = load_spec(_fragments("microwave"), edit)
     # interior between the collision walls (left wall x -0.287, control panel x 0.127, back y 0.161,
-    # floor z 0.048, ceiling z 0.336; the door closes the front at y -0.176), 1 cm in from each
+    # floor z 0.048, ceiling z 0.336; the door closes the front at y -0.176), 2 mm in from each
     return Raw(
         spec=spec,
         joints={"door_hinge": ("door", 0.0)},
         collision_group=COLLISION_GROUP,
-        cavities=[Cavity("oven_space", (-0.08, -0.007, 0.192), (0.197, 0.158, 0.134), "front", "door_hinge")],
+        cavities=[Cavity("oven_space", (-0.08, -0.0075, 0.192), (0.205, 0.1665, 0.142), "front", "door_hinge")],
         surfaces=[Surface("top", (-0.08, 0.0, 0.374), (0.25, 0.15))],
         parts={"door": ["door"], "handle": ["handle_bar", "handle_bar_col"]},
         features=["black with a glass window", "side-hinged door with a bar handle", "control panel"],
