@@ -6,29 +6,18 @@ from __future__ import annotations
 
 import pytest
 
-from support.kb_scenes import build_with_kb_plans
+from support.kb_scenes import build_with_kb_plans, kb_task
 
 pytestmark = pytest.mark.slow
 
 
-def make_task(task_id, hazard_class, target, hazard, placement, *, articulations=(), container=None):
-    from anomalygen.schema import TaskProposal
-
-    return TaskProposal(
-        id=task_id, name=f"task {task_id}", explanation="test", description=f"A {hazard} at {placement}.",
-        category="household_hazard", hazard_class=hazard_class, target_asset=target,
-        scenario=dict(hazard_object=hazard, room="kitchen", placement=placement, container=container, co_objects=[]),
-        articulations=[dict(object=o, part=p, initial_state=s) for o, p, s in articulations],
-        provenance=dict(engine="knowledge", mode="brainstorm"))
-
-
 TASKS = {
-    "stove": make_task("t-stove", "switch_off_appliance", "Stove", "Stove", "floor",
+    "stove": kb_task("t-stove", "switch_off_appliance", "Stove", "Stove", "floor",
                        articulations=[("Stove", "knob", "on")]),
-    "microwave": make_task("t-microwave", "remove_item_from_appliance", "Microwave", "fork", "inside:Microwave"),
-    "cabinet": make_task("t-cabinet-0", "close_open_furniture", "StorageFurniture", "StorageFurniture", "floor",
+    "microwave": kb_task("t-microwave", "remove_item_from_appliance", "Microwave", "fork", "inside:Microwave"),
+    "cabinet": kb_task("t-cabinet-0", "close_open_furniture", "StorageFurniture", "StorageFurniture", "floor",
                          articulations=[("StorageFurniture", "door", "open")]),
-    "knife": make_task("t-knife", "store_sharp_objects", "Knife", "Knife", "counter", container="storage_box"),
+    "knife": kb_task("t-knife", "store_sharp_objects", "Knife", "Knife", "counter", container="storage_box"),
 }
 
 

@@ -17,3 +17,15 @@ def build_with_kb_plans(tasks: dict, root, *, clutter: int) -> dict:
         spec = build_scene(task, seed=0, settings=Settings(build={"clutter": clutter, **NO_MIX}), out_dir=root / key)
         out[key] = (root / key, spec, plan_from_kb(task.id, task.hazard_class, dict(spec.bindings), spec=spec))
     return out
+
+
+def kb_task(task_id, hazard_class, target, hazard, placement, *, container=None, articulations=(), room="kitchen"):
+    """A knowledge-engine TaskProposal for a scene test: ``articulations`` are (object, part, state)."""
+    from anomalygen.schema import TaskProposal
+
+    return TaskProposal(
+        id=task_id, name=f"task {task_id}", explanation="test", description=f"A {hazard} at {placement}.",
+        category="household_hazard", hazard_class=hazard_class, target_asset=target,
+        scenario=dict(hazard_object=hazard, room=room, placement=placement, container=container, co_objects=[]),
+        articulations=[dict(object=o, part=p, initial_state=s) for o, p, s in articulations],
+        provenance=dict(engine="knowledge", mode="brainstorm"))

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from anomalygen.assets.describe import describe
+from anomalygen.assets.importers import exclude_self_contacts, scale_spec
 from anomalygen.assets.model import Asset, AssetJoint, Cavity, Surface
 from anomalygen.schema import AssetSource
 
@@ -124,33 +125,6 @@ def _source_inertials(spec) -> tuple[dict[str, tuple], tuple[np.ndarray, np.ndar
     return inertials, _aabb(model, data)
 
 
-def _scale_and_shift(spec, s: float, offset: np.ndarray) -> None:
-    """Scale every length by ``s``; move the root's contents by ``offset`` (already scaled)."""
-    import mujoco
-
-    root = spec.worldbody.first_body()
-    if root.frames:
-        raise ValueError("a packaged model's root body may not hold frames")
-    for b in spec.bodies:
-        if b.name != "world":
-            b.pos = np.asarray(b.pos) * s + (offset if b.parent.name == "root" else 0.0)
-    for g in spec.geoms:
-        g.pos = np.asarray(g.pos) * s + (offset if g.parent.name == "root" else 0.0)
-        if not np.isnan(g.fromto[0]):
-            g.fromto = np.asarray(g.fromto) * s + np.r_[offset, offset] * (g.parent.name == "root")
-        if g.type != mujoco.mjtGeom.mjGEOM_MESH:
-            g.size = np.asarray(g.size) * s
-    for m in spec.meshes:
-        m.scale = np.asarray(m.scale) * s
-    for j in spec.joints:
-        j.pos = np.asarray(j.pos) * s
-        if j.type == mujoco.mjtJoint.mjJNT_SLIDE:
-            j.range = np.asarray(j.range) * s
-    for site in spec.sites:
-        site.pos = np.asarray(site.pos) * s + (offset if site.parent.name == "root" else 0.0)
-        site.size = np.asarray(site.size) * s
-
-
 def _set_inertials(spec, inertials: dict[str, tuple], s: float, k: float, offset: np.ndarray) -> None:
     """Explicit inertials from the source compile: mass x k, lengths x s (the root's moved by ``offset``)."""
     for b in spec.bodies:
@@ -202,14 +176,6 @@ def _tune_joints(spec, resistance: dict[str, tuple[float, float]]) -> None:
         joint.stiffness = [0.0, 0.0, 0.0]
 
 
-def _exclude_self_contacts(spec) -> None:
-    names = [b.name for b in spec.bodies if b.name != "world"]
-    for i, a in enumerate(names):
-        for b in names[i + 1 :]:
-            ex = spec.add_exclude()
-            ex.bodyname1, ex.bodyname2 = a, b
-
-
 def _joints(model, data, declared: dict[str, tuple[str, float]], s: float) -> list[AssetJoint]:
     import mujoco
 
@@ -255,12 +221,14 @@ def to_asset(raw: Raw, *, key: str, category: str, real_size: float, real_mass: 
     offset = -np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2]]) * s
     _set_inertials(spec, inertials, s, k, offset)
     _normalise_geoms(spec, raw.collision_group)
-    _scale_and_shift(spec, s, offset)
+    if spec.worldbody.first_body().frames:
+        raise ValueError("a packaged model's root body may not hold frames")
+    scale_spec(spec, s, root_offset=offset)
     defaults = new_spec().compiler
     spec.compiler.degree = defaults.degree
     spec.compiler.autolimits = True
     spec.compiler.inertiagrouprange = defaults.inertiagrouprange
-    _exclude_self_contacts(spec)
+    exclude_self_contacts(spec)
     _tune_joints(spec, raw.resistance)
     model = spec.compile()
     data = mujoco.MjData(model)

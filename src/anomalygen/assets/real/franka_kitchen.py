@@ -48,24 +48,27 @@ def _rename(doc: ET.Element, tag: str, old: str, new: str) -> ET.Element:
     return el
 
 
-def _name_geoms(body: ET.Element, names: dict[int, str]) -> None:
-    """Name the body's geoms by position in its child list (the sources leave them unnamed)."""
-    geoms = body.findall("geom")
-    for i, name in names.items():
-        geoms[i].set("name", name)
+def _moving_part(doc: ET.Element, body: str, name: str, joint: str, joint_name: str,
+                 geoms: dict[int, str] | None = None) -> ET.Element:
+    """Rename a moving part and its joint, name some of its geoms (by position: the sources leave
+    them unnamed) and drop its sites (the source robot's targets)."""
+    part = _rename(doc, "body", body, name)
+    _rename(doc, "joint", joint, joint_name)
+    found = part.findall("geom")
+    for i, geom_name in (geoms or {}).items():
+        found[i].set("name", geom_name)
+    for site in part.findall("site"):
+        part.remove(site)
+    return part
 
 
 # ----------------------------------------------------------------------------- microwave
 
 def microwave() -> Raw:
     def edit(doc: ET.Element) -> None:
-        _rename(doc, "joint", "microwave", "door_hinge")
-        door = _rename(doc, "body", "microdoorroot", "door")
         _rename(doc, "body", "microroot", "carcass")
         # geoms 2-4 are the visual handle bar and its two posts, 5-7 their collision capsules
-        _name_geoms(door, {2: "handle_bar", 5: "handle_bar_col"})
-        for site in list(door.findall("site")):
-            door.remove(site)
+        _moving_part(doc, "microdoorroot", "door", "microwave", "door_hinge", {2: "handle_bar", 5: "handle_bar_col"})
 
     spec = load_spec(_fragments("microwave"), edit)
     # interior between the collision walls (left wall x -0.287, control panel x 0.127, back y 0.161,
@@ -85,14 +88,10 @@ def microwave() -> Raw:
 
 def hinge_cabinet() -> Raw:
     def edit(doc: ET.Element) -> None:
-        _rename(doc, "joint", "left_hinge_cabinet", "left_door_hinge")
-        _rename(doc, "joint", "right_hinge_cabinet", "right_door_hinge")
         _rename(doc, "body", "hingecab", "carcass")
         for side in ("left", "right"):
-            door = _rename(doc, "body", f"hinge{side}door", f"{side}_door")
-            _name_geoms(door, {0: f"{side}_handle_bar"})
-            for site in list(door.findall("site")):
-                door.remove(site)
+            _moving_part(doc, f"hinge{side}door", f"{side}_door", f"{side}_hinge_cabinet", f"{side}_door_hinge",
+                         {0: f"{side}_handle_bar"})
 
     spec = load_spec(_fragments("hingecabinet"), edit)
     # two compartments either side of the 8 cm middle wall: x 0.04..0.36, y -0.30..0.26, z -0.16..0.16
@@ -113,12 +112,8 @@ def hinge_cabinet() -> Raw:
 
 def slide_cabinet() -> Raw:
     def edit(doc: ET.Element) -> None:
-        _rename(doc, "joint", "slide_cabinet", "door_slide")
         _rename(doc, "body", "slide", "carcass")
-        door = _rename(doc, "body", "slidelink", "door")
-        _name_geoms(door, {2: "handle_bar"})
-        for site in list(door.findall("site")):
-            door.remove(site)
+        _moving_part(doc, "slidelink", "door", "slide_cabinet", "door_slide", {2: "handle_bar"})
 
     spec = load_spec(_fragments("slidecabinet"), edit)
     # the left half is the compartment (x -0.404..-0.002, y -0.3..0.252, z -0.16..0.16); the sliding
@@ -138,9 +133,9 @@ def slide_cabinet() -> Raw:
 
 def kettle() -> Raw:
     def edit(doc: ET.Element) -> None:
-        _rename(doc, "body", "kettleroot", "body")
-        for site in list(find(doc, "body", "body").findall("site")):
-            find(doc, "body", "body").remove(site)
+        body = _rename(doc, "body", "kettleroot", "body")
+        for site in body.findall("site"):
+            body.remove(site)
 
     return Raw(
         spec=load_spec(_fragments("kettle"), edit),
@@ -186,12 +181,8 @@ def stove() -> Raw:
             geom.attrib.pop("material", None)
             geom.set("rgba", _BURNER_RGBA)
             oven.append(geom)
-            k = _rename(doc, "body", knob, f"knob_{i}")
+            k = _moving_part(doc, knob, f"knob_{i}", f"knob_Joint_{knob.split()[1]}", f"knob_{i}_joint")
             k.set("pos", f"{x} {_BAND_FRONT_Y} {_BAND_Z}")
-            joint = k.find("joint")
-            joint.set("name", f"knob_{i}_joint")
-            for site in list(k.findall("site")):
-                k.remove(site)
             names[f"knob_{i}_joint"] = f"burner_{i}"
         for i in range(1, 5):  # knobs in the order of their names, left to right
             k = find(doc, "body", f"knob_{i}")
