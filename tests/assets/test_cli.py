@@ -49,6 +49,16 @@ def test_validate_reports_categories_and_exit_code():
     assert summary["passed"] == 2 and summary["assets_ok"] == 2
 
 
+def test_show_real_gives_the_packaged_model_with_its_licence():
+    res = runner.invoke(app, ["show", "Stove", "--real", "--json"])
+    assert res.exit_code == 0, res.output
+    info = json.loads(res.stdout)
+    assert (info["source"], info["package"], info["licence"]) == ("packaged", "gymnasium-robotics", "Apache-2.0")
+    assert [j["label"] for j in info["joints"]] == ["knob"] * 4 and all(j["closed"] == 0.0 for j in info["joints"])
+    res = runner.invoke(app, ["show", "Dishwasher", "--real", "--json"])  # no real model: procedural
+    assert json.loads(res.stdout)["source"] == "procedural"
+
+
 def test_validate_real_checks_each_packaged_model():
     res = runner.invoke(app, ["validate", "--real", "--name", "StorageFurniture", "--no-render", "--json"])
     assert res.exit_code == 0, res.output

@@ -65,16 +65,19 @@ def show(
     name: str,
     seed: Annotated[int, typer.Option(help="Variant seed.")] = 0,
     size: Annotated[float | None, typer.Option(help="Largest dimension in metres.")] = None,
+    real: Annotated[bool, typer.Option("--real", help="The real model a scene draws for this seed, if any.")] = False,
     json_out: Annotated[bool, typer.Option("--json")] = False,
 ) -> None:
     """Facts about one asset variant: size, mass, joints, surfaces, cavities, description."""
-    from anomalygen.assets.core import generate
+    from anomalygen.assets.core import draw
 
-    a = generate(_check_name(name), seed, size)
+    a = draw(_check_name(name), seed, size, real=real)
     info = {
         "asset_id": a.asset_id,
         "category": a.category,
         "source": str(a.source),
+        "package": a.package,
+        "licence": a.licence,
         "size": round(a.size, 4),
         "aabb": [a.aabb[0].round(4).tolist(), a.aabb[1].round(4).tolist()],
         "mass": round(a.mass, 4),
@@ -124,13 +127,14 @@ def render(
     open_fraction: Annotated[float, typer.Option("--open", help="Pose joints this far open (0..1).")] = 0.3,
     width: int = 480,
     height: int = 360,
+    real: Annotated[bool, typer.Option("--real", help="The real model a scene draws for this seed, if any.")] = False,
 ) -> None:
     """Render one asset variant to a PNG."""
     os.environ.setdefault("MUJOCO_GL", "egl")
-    from anomalygen.assets.core import generate
+    from anomalygen.assets.core import draw
     from anomalygen.assets.render import render_asset, save_png
 
-    a = generate(_check_name(name), seed)
+    a = draw(_check_name(name), seed, real=real)
     save_png(render_asset(a, width=width, height=height, open_fraction=open_fraction), out_path)
     out.print(f"wrote {out_path}")
 
