@@ -263,13 +263,17 @@ def gallery(
     seed: Annotated[int, typer.Option(help="Variant seed.")] = 0,
     cell: Annotated[int, typer.Option(help="Thumbnail size in pixels.")] = 200,
     household: Annotated[bool, typer.Option("--household/--targets")] = False,
+    real: Annotated[bool, typer.Option("--real", help="Every name with a real model, drawn as a scene would.")] = False,
 ) -> None:
     """Contact sheet of all 44 target categories (or the household objects), labelled."""
     os.environ.setdefault("MUJOCO_GL", "egl")
     from anomalygen.assets.names import household_names, target_names
+    from anomalygen.assets.real.catalogue import by_category
     from anomalygen.assets.render import gallery as make_gallery
     from anomalygen.assets.render import save_png
 
     names = household_names() if household else target_names()
-    save_png(make_gallery(names, seed, cell=cell, cols=8 if not household else 10), out_path)
+    if real:
+        names = [n for n in target_names() + household_names() if n in by_category()]
+    save_png(make_gallery(names, seed, cell=cell, cols=8 if not household else 10, real=real), out_path)
     out.print(f"wrote {out_path} ({len(names)} assets)")
