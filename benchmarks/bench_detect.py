@@ -1,14 +1,17 @@
-"""Detection figures: rule-detector speed and accuracy, judge calibration, and hit@k on built runs.
+"""Detection figures: rule-detector speed and accuracy, text-judge calibration, scores on built runs.
 
 Run: ``.venv/bin/python benchmarks/bench_detect.py [--run runs/x] [--clutter-run runs/x5] [--json]``.
 Prints one JSON object.
 - ``kb_sweep``: the rule detector on every (class, object, placement) the knowledge base can set up, as
   minimal synthetic scene graphs, without and with 5 clutter objects (``anomalygen.detect.kbcheck``).
 - ``rules_speed``: scene graphs per second through the rule detector (22 classes' preconditions).
-- ``judge``: the SBERT threshold re-calibrated on ``data/judge/calibration.jsonl`` with precision,
-  recall and leave-one-task-out figures, and judged pairs per second.
-- ``run`` / ``clutter_run``: hit@1..3 of the rule detector on the scenes of built run folders (read
-  only: nothing is written), the misses with reasons, and the hit@1 drop between the two.
+- ``judge``: the text judge's SBERT threshold re-calibrated on ``data/judge/calibration.jsonl`` with
+  precision, recall and leave-one-task-out figures, and judged pairs per second (the text judge is a
+  diagnostic; detection is scored against the truth).
+- ``run`` / ``clutter_run``: the rule detector on the scenes of built run folders (read only: nothing
+  is written), scored against each scene's truth.json: recall, precision, F1, false alarms on
+  hazard-free scenes, hit@1..3 on single-hazard scenes, the hazards missed; and the drop in
+  "first claim names a truth hazard" between the two runs.
 """
 
 from __future__ import annotations
@@ -44,8 +47,8 @@ def bench_rules_speed(repeat: int = 3) -> dict:
 
 
 def bench_judge() -> dict:
-    from anomalygen.detect.calibrate import calibrate, load_pairs, similarities
     from anomalygen.embedding import encoder
+    from anomalygen.evaluate.judge_calibration import calibrate, load_pairs, similarities
 
     pairs = load_pairs()
     encoder()  # load once, outside the timing
@@ -59,52 +62,58 @@ def bench_judge() -> dict:
 
 
 def bench_run(root: Path, k: int = 3) -> dict:
-    """Rule detection + judging on every built scene of a run, in memory."""
+    """Rule detection on every built scene of a run, in memory, scored against its truth.json."""
     from anomalygen.config import load_settings
-    from anomalygen.detect.report import summarise
-    from anomalygen.detect.stage import detect_scene, make_detector, make_judge
+    from anomalygen.detect.stage import detect_scene, make_detector
+    from anomalygen.evaluate import run_metrics as rm
+    from anomalygen.evaluate.detection_report import summarise
+    from anomalygen.evaluate.detection_scores import finds
     from anomalygen.runfolder import RunFolder, try_read_model
-    from anomalygen.schema import SceneGraph, SceneSpec
+    from anomalygen.schema import SceneGraph
 
     run = RunFolder.open(root)
     settings = load_settings(None, {"quiet": True, "detect.k": k, "detect.detector": "rules"})
-    detector, judge = make_detector(settings), make_judge(settings)
+    detector = make_detector(settings)
     tasks = run.load_tasks()
     dets = []
     start = time.perf_counter()
     for t in tasks:
         graph = try_read_model(run.scene_dir(t.id) / "scene_graph.json", SceneGraph)
-        if graph is None:
-            continue
-        spec = try_read_model(run.scene_dir(t.id) / "scene.json", SceneSpec)
-        dets.append(detect_scene(t, graph, spec, settings, detector=detector, judge=judge))
+        if graph is not None:
+            dets.append(detect_scene(t.id, graph, settings, detector=detector))
     wall = time.perf_counter() - start
-    report = summarise(dets, tasks, k)
+    manifests = rm.load_manifests(run, tasks)
+    report = summarise(dets, tasks, manifests, k)
+    sc = report.overall
     return {
         "run": str(root),
         "tasks": len(tasks),
         "scenes": report.scenes,
-        "hit_at": report.overall.rate,
-        "per_category": {c: r.rate for c, r in report.per_category.items()},
+        "against_truth": sc.model_dump() if sc else None,
         "misses": [m.model_dump() for m in report.misses],
         "missing_scenes": len(report.missing_scenes),
         "wall_s": round(wall, 3),
-        "hit_rank": {d.task_id: d.hit_rank for d in dets},
+        # per scene: does the first claim name one of the scene's truth hazards (None: no truth, or no hazard)
+        "first_claim_true": {d.task_id: (any(finds(d.hypotheses[:1], z) for z in manifests[d.task_id].hazards)
+                                         if d.task_id in manifests and manifests[d.task_id].hazards else None)
+                             for d in dets},
     }
 
 
 def clutter_drop(plain: dict, cluttered: dict) -> dict:
-    """hit@1 of both runs over the tasks built in both (the same tasks, with and without clutter)."""
-    both = sorted(set(plain["hit_rank"]) & set(cluttered["hit_rank"]))
+    """How often the first claim names a truth hazard, in both runs, over the scenes with a hazard
+    built in both (the same tasks, with and without clutter)."""
+    a, b = plain["first_claim_true"], cluttered["first_claim_true"]
+    both = sorted(t for t in set(a) & set(b) if a[t] is not None and b[t] is not None)
     if not both:
         return {"common_scenes": 0}
 
-    def hit1(r: dict) -> float:
-        return sum(1 for t in both if r["hit_rank"][t] == 1) / len(both)
+    def rate(r: dict) -> float:
+        return sum(1 for t in both if r[t]) / len(both)
 
-    changed = [t for t in both if (plain["hit_rank"][t] == 1) != (cluttered["hit_rank"][t] == 1)]
-    return {"common_scenes": len(both), "hit1_plain": round(hit1(plain), 4), "hit1_clutter": round(hit1(cluttered), 4),
-            "drop": round(hit1(plain) - hit1(cluttered), 4), "changed": changed}
+    return {"common_scenes": len(both), "first_claim_true_plain": round(rate(a), 4),
+            "first_claim_true_clutter": round(rate(b), 4), "drop": round(rate(a) - rate(b), 4),
+            "changed": [t for t in both if a[t] != b[t]]}
 
 
 def main() -> None:

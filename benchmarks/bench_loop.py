@@ -2,17 +2,21 @@
 
 Runs the real pipeline through the CLI: ``brainstorm --engine knowledge --n N --seed S``, ``build``
 (default judgement mix: near-misses, second hazards, hazard-free scenes), ``detect --detector rules``,
-then plan and learn twice from the same scenes and detections: from perception (the default,
-``plan_source = detected``) and with the oracle (``ground_truth``: the builder's class and bindings).
-Prints the detection scores and, per mode, the table by class (hazards present, detected, planned,
-resolved; runs that created a hazard or acted on a safe object), then one JSON line.
+then plan, learn and judge twice from the same scenes and detections: from perception (the default,
+``plan.source = detected``) and with the oracle (``ground_truth``: the builder's class and bindings).
+Every figure is the referee's (``anomalygen judge``: each run's final state released, settled and
+judged against truth.json). Prints the detection scores and, per mode, the table by class (hazards
+present, detected, planned, resolved — no class firing on the object and no new hazard in the run;
+runs that created a hazard or acted on a safe object), then one JSON line.
 
     .venv/bin/python benchmarks/bench_loop.py [--n 111] [--seed 0] [--seeds 1] [--workers 2] [--out DIR]
-        [--compare-detectors N] [--skip-learn]
+        [--compare-detectors N] [--noise] [--skip-learn]
 
 ``--compare-detectors N`` also runs the LLM and hybrid detectors (the configured LLM backend; by
 default the bundled tiny GGUF, which measures the mechanics, not judgement) on the first N scenes
-and scores all three detectors on those same N scenes.
+and scores all three detectors on those same N scenes. ``--noise`` also detects with perception noise
+(``detect --noise``, the ``detect.noise`` settings) on a copy of the run and scores that too; plans and
+skills stay on the noise-free detections.
 """
 
 from __future__ import annotations
@@ -46,8 +50,8 @@ def _copy_run(src: Path, dst: Path) -> None:
 
 def _detection_scores(folder: Path, ids: set[str] | None = None):
     """The run's detections scored against truth.json (only the tasks in ``ids`` when given)."""
-    from anomalygen.detect.score import score_detections
     from anomalygen.evaluate.run_metrics import load_detections, load_manifests
+    from anomalygen.referee.score import score_detections
     from anomalygen.runfolder import RunFolder
 
     run = RunFolder(folder)
@@ -74,6 +78,7 @@ def main() -> int:
     ap.add_argument("--out", default=None, help="folder for the runs (default: a temporary one)")
     ap.add_argument("--compare-detectors", type=int, default=0, metavar="N",
                     help="score rules, llm and hybrid detection on the first N scenes")
+    ap.add_argument("--noise", action="store_true", help="also score rule detection with perception noise")
     ap.add_argument("--skip-learn", action="store_true", help="stop after detection")
     a = ap.parse_args()
     root = Path(a.out or tempfile.mkdtemp(prefix="bench_loop_"))
@@ -90,15 +95,22 @@ def main() -> int:
     scores = _detection_scores(base)
     print(f"detection (rules) against truth.json: {scores.model_dump_json()}")
     out["detection"] = _summary(scores)
+    if a.noise:
+        noisy = root / "detect_noise"
+        _copy_run(base, noisy)
+        _cli("detect", "--run", str(noisy), "--detector", "rules", "--noise", "--force", env=env)
+        out["detection_noise"] = _summary(_detection_scores(noisy))
+        print(f"detection (rules, perception noise) against truth.json: {json.dumps(out['detection_noise'])}")
     if a.compare_detectors:
         out["detectors"] = _compare_detectors(root, base, ids, a.compare_detectors, env)
     for mode, folder in (() if a.skip_learn else (("detected", base), ("ground_truth", root / "oracle"))):
         t = time.perf_counter()
-        menv = {**env, "ANOMALYGEN_LEARN__PLAN_SOURCE": mode}
+        menv = {**env, "ANOMALYGEN_PLAN__SOURCE": mode}
         _cli("plan", "--run", str(folder), env=menv)
         _cli("learn", "--run", str(folder), "--seeds", str(a.seeds), "--workers", str(a.workers), env=menv)
+        _cli("judge", "--run", str(folder), "--workers", str(a.workers), env=menv)  # the referee, after the robot
         table = hazard_table(RunFolder(folder), ids, a.seeds)
-        print(markdown(table, f"plan_source = {mode}"))
+        print(markdown(table, f"plan.source = {mode}"))
         tot = table.total
         out[mode] = {"hazards": tot.hazards, "detected": tot.detected, "planned": tot.planned, "runs": tot.runs,
                      "resolved": tot.resolved, "resolved_rate": round(tot.resolved / tot.runs, 3) if tot.runs else None,

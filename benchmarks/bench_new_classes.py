@@ -3,7 +3,7 @@
 A fixed task file (each class with several hazard objects and rooms) goes through the real CLI:
 ``brainstorm --tasks`` (validated copy), ``build`` (single-hazard scenes: no near-misses, second
 hazards or hazard-free variants, so each scene holds the one hazard of its task), ``detect
---detector rules``, then ``plan`` and ``learn`` with the oracle (``plan_source = ground_truth``:
+--detector rules``, then ``plan`` and ``learn`` with the oracle (``plan.source = ground_truth``:
 the builder's class and bindings) and, with ``--detected``, from perception as well. Prints the
 loop table per class, judged against each scene's truth.json by the referee, then one JSON line.
 
@@ -80,7 +80,7 @@ def main() -> int:
     out: dict = {"name": "new_classes", "tasks": len(TASKS), "seeds": a.seeds}
     for mode in ("ground_truth", "detected") if a.detected else ("ground_truth",):
         run = root / mode
-        menv = {**env, "ANOMALYGEN_LEARN__PLAN_SOURCE": mode}
+        menv = {**env, "ANOMALYGEN_PLAN__SOURCE": mode}
         _cli("brainstorm", "--run", str(run), "--tasks", str(tasks_file), env=menv)
         _cli("build", "--run", str(run), "--workers", str(a.workers), env=menv)
         _cli("detect", "--run", str(run), "--detector", "rules", env=menv)
@@ -88,7 +88,7 @@ def main() -> int:
         _cli("learn", "--run", str(run), "--seeds", str(a.seeds), "--workers", str(a.workers), env=menv)
         rf = RunFolder(run)
         table = hazard_table(rf, [t.id for t in rf.load_tasks()], a.seeds)
-        print(markdown(table, f"plan_source = {mode}"))
+        print(markdown(table, f"plan.source = {mode}"))
         tot = table.total
         out[mode] = {"hazards": tot.hazards, "detected": tot.detected, "planned": tot.planned, "runs": tot.runs,
                      "resolved": tot.resolved, "runs_with_new_hazards": table.runs_with_new_hazards,

@@ -1,9 +1,10 @@
 """Skill success on the knowledge run with oracle plans: the issue's acceptance figure, by class.
 
 Runs the real pipeline through the CLI in a scratch run folder: ``brainstorm --engine knowledge --n N``,
-``build``, ``plan`` and ``learn --seeds K`` (videos off) on the tasks of every hazard class (or only
-those named by ``--classes``). Prints the table and one JSON line: per-class and overall success over
-all (task, seed) runs.
+``build``, ``plan``, ``learn --seeds K`` (videos off) and ``judge`` on the tasks of every hazard class (or
+only those named by ``--classes``). Prints the table and one JSON line: per class and overall, the
+referee's verdict (``verdict.json``: resolved) over all (task, seed) runs, and beside it, labelled, the
+robot's own check (``result.json``'s ``success``).
 
     .venv/bin/python benchmarks/bench_primitives.py [--n 111] [--seeds 3] [--workers 2] [--out DIR]
         [--retries K] [--classes close_toilet_lid,store_sharp_objects]
@@ -40,7 +41,7 @@ def main() -> int:
     run = Path(a.out or tempfile.mkdtemp(prefix="bench_primitives_")) / "run"
     # the oracle plans on single-hazard scenes: this figure measures the skills, not detection (that is
     # bench_loop.py), so plans come from the builder's bindings and the judgement mix is off
-    env = {**os.environ, "ANOMALYGEN_LEARN__VIDEO": "false", "ANOMALYGEN_LEARN__PLAN_SOURCE": "ground_truth",
+    env = {**os.environ, "ANOMALYGEN_LEARN__VIDEO": "false", "ANOMALYGEN_PLAN__SOURCE": "ground_truth",
            "ANOMALYGEN_BUILD__HAZARD_FREE": "0", "ANOMALYGEN_BUILD__MULTI_HAZARD": "0",
            "ANOMALYGEN_BUILD__NEAR_MISSES": "0"}
     if a.retries is not None:
@@ -58,28 +59,35 @@ def main() -> int:
     _cli("plan", "--run", str(run), *only, env=env)
     t_learn = time.perf_counter()
     _cli("learn", "--run", str(run), "--seeds", str(a.seeds), "--workers", str(a.workers), *only, env=env)
+    _cli("judge", "--run", str(run), "--workers", str(a.workers), *only, env=env)
     t_end = time.perf_counter()
 
-    by_class: dict[str, list[int]] = {}
+    from anomalygen.referee import load_verdict
+
+    by_class: dict[str, list[int]] = {}  # class -> [runs, resolved (the referee), robot's own check]
     cls_of = {t["id"]: t["hazard_class"] for t in tasks}
     for tid in built:
         for seed in range(a.seeds):
             res = run / "skills" / tid / f"seed{seed}" / "result.json"
-            ok = res.is_file() and json.loads(res.read_text()).get("success", False)
-            row = by_class.setdefault(cls_of[tid], [0, 0])
+            own = res.is_file() and json.loads(res.read_text()).get("success", False)
+            verdict = load_verdict(run, tid, seed)
+            row = by_class.setdefault(cls_of[tid], [0, 0, 0])
             row[0] += 1
-            row[1] += int(bool(ok))
+            row[1] += int(verdict is not None and verdict.resolved)
+            row[2] += int(bool(own))
     n = sum(r[0] for r in by_class.values())
     s = sum(r[1] for r in by_class.values())
-    print("| hazard class | runs | success | rate |\n|---|---|---|---|")
-    for hc, (k, ok) in sorted(by_class.items()):
-        print(f"| {hc} | {k} | {ok} | {ok / k:.0%} |")
-    print(f"| all | {n} | {s} | {s / max(n, 1):.0%} |")
+    own_all = sum(r[2] for r in by_class.values())
+    print("| hazard class | runs | resolved (referee) | rate | robot's own check |\n|---|---|---|---|---|")
+    for hc, (k, ok, mine) in sorted(by_class.items()):
+        print(f"| {hc} | {k} | {ok} | {ok / k:.0%} | {mine} |")
+    print(f"| all | {n} | {s} | {s / max(n, 1):.0%} | {own_all} |")
     print(json.dumps({
         "name": "primitives",
         "tasks_in_classes": len(chosen), "tasks_built": len(built), "seeds": a.seeds,
-        "runs": n, "successes": s, "rate": round(s / max(n, 1), 3),
-        "by_class": {hc: {"n": k, "success": ok} for hc, (k, ok) in sorted(by_class.items())},
+        "runs": n, "resolved": s, "rate": round(s / max(n, 1), 3), "robot_own_check": own_all,
+        "by_class": {hc: {"n": k, "resolved": ok, "robot_own_check": mine}
+                     for hc, (k, ok, mine) in sorted(by_class.items())},
         "build_s": round(t_learn - t_build, 1), "learn_s": round(t_end - t_learn, 1),
         "retries": env.get("ANOMALYGEN_LEARN__RETRIES", "config"), "total_s": round(t_end - t0, 1), "run": str(run),
     }))

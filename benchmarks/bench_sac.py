@@ -12,7 +12,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))  # the door env is test support
 
 
 def main() -> None:
@@ -26,11 +30,11 @@ def main() -> None:
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
 
-    from anomalygen.rl.door_env import DoorCloseEnv
-    from anomalygen.rl.sac import train_sac
+    from anomalygen.skills.learned.sac import train_sac
+    from support.door_env import make_door_env
 
     t0 = time.perf_counter()
-    _, res = train_sac(DoorCloseEnv, args.steps, seed=args.seed, eval_every=args.eval_every,
+    _, res = train_sac(make_door_env, args.steps, seed=args.seed, eval_every=args.eval_every,
                        eval_episodes=args.eval_episodes, threads=args.threads, stop_at=args.stop_at,
                        log=lambda s: print(s, flush=True))
     first80 = next((c["step"] for c in res.curve if c["success"] >= 0.8), None)

@@ -4,8 +4,9 @@ On a run folder whose switch-off scenes are built (e.g. the held-out folder of
 ``benchmarks/train_warm_start.py``), plans every ``switch_off_appliance`` task with the knowledge
 planner (which hands each knob or switch that is on to SAC) and runs the learn stage with ``--seeds``
 seeds, videos off. ``--method primitive`` rewrites the plans' sub-tasks to the primitive first, for
-the baseline on the same scenes. Prints a table and one JSON line: task success over (task, seed)
-runs, sub-task success, how many SAC sub-tasks were fine-tuned or fell back to the primitive, wall time.
+the baseline on the same scenes. Prints a table and one JSON line: runs the referee judged resolved
+over (task, seed) runs (the headline), the robot's own check beside it, sub-task success, how many
+SAC sub-tasks were fine-tuned or fell back to the primitive, wall time.
 
     .venv/bin/python benchmarks/bench_sac_switch_off.py [--run /tmp/ws/test] [--seeds 2] [--sac-steps 1000]
         [--method sac|primitive]
@@ -44,7 +45,7 @@ def main() -> int:
     else:
         run = Path(a.run)
     exe = Path(sys.executable).with_name("anomalygen")
-    env = {**os.environ, "ANOMALYGEN_LEARN__VIDEO": "false", "ANOMALYGEN_LEARN__PLAN_SOURCE": "ground_truth"}
+    env = {**os.environ, "ANOMALYGEN_LEARN__VIDEO": "false", "ANOMALYGEN_PLAN__SOURCE": "ground_truth"}
     tasks = [json.loads(x) for x in (run / "tasks.jsonl").read_text().splitlines() if x.strip()]
     ids = [t["id"] for t in tasks if t["hazard_class"] == CLASS and (run / "scenes" / t["id"] / "scene.json").is_file()]
     only = [x for tid in ids for x in ("--only", tid)]
@@ -60,24 +61,35 @@ def main() -> int:
     subprocess.run([str(exe), "learn", "--run", str(run), "--seeds", str(a.seeds), "--sac-steps", str(a.sac_steps),
                     "--workers", "1", "--force", *only, "--quiet"], check=True, env=env)
     wall = time.perf_counter() - t0
-    runs = ok = sub = sub_ok = tuned = fell = 0
-    print("| task | seed | success | sub-tasks | detail |\n|---|---|---|---|---|")
+    from anomalygen.evaluate.verdicts import verdict_of
+    from anomalygen.runfolder import RunFolder
+
+    folder = RunFolder(run)
+    runs = ok = resolved = judged = sub = sub_ok = tuned = fell = 0
+    print("| task | seed | referee | robot's own check | sub-tasks | detail |\n|---|---|---|---|---|---|")
     for tid in ids:
         for seed in range(a.seeds):
             f = run / "skills" / tid / f"seed{seed}" / "result.json"
             if not f.is_file():
                 continue
             r = json.loads(f.read_text())
+            verdict = verdict_of(folder, tid, seed)
             runs += 1
             ok += bool(r["success"])
+            judged += verdict is not None
+            resolved += bool(verdict is not None and verdict.resolved)
             subs = r["subtasks"]
             sub += len(subs)
             sub_ok += sum(s["success"] for s in subs)
             tuned += sum("SAC steps" in s["detail"] for s in subs)
             fell += sum("fell back" in s["detail"] for s in subs)
             first = subs[0]["detail"][:110] if subs else ""
-            print(f"| {tid[:34]} | {seed} | {r['success']} | {sum(s['success'] for s in subs)}/{len(subs)} | {first} |")
-    print(json.dumps({"method": a.method, "runs": runs, "success": ok, "rate": round(ok / max(1, runs), 3),
+            status = verdict.status if verdict is not None else "no truth"
+            print(f"| {tid[:34]} | {seed} | {status} | {r['success']} | {sum(s['success'] for s in subs)}/{len(subs)} "
+                  f"| {first} |")
+    print(json.dumps({"method": a.method, "runs": runs, "judged": judged, "resolved": resolved,
+                      "resolved_rate": round(resolved / max(1, judged), 3),
+                      "robot_own_check": ok, "robot_own_check_rate": round(ok / max(1, runs), 3),
                       "subtasks": sub, "subtask_success": sub_ok, "fine_tuned": tuned, "fell_back": fell,
                       "learn_wall_s": round(wall, 1), "sac_steps": a.sac_steps}))
     return 0

@@ -27,24 +27,24 @@ def _free_pose(drv, cup, axis, mouth_base, lateral, rng, restarts: int) -> bool:
     """A collision-free arm (and base) with the cup face at ``cup``, its axis along ``axis``?"""
     import mujoco
 
-    from anomalygen.control.arm_motion import _checker, _reference_state
-    from anomalygen.control.ik import quat_z_to, solve_ik
-    from anomalygen.scene import robot
+    from anomalygen.robot.agent import Agent
+    from anomalygen.robot.arm_motion import _checker, _reference_state
+    from anomalygen.robot.ik import quat_z_to, solve_ik
 
     m, d = drv.model, drv.data
-    lim = m.jnt_range[[m.joint(n).id for n in robot.ARM_JOINTS]]
+    lim = m.jnt_range[[m.joint(n).id for n in Agent.ARM_JOINTS]]
     for off in lateral:
         for dyaw in (0.0, -0.3, 0.3):
             b = mouth_base + off
             yaw = float(np.arctan2(cup[1] - b[1], cup[0] - b[0])) + dyaw
-            for n, v in zip(robot.BASE_JOINTS, (b[0], b[1], yaw), strict=True):
+            for n, v in zip(Agent.BASE_JOINTS, (b[0], b[1], yaw), strict=True):
                 d.actuator(n).ctrl[0] = d.joint(n).qpos[0] = v
             mujoco.mj_kinematics(m, d)
             ref = _reference_state(m, d)
             chk = _checker(m, ref, None, None, 0.0, ())
             for k in range(restarts):
-                q0 = np.asarray(robot.HOME_ARM) if k == 0 else rng.uniform(lim[:, 0], lim[:, 1])
-                r = solve_ik(m, ref, robot.CUP_SITE, robot.ARM_JOINTS, cup, quat_z_to(axis), q_init=q0, iterations=150)
+                q0 = np.asarray(Agent.HOME_ARM) if k == 0 else rng.uniform(lim[:, 0], lim[:, 1])
+                r = solve_ik(m, ref, Agent.CUP_SITE, Agent.ARM_JOINTS, cup, quat_z_to(axis), q_init=q0, iterations=150)
                 if r.success and chk.valid(r.qpos[chk.qadr]):
                     return True
     return False
@@ -53,13 +53,13 @@ def _free_pose(drv, cup, axis, mouth_base, lateral, rng, restarts: int) -> bool:
 def main() -> None:
     import mujoco
 
-    from anomalygen.control.driver import Driver
-    from anomalygen.learn.execute import run_subtask
     from anomalygen.perception import perceived_spec
     from anomalygen.rng import item_rng
-    from anomalygen.scene import robot
+    from anomalygen.robot.agent import Agent
     from anomalygen.scene.graph import load_scene
     from anomalygen.schema import Plan
+    from anomalygen.skills.catalogue import skill_for
+    from anomalygen.skills.episode import Episode
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--run", required=True)
@@ -70,18 +70,19 @@ def main() -> None:
     a = ap.parse_args()
     plan = Plan.model_validate_json(open(f"{a.run}/plans/{a.task}.json").read())
     model, data, spec = load_scene(f"{a.run}/scenes/{a.task}")
-    drv = Driver(model, data, perceived_spec(spec), rng=item_rng(a.seed, a.task))
+    ep = Episode(model, data, perceived_spec(spec), rng=item_rng(a.seed, a.task), plan=plan)
+    drv = ep.driver
     step = next(st for st in plan.subtasks if st.primitive == "take_out_of")
     for st in plan.subtasks[:plan.subtasks.index(step)]:
-        run_subtask(drv, st, plan)
+        skill_for(ep, st)().run(ep, st)
         drv.settle(10)
     obj, container = step.params["object"], step.params["region"]
-    lo, hi, out = drv.compartments[container]
+    lo, hi, out = ep.memory.compartments[container]
     k = int(np.argmax(np.abs(out[:2])))
     mouth = hi[k] if out[k] > 0 else lo[k]
     olo, ohi = drv.aabb(obj)
     face = ohi[k] if out[k] > 0 else olo[k]
-    need = abs(face - mouth) - robot.SUCTION_RANGE  # cup depth behind the opening that touches the face
+    need = abs(face - mouth) - Agent.SUCTION_RANGE  # cup depth behind the opening that touches the face
     side = np.zeros(3)
     side[1 - k] = 1.0
     centre = (olo + ohi) / 2
@@ -89,8 +90,8 @@ def main() -> None:
     lateral = [side * s * width / 2 for s in (0.0, -0.6, 0.6)]
     # the base's rim just outside the opening, in line with the object
     mouth_base = centre.copy()
-    mouth_base[k] = mouth + out[k] * (robot.BASE_RADIUS + 0.03)
-    model.body(robot.TORSO).pos[2] = -a.drop
+    mouth_base[k] = mouth + out[k] * (Agent.BASE_RADIUS + 0.03)
+    model.body(Agent.TORSO).pos[2] = -a.drop
     rng = np.random.default_rng(a.seed)
     inward = -out / np.linalg.norm(out)
     heights = np.linspace(olo[2] + 0.03, ohi[2] - 0.03, 3)

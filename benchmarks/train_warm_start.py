@@ -49,15 +49,15 @@ def starts_of(run: Path, log=lambda m: print(m, file=sys.stderr)) -> list:
     import mujoco
     import numpy as np
 
-    from anomalygen.control.driver import Driver
     from anomalygen.perception import perceived_spec
     from anomalygen.plan.planner import plan_from_kb
-    from anomalygen.rl.part_env import PartStart
-    from anomalygen.rl.part_skill import grasp_part
-    from anomalygen.rl.part_subtask import far_value
     from anomalygen.runfolder import read_model
     from anomalygen.scene.graph import load_scene
     from anomalygen.schema import SceneSpec
+    from anomalygen.skills.episode import Episode
+    from anomalygen.skills.learned.part_env import PartStart
+    from anomalygen.skills.learned.part_skill import grasp_part
+    from anomalygen.skills.learned.part_subtask import far_value
 
     tasks = {json.loads(x)["id"]: json.loads(x) for x in (run / "tasks.jsonl").read_text().splitlines() if x.strip()}
     out = []
@@ -70,10 +70,10 @@ def starts_of(run: Path, log=lambda m: print(m, file=sys.stderr)) -> list:
         for st in plan_from_kb(tid, CLASS, bindings, spec=read_model(sd / "scene.json", SceneSpec)).subtasks:
             model, data, spec = load_scene(sd)
             spec = perceived_spec(spec)
-            drv = Driver(model, data, spec, rng=np.random.default_rng(0))
+            ep = Episode(model, data, spec, rng=np.random.default_rng(0))
             joint = str(st.params.get("joint"))
             js = next(j for o in spec.objects for j in o.joint_states if j.name == joint)
-            ok, why = grasp_part(drv, joint)
+            ok, why = grasp_part(ep, joint)
             if not ok:
                 log(f"{tid} {joint}: {why}")
                 continue
@@ -88,10 +88,10 @@ def demonstrations(starts, episodes: int, seed: int) -> dict:
     """Transitions of the scripted reference (``part_skill.reference_action``) on the training starts."""
     import numpy as np
 
-    from anomalygen.rl.part_env import PartTurnEnv
-    from anomalygen.rl.part_skill import reference_action
+    from anomalygen.skills.learned.part_env import make_part_env
+    from anomalygen.skills.learned.part_skill import reference_action
 
-    env = PartTurnEnv(starts)
+    env = make_part_env(starts)
     cols = {k: [] for k in ("obs", "next_obs", "action", "reward", "done")}
     wins = 0
     for k in range(episodes):
@@ -112,7 +112,7 @@ def demonstrations(starts, episodes: int, seed: int) -> dict:
 
 def seeded_with(demos: dict, bc_steps: int, seed: int):
     """A ``train_sac`` pretrain hook: behaviour cloning on the demos, and the demos in the replay buffer."""
-    from anomalygen.rl.sac import behaviour_clone
+    from anomalygen.skills.learned.sac import behaviour_clone
 
     def pretrain(model) -> None:
         nll = behaviour_clone(model, demos["obs"], demos["action"], steps=bc_steps, seed=seed)
@@ -127,12 +127,12 @@ def seeded_with(demos: dict, bc_steps: int, seed: int):
 
 
 def held_out_success(policy, starts, seeds: int) -> list[dict]:
-    from anomalygen.rl.part_env import PartTurnEnv
-    from anomalygen.rl.sac import evaluate_policy
+    from anomalygen.skills.learned.part_env import make_part_env
+    from anomalygen.skills.learned.sac import evaluate_policy
 
     rows = []
     for tid, s in starts:
-        env = PartTurnEnv([s])
+        env = make_part_env([s])
         rate, ret = evaluate_policy(policy, env, seeds, seed=50_000)
         env.close()
         rows.append({"task": tid, "joint": s.joint, "success": rate, "return": round(ret, 2)})
@@ -154,8 +154,8 @@ def main() -> int:
     ap.add_argument("--bc-steps", type=int, default=2000)
     a = ap.parse_args()
 
-    from anomalygen.rl.part_env import PartTurnEnv
-    from anomalygen.rl.sac import train_sac
+    from anomalygen.skills.learned.part_env import make_part_env
+    from anomalygen.skills.learned.sac import train_sac
 
     train_run, test_run = Path(a.train), Path(a.held_out)
     if a.make:
@@ -171,8 +171,8 @@ def main() -> int:
         demos = demonstrations(starts, a.demos, a.seed)
         pretrain = seeded_with(demos, a.bc_steps, a.seed)
         print(f"reference: success {demos['success']:.2f} on {a.demos} training episodes", file=sys.stderr)
-    eval_env = PartTurnEnv([s for _, s in test])
-    policy, res = train_sac(lambda: PartTurnEnv(starts), a.steps, seed=a.seed, eval_every=a.eval_every,
+    eval_env = make_part_env([s for _, s in test])
+    policy, res = train_sac(lambda: make_part_env(starts), a.steps, seed=a.seed, eval_every=a.eval_every,
                             eval_episodes=max(5, len(test)), learning_starts=500, net_arch=(64, 64),
                             n_envs=a.n_envs, eval_env=eval_env, stop_at=None, pretrain=pretrain,
                             log=lambda m: print(m, file=sys.stderr, flush=True))

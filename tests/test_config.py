@@ -18,7 +18,7 @@ def test_defaults_use_the_offline_engine_when_no_llm_is_configured():
     s = load_settings()
     assert s.llm.backend == "none"
     assert s.engine_for("brainstorm") is Engine.KNOWLEDGE
-    assert s.engine_for("learn") is Engine.KNOWLEDGE
+    assert s.engine_for("plan") is Engine.KNOWLEDGE
 
 
 def test_llm_engine_is_the_default_once_an_llm_is_configured():
@@ -75,3 +75,39 @@ def test_secrets_are_masked_in_dumps(monkeypatch):
     dumped = s.masked_dump()
     assert dumped["llm"]["api_key"] == "***"
     assert "sk-very-secret" not in str(dumped)
+
+
+def test_the_plan_stage_reads_its_own_section(tmp_path, monkeypatch):
+    path = tmp_path / "plan.toml"
+    path.write_text('[plan]\nsource = "ground_truth"\nmax_fixes = 2\nsac_actions = ["close_joint"]\n[learn]\nseeds = 3\n')
+    s = load_settings(path)
+    assert (s.plan.source, s.plan.max_fixes, s.plan.sac_actions, s.learn.seeds) == ("ground_truth", 2, ["close_joint"], 3)
+    monkeypatch.setenv("ANOMALYGEN_PLAN__SOURCE", "detected")
+    assert load_settings(path).plan.source == "detected"
+    assert load_settings(path, {"plan.source": "ground_truth"}).plan.source == "ground_truth"
+
+
+def test_old_learn_keys_of_the_plan_stage_are_read_under_their_new_names_with_a_warning(tmp_path, monkeypatch, caplog):
+    old = tmp_path / "old.toml"
+    old.write_text('[learn]\nplan_source = "ground_truth"\nengine = "knowledge"\nmax_fixes = 2\nseeds = 3\n')
+    with caplog.at_level("WARNING", logger="anomalygen.config"):
+        s = load_settings(old)
+    assert (s.plan.source, s.plan.engine, s.plan.max_fixes, s.learn.seeds) == ("ground_truth", Engine.KNOWLEDGE, 2, 3)
+    said = caplog.text
+    assert f"learn.plan_source (in {old}) is read as plan.source" in said and "learn.max_fixes" in said
+    # precedence still holds across layers, whichever name each layer uses
+    monkeypatch.setenv("ANOMALYGEN_LEARN__PLAN_SOURCE", "detected")
+    caplog.clear()
+    with caplog.at_level("WARNING", logger="anomalygen.config"):
+        assert load_settings(old).plan.source == "detected"
+    assert "ANOMALYGEN_LEARN__PLAN_SOURCE (in the environment) is read as ANOMALYGEN_PLAN__SOURCE" in caplog.text
+    assert load_settings(old, {"plan.source": "ground_truth"}).plan.source == "ground_truth"
+
+
+def test_old_and_new_name_disagreeing_in_one_layer_is_refused(tmp_path):
+    both = tmp_path / "both.toml"
+    both.write_text('[learn]\nplan_source = "ground_truth"\n[plan]\nsource = "detected"\n')
+    with pytest.raises(UserError, match="learn.plan_source .* is the old name of plan.source"):
+        load_settings(both)
+    both.write_text('[learn]\nplan_source = "detected"\n[plan]\nsource = "detected"\n')
+    assert load_settings(both).plan.source == "detected"

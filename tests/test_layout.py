@@ -1,5 +1,8 @@
 """The package layout's rules: imports form no cycles, counting imports inside functions and
-type-checking-only imports too; no module is longer than MAX_LINES, except catalogues of generators."""
+type-checking-only imports too; no module is longer than MAX_LINES, except catalogues of generators;
+and the robot's side reaches neither the referee nor the builder's internals, not even through a
+shared module; the robot's element names and controllers live in ``robot/`` only; the old homes of
+the skills are gone."""
 
 import ast
 from pathlib import Path
@@ -10,7 +13,20 @@ ROOT = Path(anomalygen.__file__).parent
 MAX_LINES = 500
 # one generator function per vocabulary name: long, but a list, not a tangle
 CATALOGUES = {"assets/generators/household.py", "assets/generators/furniture.py"}
-
+# The robot's side: it perceives the scene (scene graph, renders, simulator state, the spec without the
+# answer key) and acts on it.
+ROBOT_SIDE = ("anomalygen.detect", "anomalygen.plan", "anomalygen.learn", "anomalygen.robot", "anomalygen.skills")
+# The doors through which it (and a researcher's own policy) reads a built scene: held to the same rule.
+ROBOT_READS = ("anomalygen.perception", "anomalygen.scene.env")
+# What the robot's side may not reach: the referee (truth manifests, matching, scoring, judging), the
+# evaluation and report built on it, the task generator (task words), and the builder's internals
+# (what it chose, why, and how it checked it). The builder's shared products stay allowed: the scene
+# graph, the env, the robot, the room layout and furniture it composes, renders, sensors, saved states.
+FORBIDDEN = ("anomalygen.referee", "anomalygen.evaluate", "anomalygen.brainstorm",
+             "anomalygen.scene.build", "anomalygen.scene.stage", "anomalygen.scene.casting",
+             "anomalygen.scene.asset_choice", "anomalygen.scene.placement", "anomalygen.scene.instances",
+             "anomalygen.scene.judgement", "anomalygen.scene.mix", "anomalygen.scene.llm_engine",
+             "anomalygen.scene.hints", "anomalygen.scene.validate", "anomalygen.scene.verify")
 
 
 def _module_graph() -> dict[str, set[str]]:
@@ -73,8 +89,8 @@ def _cycles(edges: dict[str, set[str]]) -> list[set[str]]:
 
 def test_no_import_cycles():
     edges = _module_graph()
-    # imports inside functions count: execute.py imports the part skills inside _drive_joints
-    assert "anomalygen.control.parts" in edges["anomalygen.learn.execute"]
+    # imports inside functions count: execute.py imports the skill catalogue inside _run_skill
+    assert "anomalygen.skills.catalogue" in edges["anomalygen.learn.execute"]
     # so do type-checking-only ones: placement.py names Settings only in annotations
     assert "anomalygen.config" in edges["anomalygen.scene.placement"]
     cycles = _cycles(edges)
@@ -92,3 +108,89 @@ def test_no_module_is_longer_than_the_limit():
         if (n := len(path.read_text().splitlines())) > MAX_LINES
     }
     assert {p: n for p, n in long.items() if p not in CATALOGUES} == {}
+
+
+def _under(module: str, packages: tuple[str, ...]) -> bool:
+    return any(module == p or module.startswith(p + ".") for p in packages)
+
+
+def _forbidden_paths(edges: dict[str, set[str]], sources: tuple[str, ...], forbidden: tuple[str, ...]) -> list[list[str]]:
+    """One shortest import path from each source module to a forbidden module it reaches, through
+    any modules in between (imports inside functions count: they run when the function does)."""
+    found = []
+    for start in sorted(m for m in edges if _under(m, sources)):
+        parent: dict[str, str | None] = {start: None}
+        queue = [start]
+        while queue:
+            v = queue.pop(0)
+            if _under(v, forbidden):
+                path = [v]
+                while parent[path[-1]] is not None:
+                    path.append(parent[path[-1]])
+                found.append(path[::-1])
+                break
+            for w in sorted(edges.get(v, ())):
+                if w not in parent:
+                    parent[w] = v
+                    queue.append(w)
+    return found
+
+
+def test_the_robot_side_reaches_neither_the_referee_nor_the_builders_internals():
+    edges = _module_graph()
+    robot = [m for m in edges if _under(m, ROBOT_SIDE)]
+    assert "anomalygen.learn.stage" in robot and "anomalygen.detect.stage" in robot
+    # the answer-key side is real and reaches what it must: the builder writes truth.json through the referee
+    assert _forbidden_paths(edges, ("anomalygen.scene.build",), ("anomalygen.referee",))
+    assert "anomalygen.perception" in edges and "anomalygen.scene.env" in edges
+    paths = _forbidden_paths(edges, ROBOT_SIDE + ROBOT_READS, FORBIDDEN)
+    assert paths == [], "robot side reaches the answer key: " + "; ".join(" -> ".join(p) for p in paths)
+
+
+def test_the_reach_check_follows_imports_through_shared_modules():
+    edges = {"anomalygen.plan.x": {"anomalygen.shared"}, "anomalygen.shared": {"anomalygen.referee.truth"},
+             "anomalygen.referee.truth": set(), "anomalygen.detect.y": {"anomalygen.scene.graph"},
+             "anomalygen.scene.graph": set()}
+    assert _forbidden_paths(edges, ROBOT_SIDE, FORBIDDEN) == [
+        ["anomalygen.plan.x", "anomalygen.shared", "anomalygen.referee.truth"]]
+def _string_constants(tree: ast.AST) -> list[str]:
+    """Every string literal of a module, f-string pieces included."""
+    return [n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)]
+
+
+def test_only_the_robot_package_names_robot_elements_or_drives_its_actuators():
+    """The agent owns the element names and the controllers: no module outside ``robot/`` spells a
+    distinctive element name (a Panda joint or link, the cup's geom and sites, the end-effector target
+    and its weld, the suction weld prefix) or writes actuator gains (a control mode of its own)."""
+    from anomalygen.robot.agent import Agent
+
+    names = {*Agent.ROBOT_JOINTS, Agent.CUP_GEOM, Agent.CUP_SITE, Agent.EE_SITE, Agent.EE_TARGET, Agent.EE_TRACK,
+             Agent.TORSO, Agent.SUCTION_PREFIX}
+    spelled, driven = {}, {}
+    for path in ROOT.rglob("*.py"):
+        rel = path.relative_to(ROOT).as_posix()
+        if rel.startswith("robot/"):
+            continue
+        tree = ast.parse(path.read_text())
+        hits = {c for c in _string_constants(tree) if c in names or Agent.ARM_LINK_PREFIX + "joint" in c
+                or Agent.ARM_LINK_PREFIX + "link" in c}
+        if hits:
+            spelled[rel] = sorted(hits)
+        gains = {n.attr for n in ast.walk(tree) if isinstance(n, ast.Attribute)
+                 and n.attr in ("actuator_gainprm", "actuator_biasprm")}
+        if gains:
+            driven[rel] = sorted(gains)
+    assert spelled == {} and driven == {}, (spelled, driven)
+
+
+def test_the_checker_sees_an_element_name_spelled_out():
+    tree = ast.parse('ARM = [f"panda_joint{i}" for i in range(1, 8)]\nCUP = "suction_site"')
+    assert "suction_site" in _string_constants(tree)
+    assert any("panda_joint" in c for c in _string_constants(tree))
+
+
+def test_skills_have_one_home():
+    """``control/`` and ``rl/`` are gone: scripted and learned skills live in ``skills/``, the motion
+    layer in ``robot/``."""
+    assert not (ROOT / "control").exists() and not (ROOT / "rl").exists()
+    assert (ROOT / "robot" / "agent.py").is_file() and (ROOT / "skills" / "registry.py").is_file()

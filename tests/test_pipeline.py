@@ -46,7 +46,7 @@ def test_one_registry_names_every_stage_the_cli_and_the_pipeline_run():
     from anomalygen.cli import app
 
     names = [s.name for s in registry.STAGES]
-    assert names == ["brainstorm", "build", "detect", "plan", "learn", "evaluate", "report"]
+    assert names == ["brainstorm", "build", "detect", "plan", "learn", "judge", "evaluate", "report"]
     commands = {c.name or c.callback.__name__ for c in app.registered_commands}
     assert set(names) <= commands
     for s in registry.STAGES:  # every module exists and has the entry point the registry calls
@@ -55,6 +55,7 @@ def test_one_registry_names_every_stage_the_cli_and_the_pipeline_run():
     # stage modules live in the package of the same name (build's package is scene/, report's evaluate/)
     assert registry.stage("plan").module == "anomalygen.plan.stage"
     assert registry.stage("learn").module == "anomalygen.learn.stage"
+    assert registry.stage("judge").module == "anomalygen.referee.stage"  # the referee judges after the robot
 
 
 def test_a_whole_run_stage_refuses_only(tmp_path):
@@ -64,7 +65,7 @@ def test_a_whole_run_stage_refuses_only(tmp_path):
 
 def test_demo_defaults_are_the_embedded_offline_ones():
     s = load_settings(pipeline.demo_config_path())
-    assert (s.brainstorm.engine, s.build.engine, s.learn.engine) == ("knowledge",) * 3
+    assert (s.brainstorm.engine, s.build.engine, s.plan.engine) == ("knowledge",) * 3
     assert s.detect.detector == "rules" and s.llm.backend == "none"
     assert 15 <= s.brainstorm.n <= 25 and s.learn.sac_steps <= 1000
 
@@ -110,7 +111,7 @@ def test_killed_run_resumes_without_duplicates_or_losses(tmp_path):
     done = subprocess.run(_cli("run", "--out", str(run_dir), "--config", str(cfg), "--json"), env=_env(),
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr[-2000:]
-    result = json.loads(done.stdout[done.stdout.index("{"):])
+    result = json.loads(done.stdout)  # --json: nothing else on stdout
     ids = [json.loads(line)["id"] for line in (run_dir / "tasks.jsonl").read_text().splitlines() if line.strip()]
     assert len(ids) == len(set(ids)) == 5
     scenes = sorted(p.parent.name for p in (run_dir / "scenes").glob("*/scene.json"))

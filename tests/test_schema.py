@@ -56,6 +56,9 @@ def _example(cls):
         S.HazardManifest: S.HazardManifest(scene_id="s", task_id="t", hazards=[S.ManifestHazard(
             hazard_class="close_open_refrigerator", object="fridge_0", category="Refrigerator", severity=0.7,
             variable="$target", success=[S.PredicateCall(name="joint_closed", args={"object": "fridge_0"})])]),
+        S.Verdict: S.Verdict(task_id="t", seed=0, status="unresolved", resolved=False, hazards=[S.HazardVerdict(
+            hazard_class="close_open_refrigerator", object="fridge_0", source="intended", resolved=False,
+            still_firing=["close_open_refrigerator"])], new_hazards=["x on y"], released=["mug_0"]),
     }
     return examples[cls]
 

@@ -6,7 +6,10 @@ __all__ = ["__version__", "make_env"]
 
 
 def make_env(scene_dir, **kwargs):
-    """Create the Gymnasium env for a built scene folder (see :mod:`anomalygen.scene.env`)."""
+    """The Gymnasium env of a built scene folder, judged: the perception-only scene env
+    (:mod:`anomalygen.scene.env`) wrapped in :class:`anomalygen.referee.env.JudgedEnv`, which puts the
+    referee's verdict in ``info["verdict"]`` (and ``info["is_success"]``) when an episode ends."""
+    from anomalygen.referee.env import JudgedEnv
     from anomalygen.scene.env import make_env as _make_env
 
-    return _make_env(scene_dir, **kwargs)
+    return JudgedEnv(_make_env(scene_dir, **kwargs), scene_dir)

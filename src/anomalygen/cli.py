@@ -6,6 +6,7 @@ User mistakes end as one red line and exit code 2, never a traceback.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import json
 import os
@@ -82,7 +83,43 @@ def _run_stage(name: str, run, settings: Settings, **kwargs):
     return stage(name).run(run, settings, **kwargs)
 
 
-def _finish(summary, as_json: bool) -> None:
+@contextlib.contextmanager
+def _json_stdout(as_json: bool):
+    """With ``--json``, stdout carries the JSON and nothing else: while the command runs, whatever else
+    is written there (a library's print, C code, a child process) goes to stderr. Yields the stream
+    the JSON goes to."""
+    if not as_json:
+        yield sys.stdout
+        return
+    saved = sys.stdout
+    saved.flush()
+    try:
+        on_fd1 = saved.fileno() == 1
+    except (AttributeError, ValueError, OSError):  # a captured or replaced stream: Python-level only
+        on_fd1 = False
+    json_fd = os.dup(1) if on_fd1 else None
+    if json_fd is not None:
+        os.dup2(2, 1)
+    out = os.fdopen(os.dup(json_fd), "w") if json_fd is not None else saved
+    try:
+        with contextlib.redirect_stdout(sys.stderr):
+            yield out
+    finally:
+        out.flush()
+        if json_fd is not None:
+            out.close()
+            sys.stderr.flush()
+            os.dup2(json_fd, 1)
+            os.close(json_fd)
+
+
+def _stage(name: str, run, settings: Settings, as_json: bool, **kwargs) -> None:
+    """Run a registered stage and report it (``--json``: the summary alone on stdout)."""
+    with _json_stdout(as_json) as out:
+        _finish(_run_stage(name, run, settings, **kwargs), as_json, out)
+
+
+def _finish(summary, as_json: bool, out=None) -> None:
     from rich.markup import escape
     if as_json:
         payload = {
@@ -93,7 +130,7 @@ def _finish(summary, as_json: bool) -> None:
             "wall_s": round(summary.wall_s, 3),
             "errors": summary.errors,
         }
-        print(json.dumps(payload, indent=2))
+        print(json.dumps(payload, indent=2), file=out or sys.stdout, flush=True)
     else:
         err.print(summary.line())
         for item_id, reason in list(summary.errors.items())[:10]:
@@ -139,7 +176,7 @@ def brainstorm(
            "brainstorm.rounds": rounds, "brainstorm.tasks_file": str(tasks) if tasks else None,
            "brainstorm.tasks_text": str(tasks_text) if tasks_text else None},
     )
-    _finish(_run_stage("brainstorm", _open_run(run, create=True, settings=settings), settings, force=force), as_json)
+    _stage("brainstorm", _open_run(run, create=True, settings=settings), settings, as_json, force=force)
 
 
 @app.command()
@@ -163,7 +200,7 @@ def build(
     settings = _common(config, seed, quiet, workers, executor, address, backend=backend, model=model,
                        **{"build.clutter": clutter, "build.engine": engine})
     folder = _open_run(run)
-    _finish(_run_stage("build", folder, settings, force=force, only=only), as_json)
+    _stage("build", folder, settings, as_json, force=force, only=only)
 
 
 @app.command()
@@ -171,6 +208,8 @@ def detect(
     run: RunOpt = Path("runs/default"),
     detector: Annotated[str | None, typer.Option(help="rules, llm or hybrid.")] = None,
     k: Annotated[int | None, typer.Option("--k", help="Hypotheses per scene.")] = None,
+    noise: Annotated[bool | None, typer.Option(
+        "--noise/--no-noise", help="Perception noise on the detectors' scene graph (settings: detect.noise).")] = None,
     only: OnlyOpt = None,
     config: ConfigOpt = None,
     force: ForceOpt = False,
@@ -182,9 +221,9 @@ def detect(
 ):
     """Stage 3: find the hazard in each scene without being told the task (writes detections.jsonl)."""
     settings = _common(config, None, quiet, backend=backend, model=model, no_cache=no_cache,
-                       **{"detect.detector": detector, "detect.k": k})
+                       **{"detect.detector": detector, "detect.k": k, "detect.noise.enabled": noise})
     folder = _open_run(run)
-    _finish(_run_stage("detect", folder, settings, force=force, only=only), as_json)
+    _stage("detect", folder, settings, as_json, force=force, only=only)
 
 
 @app.command()
@@ -202,9 +241,9 @@ def plan(
 ):
     """Stage 4a: decompose each fix into sub-tasks with rewards and success checks (writes plans/)."""
     settings = _common(config, None, quiet, backend=backend, model=model,
-                       **{"learn.plan_source": source, "learn.engine": engine})
+                       **{"plan.source": source, "plan.engine": engine})
     folder = _open_run(run)
-    _finish(_run_stage("plan", folder, settings, force=force, only=only), as_json)
+    _stage("plan", folder, settings, as_json, force=force, only=only)
 
 
 @app.command()
@@ -226,7 +265,26 @@ def learn(
     settings = _common(config, seed, quiet, workers, executor, address,
                        **{"learn.sac_steps": sac_steps, "learn.seeds": seeds})
     folder = _open_run(run)
-    _finish(_run_stage("learn", folder, settings, force=force, only=only), as_json)
+    _stage("learn", folder, settings, as_json, force=force, only=only)
+
+
+@app.command()
+def judge(
+    run: RunOpt = Path("runs/default"),
+    only: OnlyOpt = None,
+    workers: WorkersOpt = None,
+    config: ConfigOpt = None,
+    force: ForceOpt = False,
+    quiet: QuietOpt = False,
+    as_json: JsonOpt = False,
+    executor: ExecutorOpt = None,
+    address: AddressOpt = None,
+):
+    """The referee, after the robot: judge every run's released, settled final state against the hidden
+    truth (writes skills/<task>/seed<k>/verdict.json)."""
+    settings = _common(config, None, quiet, workers, executor, address)
+    folder = _open_run(run)
+    _finish(_run_stage("judge", folder, settings, force=force, only=only), as_json)
 
 
 @app.command()
@@ -240,7 +298,7 @@ def evaluate(
     """Measure diversity, detection hit@k and success; print the diversity table with baselines."""
     settings = _common(config, None, quiet, **{"evaluate.image_metrics": False if no_images else None})
     folder = _open_run(run)
-    _finish(_run_stage("evaluate", folder, settings), as_json)
+    _stage("evaluate", folder, settings, as_json)
 
 
 @app.command()
@@ -253,7 +311,7 @@ def report(
     """Write report/index.html, report.json and summary.md for a run."""
     settings = _common(config, None, quiet)
     folder = _open_run(run)
-    _finish(_run_stage("report", folder, settings), as_json)
+    _stage("report", folder, settings, as_json)
 
 
 @app.command("run")
@@ -273,9 +331,10 @@ def run_all(
     from anomalygen.pipeline import demo_config_path, run_pipeline
 
     settings = _common(config or demo_config_path(), seed, quiet, workers, executor, address, **{"brainstorm.n": n})
-    result = run_pipeline(_open_run(run, create=True, settings=settings), settings, force=force)
-    if as_json:
-        print(json.dumps(result, indent=2, default=str))
+    with _json_stdout(as_json) as stream:
+        result = run_pipeline(_open_run(run, create=True, settings=settings), settings, force=force)
+        if as_json:
+            print(json.dumps(result, indent=2, default=str), file=stream, flush=True)
 
 
 # ----------------------------------------------------------------------------- tools

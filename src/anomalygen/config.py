@@ -1,11 +1,14 @@
 """Effective configuration: TOML file < ``ANOMALYGEN_*`` environment < CLI flags.
 
 One settings model for the whole pipeline, so a run's manifest can record exactly what produced it.
-Nested sections map to env vars with a double underscore: ``ANOMALYGEN_LLM__BACKEND=openai``.
+Nested sections map to env vars with a double underscore: ``ANOMALYGEN_LLM__BACKEND=openai``. Each
+stage reads its own section; a key that moved to another section is still read under its old name,
+with a warning that names the new one (``MOVED``).
 """
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 from typing import Any, Literal
 
@@ -18,6 +21,8 @@ from pydantic_settings import (
 )
 
 from anomalygen.schema import BrainstormMode, Engine
+
+log = logging.getLogger(__name__)
 
 
 class Section(BaseModel):
@@ -79,29 +84,54 @@ class BuildConfig(Section):
         True, description="draw real models from installed packages where a category has them (assets/real); "
         "false: procedural assets only, for comparisons"
     )
+    start: Literal["dock", "reach"] = Field(
+        "dock", description="where the robot starts: 'dock', the same pose in every scene (says nothing about the "
+        "hazard); 'reach', the free pose nearest the dock with the hazard within reach, facing it (the answer "
+        "key as a start pose: for tests and ablations of the skills alone)"
+    )
+
+
+class NoiseConfig(Section):
+    """Perception noise on the scene graph the detectors read, so they are measured off the perfect
+    graph too (``detect/noise.py``). Off by default; plan and learn always see the simulator."""
+
+    enabled: bool = False
+    pose_jitter: float = Field(0.02, ge=0, le=0.5, description="m: each object's position error bound, per axis (uniform)")
+    miss_rate: float = Field(0.1, ge=0, le=1, description="chance that a small object is not seen at all")
+    small_size: float = Field(0.06, gt=0, description="m: an object whose largest extent is at most this counts as small")
+    confusion_rate: float = Field(
+        0.1, ge=0, le=1, description="chance that an object with look-alikes (knowledge base) is seen as one of them"
+    )
 
 
 class DetectConfig(Section):
     detector: Literal["rules", "llm", "hybrid"] = "rules"
     k: int = Field(3, ge=1, le=10)
-    llm_judge: bool = Field(True, description="when an LLM is configured, ask it about hypotheses exact+SBERT judged a miss")
-    judge_threshold: float | None = Field(None, ge=-1, le=1, description="SBERT judge threshold; default: the calibrated one")
+    noise: NoiseConfig = Field(default_factory=NoiseConfig)
 
 
-class LearnConfig(Section):
-    engine: Engine | None = None
-    plan_source: Literal["ground_truth", "detected"] = Field(
+class PlanConfig(Section):
+    engine: Engine | None = Field(
+        None, description="knowledge: the class's recipe; llm: the configured LLM decomposes the fix; "
+        "default knowledge unless an LLM is set"
+    )
+    source: Literal["ground_truth", "detected"] = Field(
         "detected", description="detected: plan from the detections and the perceived scene alone; "
         "ground_truth: the oracle ablation (the builder's class and bindings)"
     )
-    max_fixes: int = Field(3, ge=1, description="detected hazards fixed per scene, most severe first")
+    max_fixes: int = Field(
+        3, ge=1, description="detected hazards fixed per scene, most severe first (and per look-again in learn)"
+    )
     min_score: float = Field(0.0, description="hypotheses scoring below this are not acted on")
-    seeds: int = Field(1, ge=1)
-    sac_steps: int = Field(2000, ge=0, description="SAC environment steps per SAC sub-task (paper: 1M)")
     sac_actions: list[str] = Field(
         default_factory=list,
         description="recipe actions the knowledge planner hands to SAC instead of a primitive, e.g. close_joint",
     )
+
+
+class LearnConfig(Section):
+    seeds: int = Field(1, ge=1)
+    sac_steps: int = Field(2000, ge=0, description="SAC environment steps per SAC sub-task (paper: 1M)")
     retries: int = Field(
         1, ge=0, description="times a primitive sub-task whose success check fails right after it is run again"
     )
@@ -115,7 +145,7 @@ class LearnConfig(Section):
         "more than 1 helps only with idle cores"
     )
     reward_mode: Literal["spec", "code"] = Field(
-        "spec", description="code: SAC sub-tasks learn from reward code run in the sandbox (rl/sandbox.py), "
+        "spec", description="code: SAC sub-tasks learn from reward code run in the sandbox (skills/learned/sandbox.py), "
         "the plan's own or its reward terms rendered as code; spec: the terms evaluated in-process"
     )
 
@@ -125,6 +155,11 @@ class EvaluateConfig(Section):
     vit_weights: str | None = Field(None, description="optional path to ViT/CLIP weights for image similarity")
     wmd_pairs: int = Field(300, ge=1, description="pairs sampled per text set for mean Word Mover's Distance")
     baselines: bool = Field(True, description="recompute the six benchmark baselines in the diversity table")
+    text_judge_llm: bool = Field(
+        False, description="text judge diagnostic: when an LLM is configured, ask it about hypotheses exact+SBERT "
+        "judged a miss (detection itself is scored against the truth, not by this judge)")
+    text_judge_threshold: float | None = Field(
+        None, ge=-1, le=1, description="text judge diagnostic's SBERT threshold; default: the calibrated one")
 
 
 class Settings(BaseSettings):
@@ -146,6 +181,7 @@ class Settings(BaseSettings):
     brainstorm: BrainstormConfig = Field(default_factory=BrainstormConfig)
     build: BuildConfig = Field(default_factory=BuildConfig)
     detect: DetectConfig = Field(default_factory=DetectConfig)
+    plan: PlanConfig = Field(default_factory=PlanConfig)
     learn: LearnConfig = Field(default_factory=LearnConfig)
     evaluate: EvaluateConfig = Field(default_factory=EvaluateConfig)
 
@@ -162,9 +198,10 @@ class Settings(BaseSettings):
         toml_path = _CURRENT_TOML.get("path")
         if toml_path is not None:
             sources.append(TomlConfigSettingsSource(settings_cls, toml_file=toml_path))
-        return tuple(sources)
+        # each layer's old key names are read as the new ones before the layers merge, so precedence holds
+        return tuple(_MovedKeys(settings_cls, s, _layer_name(s, toml_path)) for s in sources)
 
-    def engine_for(self, stage: Literal["brainstorm", "build", "learn"]) -> Engine:
+    def engine_for(self, stage: Literal["brainstorm", "build", "plan"]) -> Engine:
         """The explicit per-stage engine, else ``llm`` exactly when an LLM is configured."""
         chosen = getattr(self, stage).engine
         if chosen is not None:
@@ -177,6 +214,67 @@ class Settings(BaseSettings):
         if self.llm.api_key is not None:
             data["llm"]["api_key"] = "***"
         return data
+
+
+# Keys that moved to another section: (old section, old key) -> (new section, new key). The plan stage
+# used to read its settings from [learn].
+MOVED: dict[tuple[str, str], tuple[str, str]] = {
+    ("learn", "plan_source"): ("plan", "source"),
+    ("learn", "engine"): ("plan", "engine"),
+    ("learn", "max_fixes"): ("plan", "max_fixes"),
+    ("learn", "min_score"): ("plan", "min_score"),
+    ("learn", "sac_actions"): ("plan", "sac_actions"),
+}
+
+
+def _layer_name(source: PydanticBaseSettingsSource, toml_path: Path | None) -> str:
+    from pydantic_settings import EnvSettingsSource
+
+    if isinstance(source, TomlConfigSettingsSource):
+        return str(toml_path)
+    return "the environment" if isinstance(source, EnvSettingsSource) else "the arguments"
+
+
+def _key(section: str, key: str, layer: str) -> str:
+    return f"ANOMALYGEN_{section.upper()}__{key.upper()}" if layer == "the environment" else f"{section}.{key}"
+
+
+def move_keys(data: dict[str, Any], layer: str) -> dict[str, Any]:
+    """One layer's settings with every moved key under its new name, each with a warning; the old and
+    the new name both given with different values in one layer is an error (neither is guessed)."""
+    out = dict(data)
+    for (old_sec, old_key), (new_sec, new_key) in MOVED.items():
+        section = out.get(old_sec)
+        if not isinstance(section, dict) or old_key not in section:
+            continue
+        section = dict(section)
+        value = section.pop(old_key)
+        target = dict(out.get(new_sec) or {})
+        old, new = _key(old_sec, old_key, layer), _key(new_sec, new_key, layer)
+        if new_key in target and target[new_key] != value:
+            from anomalygen.errors import UserError
+
+            raise UserError(f"{old} = {value!r} and {new} = {target[new_key]!r} in {layer}: {old} is the "
+                             f"old name of {new}; keep only {new}")
+        target[new_key] = value
+        out[old_sec], out[new_sec] = section, target
+        log.warning("%s (in %s) is read as %s, its new name: the plan stage has its own section now; "
+                    "rename it", old, layer, new)
+    return out
+
+
+class _MovedKeys(PydanticBaseSettingsSource):
+    """A settings source whose moved keys are read under their new names (``move_keys``)."""
+
+    def __init__(self, settings_cls: type[BaseSettings], inner: PydanticBaseSettingsSource, layer: str):
+        super().__init__(settings_cls)
+        self.inner, self.layer = inner, layer
+
+    def get_field_value(self, field, field_name):  # pragma: no cover - __call__ does the work
+        return self.inner.get_field_value(field, field_name)
+
+    def __call__(self) -> dict[str, Any]:
+        return move_keys(self.inner(), self.layer)
 
 
 # The TOML path of the load in progress: pydantic-settings builds sources in a classmethod with no

@@ -1,7 +1,7 @@
 """``anomalygen run``: every stage in order, each through its own ``run_stage``, resumable per item.
 
-The pipeline owns no stage logic. It calls brainstorm → build → detect → plan → learn → evaluate →
-report (the order of ``anomalygen.stages.STAGES``, the same list the CLI reads); each stage skips
+The pipeline owns no stage logic. It calls brainstorm → build → detect → plan → learn → judge →
+evaluate → report (the order of ``anomalygen.stages.STAGES``, the same list the CLI reads); each stage skips
 items whose outputs already exist (``anomalygen.runner``), so re-running after a crash or a kill
 continues where it stopped. A stage that fails is reported and the later stages still run on
 whatever exists (the report says which sections were "not run").

@@ -10,12 +10,15 @@ Layout (see docs/run-folder.md)::
     runs/<name>/skills/<task_id>/seed<k>/{result.json, video.mp4}
     runs/<name>/report/{index.html, report.json, summary.md}
     runs/<name>/errors/<stage>/<item_id>.json   (per-item failures)
+    runs/<name>/fingerprints/<stage>/<item_id>.sha256   (what each finished item was made from)
 """
 
 from __future__ import annotations
 
 import contextlib
 import datetime as _dt
+import hashlib
+import json
 import os
 import subprocess
 import tempfile
@@ -114,6 +117,29 @@ def read_jsonl(path: Path, cls: type[M], *, strict: bool = True) -> list[M]:
         shown = "\n  ".join(problems[:20])
         raise UserError(f"{path}: {len(problems)} invalid {cls.__name__} line(s):\n  {shown}")
     return items
+
+
+def fingerprint(*parts) -> str:
+    """sha256 over what an item is made from: JSON-able values (payloads, config sections) and, for
+    each path in a list or tuple, its name and bytes ("missing" when absent). A model counts as its
+    JSON. Key order never matters; a changed byte in any input does."""
+    h = hashlib.sha256()
+
+    def add(part) -> None:
+        if isinstance(part, (list, tuple)) and all(isinstance(x, Path) for x in part):
+            for path in part:
+                h.update(f"file {path.name}\0".encode())
+                h.update(path.read_bytes() if path.is_file() else b"missing")
+                h.update(b"\0")
+            return
+        if isinstance(part, BaseModel):
+            part = part.model_dump(mode="json")
+        h.update(json.dumps(part, sort_keys=True, default=str).encode())
+        h.update(b"\0")
+
+    for part in parts:
+        add(part)
+    return h.hexdigest()
 
 
 # --------------------------------------------------------------------------- run folder
@@ -217,6 +243,9 @@ class RunFolder:
     def error_path(self, stage: str, item_id: str) -> Path:
         return self.root / "errors" / stage / f"{item_id}.json"
 
+    def fingerprint_path(self, stage: str, item_id: str) -> Path:
+        return self.root / "fingerprints" / stage / f"{item_id}.sha256"
+
     # -- tasks
     def load_tasks(self):
         from anomalygen.schema import TaskProposal
@@ -238,6 +267,21 @@ class RunFolder:
         if not folder.is_dir():
             return []
         return [e for p in sorted(folder.glob("*.json")) if (e := try_read_model(p, ItemError)) is not None]
+
+    # -- fingerprints: what each finished item was made from (see anomalygen.runner)
+    def read_fingerprint(self, stage: str, item_id: str) -> str | None:
+        try:
+            return self.fingerprint_path(stage, item_id).read_text(encoding="utf-8").strip() or None
+        except (FileNotFoundError, OSError, UnicodeDecodeError):
+            return None
+
+    def record_fingerprint(self, stage: str, item_id: str, value: str | None) -> None:
+        """Record ``value`` for a finished item; None forgets it (the item is redone next time)."""
+        if value is None:
+            with contextlib.suppress(FileNotFoundError):
+                self.fingerprint_path(stage, item_id).unlink()
+        else:
+            atomic_write_text(self.fingerprint_path(stage, item_id), value + "\n")
 
     # -- manifest
     def load_manifest(self) -> RunManifest:

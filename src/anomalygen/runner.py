@@ -3,6 +3,11 @@
 Every stage uses this one code path, locally (inline or a process pool) or on Ray, so resuming,
 ``--force`` and failure handling behave the same everywhere. Item functions must be module-level
 (picklable) and write their own outputs atomically through :mod:`anomalygen.runfolder`.
+
+Resume notices change: each item's fingerprint (its payload, the input files it reads and the
+stage's config section, :func:`anomalygen.runfolder.fingerprint`) is recorded when the item
+succeeds, and an item counts as done only when its outputs are valid *and* the recorded fingerprint
+is the current one. A re-planned task re-runs its skill; a rebuilt scene is detected again.
 """
 
 from __future__ import annotations
@@ -13,13 +18,13 @@ import tempfile
 import time
 import traceback
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from dataclasses import dataclass, field
-from multiprocessing import get_context
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from anomalygen.errors import AnomalygenError
-from anomalygen.runfolder import RunFolder, now_iso
+from anomalygen.errors import AnomalygenError, UserError
+from anomalygen.runfolder import RunFolder, fingerprint, now_iso
 from anomalygen.schema import StageRecord
 
 if TYPE_CHECKING:
@@ -78,18 +83,25 @@ def run_items(
     workers: int | None = None,
     executor: str | None = None,
     description: str | None = None,
+    inputs: Callable[[str], Sequence[Path]] | None = None,
+    config: Any = None,
 ) -> StageSummary:
-    """Apply ``fn(item_id, payload, ctx)`` to every item not already done; never let one item kill the batch."""
+    """Apply ``fn(item_id, payload, ctx)`` to every item not already done; never let one item kill the batch.
+
+    ``inputs(item_id)``: the files the item reads (besides its payload); ``config``: the settings it
+    depends on (:func:`config_section`). Both go into the item's fingerprint."""
     started = time.perf_counter()
     summary = StageSummary(stage)
     record = StageRecord(started=now_iso())
     ctx = StageContext(str(run.root), settings, stage)
-    todo: list[tuple[str, Any]] = []
+    todo: list[tuple[str, Any, tuple[str, bool]]] = []
     for item_id, payload in items:
-        if not force and is_done is not None and is_done(item_id):
+        fp = fingerprint(stage, payload, config, inputs(item_id) if inputs is not None else ())
+        has_output = is_done is not None and is_done(item_id)
+        if not force and has_output and run.read_fingerprint(stage, item_id) == fp:
             summary.skipped += 1
         else:
-            todo.append((item_id, payload))
+            todo.append((item_id, payload, (fp, has_output)))
 
     executor = executor or settings.executor
     workers = max(1, workers or settings.workers)
@@ -110,6 +122,7 @@ def run_items(
             summary.failed += 1
             summary.errors[item_id] = value
             run.record_error(stage, item_id, value)
+            run.record_fingerprint(stage, item_id, None)  # also when the worker itself died
 
     summary.wall_s = time.perf_counter() - started
     record.finished = now_iso()
@@ -119,31 +132,47 @@ def run_items(
     return summary
 
 
-def _call(fn: ItemFn, item_id: str, payload: Any, ctx: StageContext) -> tuple[bool, Any]:
-    """Run one item; expected failures become one line, unexpected ones keep their last frame."""
+def _call(fn: ItemFn, item_id: str, payload: Any, ctx: StageContext,
+          fp: tuple[str, bool] | None = None) -> tuple[bool, Any]:
+    """Run one item; expected failures become one line, unexpected ones keep their last frame.
+
+    ``fp`` is (the item's fingerprint, whether valid outputs existed before it ran). Without earlier
+    outputs the fingerprint is recorded first: any valid output found later was made from these
+    inputs, so a kill right after the item writes never makes it run again. Over earlier outputs
+    (stale, or ``--force``) the old record is dropped first and the new one written after success.
+    A failed item keeps no record (it is redone next time)."""
+    if fp is not None:
+        ctx.run.record_fingerprint(ctx.stage, item_id, None if fp[1] else fp[0])
     try:
-        return True, fn(item_id, payload, ctx)
+        value = fn(item_id, payload, ctx)
     except AnomalygenError as exc:
-        return False, str(exc)
+        outcome: tuple[bool, Any] = (False, str(exc))
     except Exception as exc:  # noqa: BLE001 - one bad item must not end the batch
         frame = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
         where = f" ({os.path.basename(frame.filename)}:{frame.lineno})" if frame else ""
-        return False, f"{type(exc).__name__}: {exc}{where}"
+        outcome = (False, f"{type(exc).__name__}: {exc}{where}")
+    else:
+        outcome = (True, value)
+    if fp is not None and (fp[1] or not outcome[0]):
+        ctx.run.record_fingerprint(ctx.stage, item_id, fp[0] if outcome[0] else None)
+    return outcome
 
 
 def _run_inline(todo, fn, ctx, advance) -> dict[str, tuple[bool, Any]]:
     outcomes = {}
-    for item_id, payload in todo:
-        outcomes[item_id] = _call(fn, item_id, payload, ctx)
+    for item_id, payload, fp in todo:
+        outcomes[item_id] = _call(fn, item_id, payload, ctx, fp)
         advance()
     return outcomes
 
 
 def _run_pool(todo, fn, ctx, workers, advance) -> dict[str, tuple[bool, Any]]:
-    # spawn, not fork: torch and MuJoCo's renderer do not survive a fork of a threaded parent.
+    # Workers die with this process (procs.child_pool): a killed run leaves none behind.
+    from anomalygen.procs import child_pool
+
     outcomes = {}
-    with ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=get_context("spawn")) as pool:
-        futures = {pool.submit(_call, fn, item_id, payload, ctx): item_id for item_id, payload in todo}
+    with child_pool(min(workers, len(todo))) as pool:
+        futures = {pool.submit(_call, fn, item_id, payload, ctx, fp): item_id for item_id, payload, fp in todo}
         for fut in as_completed(futures):
             item_id = futures[fut]
             try:
@@ -158,8 +187,6 @@ def _run_ray(todo, fn, ctx, settings: Settings, advance) -> dict[str, tuple[bool
     try:
         import ray
     except ImportError as exc:  # pragma: no cover - depends on the optional extra
-        from anomalygen.errors import UserError
-
         raise UserError("executor 'ray' needs Ray: pip install 'anomalygen[ray]'") from exc
     os.environ.setdefault("RAY_AUTH_MODE", "disabled")
     started_here = False
@@ -177,7 +204,7 @@ def _run_ray(todo, fn, ctx, settings: Settings, advance) -> dict[str, tuple[bool
         started_here = True
     try:
         remote_call = ray.remote(_call)
-        refs = {remote_call.remote(fn, item_id, payload, ctx): item_id for item_id, payload in todo}
+        refs = {remote_call.remote(fn, item_id, payload, ctx, fp): item_id for item_id, payload, fp in todo}
         outcomes = {}
         pending = list(refs)
         while pending:
@@ -192,6 +219,34 @@ def _run_ray(todo, fn, ctx, settings: Settings, advance) -> dict[str, tuple[bool
     finally:
         if started_here:
             ray.shutdown()
+
+
+def config_section(settings: Settings, section: str, *, exclude: Sequence[str] = (), llm: bool = False) -> dict:
+    """A stage's config section for its fingerprint, less the keys that change no item's output
+    (``exclude``: e.g. how many seeds to run); with ``llm``, the model that answers and how."""
+    out: dict[str, Any] = {section: getattr(settings, section).model_dump(mode="json", exclude=set(exclude)),
+                           "seed": settings.seed}
+    if llm:
+        out["llm"] = settings.llm.model_dump(mode="json", include=set(LLM_IDENTITY))
+    return out
+
+
+LLM_IDENTITY = ("backend", "model", "base_url", "model_path", "temperature", "max_tokens", "n_ctx")
+
+
+def check_only(only: Sequence[str] | None, known: Sequence[str], what: str = "task id") -> None:
+    """An ``--only`` id the run does not have is a mistake: say so, with the closest id."""
+    import difflib
+
+    unknown = [i for i in dict.fromkeys(only or ()) if i not in set(known)]
+    if not unknown:
+        return
+    parts = []
+    for item in unknown:
+        close = difflib.get_close_matches(item, list(known), n=1, cutoff=0.0)
+        parts.append(f"'{item}'" + (f" (closest: '{close[0]}')" if close else ""))
+    raise UserError(f"unknown {what}{'s' if len(unknown) > 1 else ''} in --only: {', '.join(parts)}; "
+                    f"the run has {len(known)} {what}s")
 
 
 class _progress:

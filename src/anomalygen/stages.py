@@ -63,6 +63,9 @@ STAGES: tuple[Stage, ...] = (
     ModuleStage("detect", "anomalygen.detect.stage", ("tasks.jsonl", "scenes/"), ("detections.jsonl",)),
     ModuleStage("plan", "anomalygen.plan.stage", ("tasks.jsonl", "scenes/", "detections.jsonl"), ("plans/",)),
     ModuleStage("learn", "anomalygen.learn.stage", ("plans/", "scenes/"), ("skills/",)),
+    # the referee, after the robot's items: detections judged, every run's final state judged
+    ModuleStage("judge", "anomalygen.referee.stage", ("tasks.jsonl", "scenes/", "detections/", "skills/"),
+                ("detections_summary.json", "skills/<task_id>/seed<k>/verdict.json")),
     ModuleStage("evaluate", "anomalygen.evaluate.stage", ("tasks.jsonl", "scenes/", "detections.jsonl", "skills/"),
                 ("evaluation.json",), takes_force=False, takes_only=False),
     ModuleStage("report", "anomalygen.evaluate.report", ("evaluation.json",), ("report/",),

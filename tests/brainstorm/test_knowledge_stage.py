@@ -12,6 +12,7 @@ from anomalygen.brainstorm.validate import proposal_problems
 from anomalygen.knowledge import load_kb
 from anomalygen.runfolder import read_jsonl
 from anomalygen.schema import TaskProposal
+from support.ids import assert_ids_carry_no_task_words
 
 
 def _brainstorm(out, *extra):
@@ -40,6 +41,7 @@ def test_111_unique_valid_covering_proposals(run111):
     sc = [(t.hazard_class, t.scenario.hazard_object, t.scenario.placement, t.scenario.room, t.scenario.person_at_risk) for t in tasks]
     assert len(set(sc)) == 111
     assert all(t.id.startswith(f"t{i:04d}-") for i, t in enumerate(tasks, start=1))
+    assert_ids_carry_no_task_words(tasks)
     assert [p for t in tasks for p in proposal_problems(t, kb)] == []
     assert {t.category.value for t in tasks} == {"household_hazard", "hygiene", "child_safety"}
     paper = {t.hazard_class for t in tasks if kb.hazard_classes[t.hazard_class].paper_class}

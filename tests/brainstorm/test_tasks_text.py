@@ -20,6 +20,7 @@ from anomalygen.knowledge import load_kb
 from anomalygen.runfolder import read_jsonl
 from anomalygen.schema import TaskProposal
 from support.fixtures import llm_config_for
+from support.ids import assert_ids_carry_no_task_words
 from support.openai_server import text
 
 FIXTURES = Path(__file__).parent / "fixtures"
@@ -46,6 +47,7 @@ def test_cli_grounds_plain_descriptions_offline(tmp_path):
         assert task.description == line  # the person's words are kept
         assert not proposal_problems(task, kb)
         assert {m.field for m in task.grounding} >= {"hazard_class", "scenario.hazard_object", "target_asset"}
+    assert_ids_carry_no_task_words(tasks)
 
 
 def test_tasks_text_with_the_llm_engine_grounds_the_models_names(scripted_server, tmp_path):
@@ -69,4 +71,5 @@ def test_tasks_text_with_the_llm_engine_grounds_the_models_names(scripted_server
     assert (task.target_asset, task.scenario.hazard_object, task.hazard_class) == ("Kettle", "Kettle", "switch_off_appliance")
     assert (task.scenario.room, task.scenario.placement) == ("kitchen", "counter")
     assert task.description == "The kettle was left switched on and is boiling away."
+    assert_ids_carry_no_task_words([task])
     assert "boiling away" in srv.requests[0]["messages"][-1]["content"]

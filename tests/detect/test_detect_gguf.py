@@ -10,9 +10,7 @@ import pytest
 @pytest.mark.gguf
 def test_llm_detector_runs_on_the_bundled_gguf(tmp_path, kb):
     from anomalygen.config import LLMConfig
-    from anomalygen.detect.judge import Judge
     from anomalygen.detect.llm_detector import LLMDetector
-    from anomalygen.detect.truth import ground_truth
     from anomalygen.llm import get_client
 
     client = get_client(LLMConfig(backend="llamacpp", cache=False, max_tokens=160, repair_retries=1))
@@ -24,5 +22,3 @@ def test_llm_detector_runs_on_the_bundled_gguf(tmp_path, kb):
     assert hyps[0].target_object in names
     assert hyps[0].hazard_class is None or hyps[0].hazard_class in kb.hazard_classes
     assert client.usage.requests >= 1 and client.usage.completion_tokens > 0
-    judgements = Judge(threshold=0.6).judge(hyps, ground_truth(g.PILL_TASK, None, graph), graph)
-    assert len(judgements) == 1 and judgements[0].method in ("exact", "sbert")

@@ -10,10 +10,10 @@ from test_detect_stage import standard_run
 
 from anomalygen.config import load_settings
 from anomalygen.detect.hybrid import HybridDetector
-from anomalygen.detect.report import DetectionReport
-from anomalygen.detect.stage import run_stage, summary_path
+from anomalygen.detect.stage import run_stage
+from anomalygen.evaluate.text_judge import text_judge_diagnostic
 from anomalygen.llm import get_client
-from anomalygen.runfolder import read_jsonl, read_model
+from anomalygen.runfolder import read_jsonl
 from anomalygen.schema import Detection
 from support.fixtures import llm_config_for
 from support.openai_server import status, text
@@ -33,7 +33,7 @@ def reply(*hyps):
 
 
 def llm_settings(srv, tmp_path, **over):
-    s = load_settings(None, {"quiet": True, "workers": 1, "detect.detector": "llm", "detect.llm_judge": False, **over})
+    s = load_settings(None, {"quiet": True, "workers": 1, "detect.detector": "llm", **over})
     s.llm = llm_config_for(srv, tmp_path, cache=False)
     return s
 
@@ -60,9 +60,11 @@ def test_llm_detector_end_to_end(scripted_server, tmp_path):
     summary = run_stage(run, llm_settings(srv, tmp_path))
     assert (summary.done, summary.failed) == (3, 0)
     dets = {d.task_id: d for d in read_jsonl(run.detections_path, Detection)}
-    assert dets["t-knife"].hit_rank == 2 and dets["t-knife"].judgements[1].method == "exact"
-    assert dets["t-pill"].hit_rank == 1 and dets["t-pill"].judgements[0].method == "sbert"
-    assert dets["t-fridge"].hit_rank == 1 and dets["t-fridge"].hypotheses[0].target_object == "refrigerator_0"
+    knife = [(h.target_object, h.hazard_class) for h in dets["t-knife"].hypotheses]
+    assert knife == [("mug_0", None), ("kitchen_knife_0", "store_sharp_objects")]
+    assert [(h.target_object, h.hazard_class) for h in dets["t-pill"].hypotheses] == [("pill_bottle_0", None)]
+    assert dets["t-fridge"].hypotheses[0].target_object == "refrigerator_0"
+    assert all(d.detector == "llm" and not d.judgements for d in dets.values())
     # the bad object name went back to the model with the validation error, once
     fridge_reqs = [r for r in srv.requests if "refrigerator_0" in _user(r) and "kitchen_knife_0" not in _user(r)]
     assert len(fridge_reqs) == 2 and "target_object" in fridge_reqs[1]["messages"][-1]["content"]
@@ -72,9 +74,9 @@ def test_llm_detector_end_to_end(scripted_server, tmp_path):
         assert "Known hazard classes" in body
         for task in (g.KNIFE_TASK, g.PILL_TASK, g.FRIDGE_TASK):
             assert_no_leak(_user(req).split("Known hazard classes")[0], task)
-    report = read_model(summary_path(run), DetectionReport)
-    assert report.overall.rate[1] == round(2 / 3, 4) and report.overall.rate[2] == 1.0
-    assert report.judge_methods == {"exact": 2, "sbert": 1}
+    # the text judge's diagnostic (evaluate side) judges free text by similarity, the rest exactly
+    tj = text_judge_diagnostic(run, list(dets.values()), run.load_tasks(), {}, 3, llm_settings(srv, tmp_path))
+    assert tj.hit_at_k[1] == round(2 / 3, 4) and tj.hit_at_k[2] == 1.0 and tj.methods == {"exact": 2, "sbert": 1}
     manifest = run.load_manifest()
     assert manifest.llm_usage.requests == 4
     # the real key reaches the server (settings cross to the item as JSON, which masks secrets)
@@ -92,17 +94,14 @@ def test_a_scene_whose_replies_never_validate_fails_alone(scripted_server, tmp_p
     summary = run_stage(run, llm_settings(srv, tmp_path))
     assert summary.done == 3  # recorded as a detection with an error, not a crashed batch
     dets = {d.task_id: d for d in read_jsonl(run.detections_path, Detection)}
-    assert dets["t-pill"].error and dets["t-pill"].hit_rank is None and dets["t-pill"].hypotheses == []
-    assert dets["t-pill"].miss_reason.startswith("detector failed:")
-    assert dets["t-fridge"].hit_rank == 1
-    report = read_model(summary_path(run), DetectionReport)
-    assert report.errors == 1 and report.overall.n == 3
+    assert dets["t-pill"].error and dets["t-pill"].hypotheses == []
+    assert dets["t-fridge"].hypotheses[0].target_object == "refrigerator_0"
     # a re-run retries only the failed scene
     again = run_stage(run, llm_settings(srv, tmp_path))
     assert (again.done, again.skipped) == (1, 2)
 
 
-def test_llm_judge_is_asked_about_misses(scripted_server, tmp_path):
+def test_the_text_judges_llm_is_asked_about_misses(scripted_server, tmp_path):
     def responder(req):
         if "grade a household robot" in _system(req):
             return text(json.dumps({"same_problem": "medicine" in _user(req), "reason": "same pills"}))
@@ -112,9 +111,12 @@ def test_llm_judge_is_asked_about_misses(scripted_server, tmp_path):
 
     srv = scripted_server(responder)
     run = standard_run(tmp_path)
-    run_stage(run, llm_settings(srv, tmp_path, **{"detect.llm_judge": True}), only=["t-pill"])
-    (det,) = read_jsonl(run.detections_path, Detection)
-    assert det.hit_rank == 1 and det.judgements[0].method == "llm" and "same pills" in det.judgements[0].reason
+    settings = llm_settings(srv, tmp_path, **{"evaluate.text_judge_llm": True})
+    run_stage(run, settings, only=["t-pill"])
+    dets = read_jsonl(run.detections_path, Detection)
+    assert not any("grade a household robot" in _system(r) for r in srv.requests)  # detect never judges
+    tj = text_judge_diagnostic(run, dets, run.load_tasks(), {}, 3, settings)
+    assert tj.hit_at_k[1] == 1.0 and tj.methods == {"llm": 1}
 
 
 def test_hybrid_llm_reorders_rule_candidates(scripted_server, tmp_path):

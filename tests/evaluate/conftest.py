@@ -11,9 +11,13 @@ from anomalygen.schema import (
     BrainstormMode,
     Detection,
     Engine,
+    FixOutcome,
     HazardCategory,
+    HazardManifest,
+    HazardOutcome,
     Hypothesis,
     LLMUsage,
+    ManifestHazard,
     ObjectRole,
     PlacedObject,
     Provenance,
@@ -27,15 +31,35 @@ from anomalygen.schema import (
 )
 
 TASKS = [
-    ("pill_on_floor", "A pill lies on the living room floor where a toddler crawls.", HazardCategory.CHILD_SAFETY, "choking", "pill"),
-    ("knife_at_edge", "A kitchen knife sticks out over the counter edge.", HazardCategory.HOUSEHOLD_HAZARD, "sharp_edge", "knife"),
-    ("fridge_open", "The fridge door was left open and food is warming up.", HazardCategory.HYGIENE, "food_spoilage", "refrigerator"),
-    ("bleach_low_shelf", "A bottle of bleach stands on a low shelf within a child's reach.", HazardCategory.CHILD_SAFETY, "poisoning", "bottle"),
-    ("towel_on_stove", "A dish towel hangs over a hot stove burner.", HazardCategory.HOUSEHOLD_HAZARD, "fire", "stove"),
+    ("pill_on_floor", "A pill lies on the living room floor where a toddler crawls.", HazardCategory.CHILD_SAFETY,
+     "remove_choking_hazards", "pill"),
+    ("knife_at_edge", "A kitchen knife sticks out over the counter edge.", HazardCategory.HOUSEHOLD_HAZARD,
+     "store_sharp_objects", "knife"),
+    ("fridge_open", "The fridge door was left open and food is warming up.", HazardCategory.HYGIENE,
+     "close_open_refrigerator", "refrigerator"),
+    ("bleach_low_shelf", "A bottle of bleach stands on a low shelf within a child's reach.", HazardCategory.CHILD_SAFETY,
+     "keep_chemicals_from_children", "bottle"),
+    ("towel_on_stove", "A dish towel hangs over a hot stove burner.", HazardCategory.HOUSEHOLD_HAZARD,
+     "switch_off_appliance", "stove"),
 ]
-# hit rank per task (None = miss) and skill success per task
+# The rank at which the detection names the truth hazard (None = never; the other ranks claim a decoy),
+# the robot's own check and the referee's verdict per task: the two verdicts disagree on the knife.
 HIT_RANKS = {"pill_on_floor": 1, "knife_at_edge": 2, "fridge_open": 1, "bleach_low_shelf": None, "towel_on_stove": 3}
 SUCCESS = {"pill_on_floor": True, "knife_at_edge": True, "fridge_open": False, "bleach_low_shelf": True, "towel_on_stove": False}
+RESOLVED = {"pill_on_floor": True, "knife_at_edge": False, "fridge_open": False, "bleach_low_shelf": True, "towel_on_stove": False}
+DECOY = ("decoy_0", "reduce_tripping_hazards")
+
+
+def manifest(task: TaskProposal, *, hazard_free: bool = False) -> HazardManifest:
+    """truth.json of a synthetic scene: the task's class on ``<asset>_0`` (nothing when hazard-free)."""
+    hazards = [] if hazard_free else [ManifestHazard(hazard_class=task.hazard_class, object=f"{task.target_asset}_0",
+                                                     category=task.target_asset, severity=0.5, variable="$hazard")]
+    return HazardManifest(scene_id=task.id, task_id=task.id, hazards=hazards)
+
+
+def outcome(task: TaskProposal, resolved: bool) -> FixOutcome:
+    return FixOutcome(hazards=[HazardOutcome(hazard_class=task.hazard_class, object=f"{task.target_asset}_0",
+                                             resolved=resolved)], resolved=resolved)
 
 
 def _png(rgb: np.ndarray) -> bytes:
@@ -84,18 +108,21 @@ def build_synthetic_run(root, *, stages=("brainstorm", "build", "detect", "learn
             write_model(run.scene_dir(t.id) / "scene.json",
                         SceneSpec(scene_id=t.id, task_id=t.id, room="kitchen", seed=0, objects=[obj]))
             atomic_write_bytes(run.scene_dir(t.id) / "render_front.png", _png(_render(i)))
+            write_model(run.scene_dir(t.id) / "truth.json", manifest(t))
     if "detect" in stages:
         dets = []
         for t in tasks:
-            hyps = [Hypothesis(rank=r, problem=f"problem {r}", solution="fix it", target_object=t.target_asset) for r in (1, 2, 3)]
-            dets.append(Detection(task_id=t.id, scene_id=t.id, detector="rules", hypotheses=hyps, hit_rank=HIT_RANKS[t.id]))
+            hyps = [Hypothesis(rank=r, problem=f"problem {r}", solution="fix it",
+                               target_object=f"{t.target_asset}_0" if r == HIT_RANKS[t.id] else DECOY[0],
+                               hazard_class=t.hazard_class if r == HIT_RANKS[t.id] else DECOY[1]) for r in (1, 2, 3)]
+            dets.append(Detection(task_id=t.id, scene_id=t.id, detector="rules", hypotheses=hyps))
         write_jsonl(run.detections_path, dets)
     if "learn" in stages:
         for i, t in enumerate(tasks):
             folder = run.skill_dir(t.id, 0)
             _video(folder / "video.mp4", i)
             write_model(folder / "result.json", SkillResult(
-                task_id=t.id, seed=0, success=SUCCESS[t.id], video="video.mp4",
+                task_id=t.id, seed=0, success=SUCCESS[t.id], video="video.mp4", outcome=outcome(t, RESOLVED[t.id]),
                 subtasks=[SubTaskResult(id="s1", method=SkillMethod.PRIMITIVE, success=True),
                           SubTaskResult(id="s2", method=SkillMethod.SAC, success=SUCCESS[t.id])]))
     with run.update_manifest() as m:

@@ -8,9 +8,11 @@ figures, with each WMD column's direction stated.
 from __future__ import annotations
 
 from anomalygen.config import Settings
-from anomalygen.detect.report import summarise
+from anomalygen.evaluate import run_metrics as rm
 from anomalygen.evaluate.baselines import PAPER_ABLATION
-from anomalygen.evaluate.report import Report, ablation_rows, detection_rows, render_markdown, run_stage
+from anomalygen.evaluate.detection_report import summarise
+from anomalygen.evaluate.report import Report, ablation_rows, render_markdown, run_stage
+from anomalygen.evaluate.scored_sections import detection_rows
 from anomalygen.evaluate.stage import evaluate_run
 from anomalygen.runfolder import read_jsonl, write_jsonl
 from anomalygen.schema import Detection, Engine
@@ -27,7 +29,7 @@ def _settings():
 
 
 def _mixed_run(tmp_path):
-    run = build_synthetic_run(tmp_path / "mixed", stages=("brainstorm", "detect"))
+    run = build_synthetic_run(tmp_path / "mixed", stages=("brainstorm", "build", "detect"))
     dets = read_jsonl(run.detections_path, Detection)
     for d in dets[:2]:
         d.detector = "llm"
@@ -41,18 +43,20 @@ def _mixed_run(tmp_path):
 
 def test_mixed_detectors_are_named_per_scene_and_in_the_label(tmp_path):
     run, dets, tasks = _mixed_run(tmp_path)
-    report = summarise(dets, tasks, 3)
+    report = summarise(dets, tasks, rm.load_manifests(run, tasks), 3)
     assert report.detector == "mixed (llm 2, rules 3)" and report.detectors == {"llm": 2, "rules": 3}
     ev = evaluate_run(run, _settings())
-    assert ev.detection.detector_label == "mixed (llm 2, rules 3)"
+    assert ev.detection.detector == "mixed (llm 2, rules 3)"
     headers, rows, classes = detection_rows(ev.detection)
     labels = [r[0] for r in rows]
     assert labels == ["measured: llm", "measured: rules", "measured: all (mixed (llm 2, rules 3))", "paper (human-judged)"]
     assert rows[0][1] == 2 and rows[1][1] == 3 and classes[-1] == "paper"
-    assert rows[-1][2:] == ["0.76", "0.80", "0.82"]
-    # per-detector rates are computed from that detector's scenes only
-    llm_hits = sum(1 for d in dets[:2] if d.hit_rank == 1) / 2
-    assert rows[0][2] == f"{llm_hits:.2f}"
+    assert headers[5] == "hit@1 (single-hazard scenes)" and rows[-1][5:] == ["0.76", "0.80", "0.82"]
+    # per-detector scores come from that detector's scenes only: the llm's two name their hazard at ranks 1, 2
+    assert rows[0][2] == "1.00" and rows[0][5] == "0.50" and rows[1][2] == f"{2 / 3:.2f}"
+    # the text judge is there, labelled a diagnostic, never in the score rows
+    assert ev.detection.text_judge.label == "text judge vs task description (diagnostic)"
+    assert not any("text judge" in str(r[0]) for r in rows)
 
 
 def test_ablation_table_has_measured_rows_per_engine_beside_the_paper(tmp_path):

@@ -47,8 +47,16 @@ def test_full_report(synthetic_run):
     assert parser.imgs >= 3 + 5  # pie, success bars, hit@k + five embedded renders
     assert len(parser.videos) == 5 and all((synthetic_run.report_dir / v).is_file() for v in parser.videos)
     data = report.Report.model_validate_json((synthetic_run.report_dir / "report.json").read_text())
-    assert data.evaluation.success.overall.successes == 3
-    assert "hit@1 = 0.40" in (synthetic_run.report_dir / "summary.md").read_text()
+    assert data.evaluation.success.verdicts.resolved == 2 and data.evaluation.success.robot_check.successes == 3
+    md = (synthetic_run.report_dir / "summary.md").read_text()
+    assert "recall 0.80 (4/5)" in md and "| **all** | 5 | 2/5 (40%) | - | 3/5 |" in md
+    html = index.read_text()
+    # the headline tiles are the truth's and the referee's; the robot's own check only beside them
+    assert "<div><b>2/5</b>resolved (referee)</div>" in html and "<div><b>4/5</b>detection recall (truth)</div>" in html
+    assert "<div><b>3/5</b>robot&#x27;s own check</div>" in html
+    assert ">success<" not in html and "hit@1" not in html.split('id="detection"')[0]
+    knife = next(g for g in data.gallery if g.task_id == "knife_at_edge")
+    assert knife.verdicts == {"unresolved": 1} and knife.robot_check == 1 and (knife.found, knife.hazards) == (1, 1)
 
 
 def test_report_with_only_tasks_says_not_run(tmp_path):

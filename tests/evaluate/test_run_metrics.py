@@ -13,22 +13,39 @@ def test_distributions(synthetic_run):
     assert sum(rm.class_distribution(tasks).values()) == 5
 
 
-def test_hit_at_k(synthetic_run):
+def test_detection_is_scored_against_the_truth(synthetic_run):
+    from anomalygen.evaluate.detection_report import summarise
+
     tasks = rm.load_tasks(synthetic_run)
-    summary = rm.detection_summary(rm.load_detections(synthetic_run), tasks, k=3)
-    # hit ranks: 1, 2, 1, miss, 3
-    assert summary.hit_at_k == {1: pytest.approx(0.4), 2: pytest.approx(0.6), 3: pytest.approx(0.8)}
-    assert summary.by_category["hygiene"][1] == 1.0
-    assert summary.by_category["household_hazard"] == {1: 0.0, 2: 0.5, 3: 1.0}
+    report = summarise(rm.load_detections(synthetic_run), tasks, rm.load_manifests(synthetic_run, tasks), 3,
+                       category_of={t.hazard_class: str(t.category) for t in tasks})
+    sc = report.overall
+    # the truth hazard is named at ranks 1, 2, 1, never, 3; every other claim is one decoy
+    assert (sc.hazards, sc.found) == (5, 4) and sc.recall == 0.8
+    assert (sc.true_claims, sc.claims) == (4, 9)
+    assert sc.hit_at_k == {1: pytest.approx(0.4), 2: pytest.approx(0.6), 3: pytest.approx(0.8)}
+    assert report.per_category["hygiene"] == {"close_open_refrigerator": rm_found(1, 1)}
+    assert report.per_category_found()["child_safety"] == rm_found(2, 1)
+    assert report.confusion["keep_chemicals_from_children"] == {"none": 1}
+    (miss,) = report.misses
+    assert miss.task_id == "bleach_low_shelf" and miss.object == "bottle_0" and "decoy_0" in miss.claims
 
 
-def test_success_by_category_and_class(synthetic_run):
+def rm_found(hazards, found):
+    from anomalygen.evaluate.detection_report import Found
+
+    return Found(hazards=hazards, found=found)
+
+
+def test_headlines_are_the_referees_verdicts_with_the_robots_own_beside(synthetic_run):
     tasks = rm.load_tasks(synthetic_run)
-    s = rm.success_summary(rm.load_skill_results(synthetic_run), tasks)
-    assert (s.overall.n, s.overall.successes) == (5, 3)
-    assert s.by_category["child_safety"].rate == 1.0
-    assert s.by_category["hygiene"].rate == 0.0
-    assert s.by_class["fire"].successes == 0 and s.by_class["choking"].successes == 1
+    results = rm.load_skill_results(synthetic_run)
+    s = rm.success_summary(results, tasks, rm.load_verdicts(synthetic_run, results))
+    assert (s.verdicts.resolved, s.verdicts.hazard_runs) == (2, 5)  # the referee: pill and bleach
+    assert (s.robot_check.successes, s.robot_check.n) == (3, 5)  # the robot also believes the knife
+    assert s.by_category["child_safety"].rate == 1.0 and s.by_category["household_hazard"].rate == 0.0
+    assert s.by_class["store_sharp_objects"].unresolved == 1 and s.robot_check_by_class["store_sharp_objects"].successes == 1
+    assert s.class_category["switch_off_appliance"] == "household_hazard"
     assert s.by_method["primitive"].rate == 1.0 and s.by_method["sac"].successes == 3
 
 
@@ -83,6 +100,7 @@ def test_mixed_brainstorm_modes_get_ablation_rows(tmp_path):
 
 
 def test_the_truth_verdict_is_counted_apart_from_the_robots_own():
+    from anomalygen.evaluate.verdicts import from_outcome
     from anomalygen.schema import FixOutcome, HazardOutcome, SkillResult, TaskProposal
 
     def task(tid, cls):
@@ -91,27 +109,33 @@ def test_the_truth_verdict_is_counted_apart_from_the_robots_own():
                             scenario=dict(hazard_object="rotten_apple", room="kitchen", placement="table"),
                             provenance=dict(engine="knowledge", mode="brainstorm"))
 
-    def verdict(ok, new=(), safe=()):
-        return FixOutcome(hazards=[HazardOutcome(hazard_class="c", object="o", resolved=ok)], resolved=ok,
-                          new_hazards=list(new), interventions_on_safe=list(safe))
+    def verdict(ok, new=(), safe=(), hazards=True):
+        found = [HazardOutcome(hazard_class="c", object="o", resolved=ok)] if hazards else []
+        return FixOutcome(hazards=found, resolved=ok, new_hazards=list(new), interventions_on_safe=list(safe))
 
     results = [
         SkillResult(task_id="a", seed=0, success=True, outcome=verdict(True)),
-        SkillResult(task_id="a", seed=1, success=True, outcome=verdict(False, new=["x on y"])),  # fooled itself
+        SkillResult(task_id="a", seed=1, success=True, outcome=verdict(True, new=["x on y"])),  # fixed, broke another
         SkillResult(task_id="b", seed=0, success=False, outcome=verdict(False, safe=["mug_0"])),
         SkillResult(task_id="b", seed=1, success=True),  # no truth.json: not judged
+        SkillResult(task_id="c", seed=0, success=True, outcome=verdict(True, hazards=False)),  # nothing to do
+        SkillResult(task_id="c", seed=1, success=True, outcome=verdict(True, safe=["mug_0"], hazards=False)),
     ]
-    s = rm.success_summary(results, [task("a", "dispose_spoiled_food"), task("b", "store_sharp_objects")])
-    assert (s.overall.successes, s.overall.n) == (3, 4)
-    assert (s.resolved.successes, s.resolved.n) == (1, 3)
-    assert s.resolved_by_class["dispose_spoiled_food"].rate == 0.5 and s.resolved_by_class["store_sharp_objects"].n == 1
-    assert (s.new_hazards, s.on_safe) == (1, 1)
+    verdicts = {(r.task_id, r.seed): from_outcome(r.outcome) if r.outcome else None for r in results}
+    s = rm.success_summary(results, [task("a", "dispose_spoiled_food"), task("b", "store_sharp_objects"),
+                                     task("c", "store_sharp_objects")], verdicts)
+    assert (s.robot_check.successes, s.robot_check.n) == (5, 6)
+    # a new hazard counts against the run; a hazard-free scene is never "resolved"
+    assert (s.verdicts.resolved, s.verdicts.hazard_runs, s.verdicts.runs, s.unjudged) == (1, 3, 5, 1)
+    assert (s.verdicts.no_action_needed, s.verdicts.acted_on_safe) == (1, 1)
+    assert s.by_class["dispose_spoiled_food"].rate == 0.5 and s.by_class["store_sharp_objects"].hazard_runs == 1
+    assert (s.verdicts.new_hazards, s.verdicts.on_safe) == (1, 2)
 
 
-def test_hazard_free_scenes_are_left_out_of_hit_at_k():
-    from anomalygen.schema import Detection, Hypothesis
+def test_a_hazard_free_scene_reads_no_action_needed_or_acted_on_safe():
+    from anomalygen.evaluate.verdicts import from_outcome
+    from anomalygen.schema import FixOutcome
 
-    hit = Detection(task_id="a", scene_id="s", detector="rules", hit_rank=1,
-                    hypotheses=[Hypothesis(rank=1, problem="p", solution="s", target_object="k_0")])
-    quiet = Detection(task_id="b", scene_id="s2", detector="rules", hazard_free=True, hypotheses=[])
-    assert rm.hit_at_k([hit, quiet], 2) == {1: 1.0, 2: 1.0}
+    assert from_outcome(FixOutcome(resolved=True)).status == "no_action_needed"
+    left = from_outcome(FixOutcome(resolved=True, new_hazards=["store_sharp_objects on knife_0"]))
+    assert left.status == "acted_on_safe" and not left.resolved

@@ -51,6 +51,7 @@ def test_fridge_door_gets_closed(built, tmp_path):
     assert max(abs(v) for v in before.values()) > 0.3, "the test scene should start with a door open"
     res = execute_plan(scene_dir, plan, seed=0, video_path=tmp_path / "v.mp4")
     assert res.success and all(s.success for s in res.subtasks)
+    assert [s.executed_by for s in res.subtasks] == [f"primitive:{s.primitive}" for s in plan.subtasks]
     assert all(p.holds for p in res.final_predicates) and res.final_predicates[0].call.name == "joint_closed"
     # physics: every door that started open was pushed and ended within 0.05 rad of closed
     for name, q0 in before.items():
@@ -95,7 +96,7 @@ def test_non_primitive_subtasks_are_reported_not_executed(built):
     sac_plan = plan.model_copy(update={"subtasks": [plan.subtasks[0].model_copy(update={"method": SkillMethod.SAC})]})
     res = execute_plan(scene_dir, sac_plan, seed=0)
     assert not res.success and not res.subtasks[0].success
-    assert res.subtasks[0].detail.startswith("not executed")
+    assert res.subtasks[0].detail.startswith("not executed") and res.subtasks[0].executed_by is None
     assert res.final_predicates and not res.final_predicates[0].holds  # the door is still open
 
 
@@ -125,3 +126,19 @@ def test_a_subtask_whose_check_fails_is_run_again(built):
     assert twice.subtasks[1].steps > once.subtasks[1].steps + 20
     # the redo picked the wrapper out of the bucket and put it back: the plan's own goal still holds
     assert twice.success and [p.call.name for p in twice.final_predicates if p.holds]
+
+
+@pytest.mark.slow
+def test_a_sac_step_that_cannot_start_falls_back_and_says_which_skill_ran(built):
+    """A SAC sub-task without reward terms cannot train; the primitive of its action runs in its place.
+    The result keeps the planned method and records the skill that executed it."""
+    from anomalygen.learn.execute import execute_plan
+    from anomalygen.schema import SkillMethod
+
+    scene_dir, _, plan = built["fridge"]
+    st = plan.subtasks[0].model_copy(update={"method": SkillMethod.SAC, "reward": None})
+    res = execute_plan(scene_dir, plan.model_copy(update={"subtasks": [st]}), seed=0, sac_steps=50, isolate=False)
+    (sub,) = res.subtasks
+    assert sub.method == SkillMethod.SAC and sub.executed_by == f"primitive:{st.primitive}"
+    assert "SAC failed (not executed:" in sub.detail and "fell back to the" in sub.detail
+    assert res.success and sub.success  # the primitive closed the door

@@ -23,6 +23,9 @@ TASKS = {
     "safe": make_task("t-safe", "secure_medications", "Safe", "pill_bottle", "low_table", container="Safe"),
     "cabinet": make_task("t-medcab", "secure_medications", "Bottle", "blister_pack", "table_edge",
                          room="living_room", container="medicine_cabinet"),
+    # the benchmark's lighter-into-a-safe task: a loose safe tipped onto its back under the arm
+    "lighter": make_task("t-lighter-safe", "keep_fire_starters_from_children", "Safe", "Lighter", "table",
+                         room="bedroom", container="Safe"),
     "cable": make_task("t-cable", "clear_cable_from_walkway", "Laptop", "power_cable", "walkway", room="office"),
 }
 
@@ -76,7 +79,7 @@ def test_cable_across_a_walkway_is_lifted_off_the_floor(built, tmp_path):
 
 
 def test_cables_are_loose_whatever_their_length():
-    from anomalygen.scene.select import FIXED_SIZE, Chosen
+    from anomalygen.scene.asset_choice import FIXED_SIZE, Chosen
     from anomalygen.schema import ObjectRole
 
     class _Big:
@@ -84,3 +87,36 @@ def test_cables_are_loose_whatever_their_length():
 
     assert not Chosen("power_cable_0", "power_cable", ObjectRole.HAZARD, _Big()).fixed
     assert Chosen("table_0", "lamp", ObjectRole.HAZARD, _Big()).fixed
+
+
+def test_a_safe_is_bolted_down_whatever_its_size():
+    from anomalygen.scene.asset_choice import FIXED_SIZE, Chosen
+    from anomalygen.schema import ObjectRole
+
+    class _Small:
+        size = FIXED_SIZE / 2
+
+    assert Chosen("safe_0", "Safe", ObjectRole.CONTAINER, _Small()).fixed
+
+
+@pytest.mark.slow
+def test_a_lighter_locked_in_a_safe_is_judged_resolved_by_the_referee(built, tmp_path):
+    """Open the safe, put the lighter in, push the door shut: the safe does not budge, and the referee
+    (released, settled, judged against the hidden truth) finds the child hazard resolved."""
+    import numpy as np
+
+    from anomalygen.learn.execute import execute_plan
+    from anomalygen.referee import judge
+    from anomalygen.scene.graph import load_scene
+    from anomalygen.scene.state import restore_state
+
+    scene_dir, spec, plan = built["lighter"]
+    container = spec.bindings["$container"]
+    model, data, _ = load_scene(scene_dir)
+    before = data.body(container).xpos.copy()
+    res = execute_plan(scene_dir, plan, seed=0, final_state_path=tmp_path / "final.npz")
+    restore_state(tmp_path / "final.npz", model, data)
+    assert np.linalg.norm(data.body(container).xpos - before) < 1e-3
+    assert abs(float(data.joint(f"{container}/door_hinge").qpos[0])) < 0.1, [s.detail for s in res.subtasks]
+    verdict = judge(scene_dir, model, data)
+    assert verdict.resolved, verdict

@@ -1,4 +1,5 @@
-"""Learn stage: task x seed items, result.json per item, resume, one bad item fails alone, class table."""
+"""Learn stage: task x seed items, result.json and the final state per item, resume, one bad item fails
+alone, the robot's own table; the referee's verdict comes after, from the judge stage."""
 
 from __future__ import annotations
 
@@ -55,24 +56,34 @@ def test_stage_writes_results_resumes_and_isolates_a_bad_item(tmp_path, scene):
         assert res.final_predicates[0].holds and res.video is None
     assert not (run.skill_dir("a", 0) / "video.mp4").exists()
     table = s.results["by_class"]
-    # the robot's own check (on_floor) holds, but the hidden truth says the litter is still there
-    assert table["pick_up_floor_litter"] == {"n": 2, "success": 2, "judged": 2, "resolved": 0, "new_hazards": 0,
-                                             "on_safe": 0, "rate": 1.0, "resolved_rate": 0.0}
-    outcome = read_model(run.skill_dir("a", 0) / "result.json", SkillResult).outcome
-    assert outcome is not None and not outcome.resolved
-    assert outcome.hazards[0].object == spec.bindings["$hazard"] and "still holds" in outcome.hazards[0].detail
+    # learn counts the robot's own check only (on_floor holds); it never reads a verdict
+    assert table["pick_up_floor_litter"] == {"n": 2, "success": 2, "rate": 1.0}
     assert table["close_open_furniture"]["success"] == 0
+    res = read_model(run.skill_dir("a", 0) / "result.json", SkillResult)
+    assert res.outcome is None and (run.skill_dir("a", 0) / "final_state.npz").is_file()
     again = run_stage(run, settings)
     assert again.skipped == 2 and again.done == 0 and again.failed == 2
+    # the referee, afterwards: the litter is still on the floor, whatever the robot believes
+    from anomalygen.referee import load_verdict
+    from anomalygen.referee.stage import run_stage as judge
+
+    judged = judge(run, settings)
+    verdict = load_verdict(run, "a", 0)
+    assert verdict.status == "unresolved" and verdict.hazards[0].object == spec.bindings["$hazard"]
+    assert "pick_up_floor_litter fires" in verdict.hazards[0].detail
+    row = judged.results["by_class"]["pick_up_floor_litter"]
+    assert (row["runs"], row["judged"], row["resolved"], row["robot_done"]) == (2, 2, 0, 2)
 
 
 def test_the_robot_side_runs_without_any_truth_file_and_only_the_referee_needs_one(tmp_path, scene):
     """Detect, plan and learn on a run folder whose truth.json files are gone: the robot's work and
-    its own verdict are unchanged; only the hidden-truth verdict is missing."""
+    its own verdict are unchanged; only the referee's verdict is missing."""
     from anomalygen.config import Settings
     from anomalygen.detect.stage import run_stage as detect
     from anomalygen.learn.stage import run_stage as learn
     from anomalygen.plan.stage import run_stage as plan
+    from anomalygen.referee import load_verdict
+    from anomalygen.referee.stage import run_stage as judge
     from anomalygen.runfolder import RunFolder, read_model, write_jsonl
 
     scene_dir, spec = scene
@@ -86,26 +97,14 @@ def test_the_robot_side_runs_without_any_truth_file_and_only_the_referee_needs_o
         settings = Settings(quiet=True, workers=1)
         settings.learn.video = False
         assert detect(run, settings).done == 1 and plan(run, settings).done == 1 and learn(run, settings).done == 1
+        judge(run, settings)
         runs[name] = run
     with_truth = read_model(runs["with"].skill_dir("a", 0) / "result.json", SkillResult)
     without = read_model(runs["without"].skill_dir("a", 0) / "result.json", SkillResult)
     assert (runs["with"].plan_path("a").read_text() == runs["without"].plan_path("a").read_text())
-    assert with_truth.success == without.success and without.outcome is None
-    assert with_truth.outcome is not None and with_truth.outcome.resolved == with_truth.success
+    def robot_side(res: SkillResult):
+        return (res.success, [(s.id, s.success, s.steps, s.detail) for s in res.subtasks], res.final_predicates)
 
-
-def test_no_robot_side_module_mentions_the_answer_key():
-    """A static guard: detect's detectors, plan, learn and control code never name truth.json or the referee."""
-    from pathlib import Path
-
-    import anomalygen
-
-    root = Path(anomalygen.__file__).parent
-    robot_side = [p for pkg in ("plan", "control", "rl") for p in (root / pkg).rglob("*.py")]
-    robot_side += [p for p in (root / "learn").rglob("*.py") if p.name != "stage.py"]  # learn/stage.py calls the referee
-    robot_side += [root / "perception.py"]
-    robot_side += [root / "detect" / n for n in ("rules.py", "llm_detector.py", "hybrid.py", "observation.py", "kbcheck.py")]
-    for p in robot_side:
-        text = p.read_text()
-        for key in ("truth.json", "TRUTH_FILE", "load_manifest", "evaluate.referee", "scene.truth", "HazardManifest"):
-            assert key not in text, (p, key)
+    assert robot_side(with_truth) == robot_side(without)
+    assert load_verdict(runs["without"], "a", 0) is None
+    assert load_verdict(runs["with"], "a", 0) is not None

@@ -40,16 +40,21 @@ def test_two_hazards_are_both_found_planned_and_judged(tmp_path):
     p = read_model(run.plan_path("m"), Plan)
     touched = {str(st.params.get("object")) for st in p.subtasks}
     assert {z.object for z in truth.hazards} <= touched  # a fix for each
-    res = read_model(run.skill_dir("m", 0) / "result.json", SkillResult)
-    assert res.outcome is not None and len(res.outcome.hazards) == 2
-    # the referee's verdict is the physical state: each hazard resolved exactly when its class no
-    # longer holds in the final scene graph the executor wrote
+    assert read_model(run.skill_dir("m", 0) / "result.json", SkillResult).outcome is None
+    # the referee's verdict, after the robot: the physical state, released and settled. Each hazard is
+    # resolved exactly when no class fires on its object in the scene graph the referee judged
     from anomalygen.knowledge import load_kb
-    from anomalygen.scene.truth import class_matches
+    from anomalygen.referee import load_verdict
+    from anomalygen.referee.stage import run_stage as judge
+    from anomalygen.referee.truth import class_matches
     from anomalygen.schema import SceneGraph
 
-    final = read_model(run.skill_dir("m", 0) / "final_graph.json", SceneGraph)
-    still = {(c, o) for c, o, _ in class_matches(final, load_kb())}
-    for h in res.outcome.hazards:
-        assert h.resolved == ((h.hazard_class, h.object) not in still)
-    assert res.outcome.resolved == all(h.resolved for h in res.outcome.hazards)
+    assert judge(run, settings).done == 1
+    verdict = load_verdict(run, "m", 0)
+    assert len(verdict.hazards) == 2 and verdict.judged_from == "state"
+    final = read_model(run.skill_dir("m", 0) / "judged_graph.json", SceneGraph)
+    still = {o for _, o, _ in class_matches(final, load_kb())}
+    for h in verdict.hazards:
+        assert (h.object in still) == bool(h.still_firing)
+        assert not h.resolved or h.object not in still
+    assert verdict.resolved == (all(h.resolved for h in verdict.hazards) and not verdict.new_hazards)

@@ -6,6 +6,7 @@ from tests.knowledge.graphs import furniture, graph, joint, obj
 
 from anomalygen.knowledge import load_kb
 from anomalygen.plan.bind import choose_container, ends_hazard
+from anomalygen.schema import LATCHING_PROPERTY
 
 
 def _scene():
@@ -14,17 +15,37 @@ def _scene():
     cabinet = furniture("storagefurniture_0", "StorageFurniture", xy=(1.5, 0.0), joints=[joint("drawer", 0.0)])
     trash = furniture("trashcan_0", "TrashCan", xy=(0.4, 0.4), size=(0.3, 0.3, 0.4), joints=[joint("lid", 0.0)])
     paper = obj("paper_ball_0", "paper_ball", at="floor", xy=(0.2, 0.3), size=(0.08, 0.08, 0.08))
-    return graph(marble, carton, cabinet, trash, paper)
+    safe = furniture("safe_0", "Safe", xy=(2.5, 0.0), size=(0.5, 0.4, 0.5), joints=[joint("door", 0.0)])
+    return graph(marble, carton, cabinet, trash, paper, safe)
 
 
-def test_a_choking_hazard_goes_behind_a_drawer_not_into_the_nearer_open_carton():
+def test_a_choking_hazard_goes_where_a_latch_keeps_a_toddler_out_not_into_a_nearer_box_or_low_drawer():
     kb, g = load_kb(), _scene()
     hc = kb.hazard_classes["remove_choking_hazards"]
     marble = next(o for o in g.objects if o.name == "marble_0")
     by = {o.name: o for o in g.objects}
     assert not ends_hazard([hc], marble, by["box_0"], g)  # flaps do not keep a toddler out
-    assert ends_hazard([hc], marble, by["storagefurniture_0"], g)
-    assert choose_container(hc, marble, g, kb) == "storagefurniture_0"
+    assert not ends_hazard([hc], marble, by["storagefurniture_0"], g)  # nor does a low drawer a toddler opens
+    assert ends_hazard([hc], marble, by["safe_0"], g)  # a shut safe latches
+    g = g.model_copy(update={"objects": [o for o in g.objects if o.name != "safe_0"]})
+    assert choose_container(hc, marble, g, kb) == "box_0"  # nothing ends it: the nearest that takes it
+
+
+def test_shut_flaps_count_as_a_shut_lid_a_latching_box_keeps_a_choking_hazard_out_of_reach_by_either():
+    """Flaps enclose as a lid does (the part-label table): a box that latches keeps a toddler out once
+    either is shut, and not when it has nothing that shuts."""
+    kb, g = load_kb(), _scene()
+    hc = kb.hazard_classes["remove_choking_hazards"]
+    marble = next(o for o in g.objects if o.name == "marble_0")
+    carton = next(o for o in g.objects if o.name == "box_0")
+    latching = carton.model_copy(update={"properties": [*carton.properties, LATCHING_PROPERTY]})
+    flapped = latching.model_copy(update={"joints": [joint("flap", 0.0)]})
+    lidded = latching.model_copy(update={"joints": [joint("lid", 0.0)]})
+    open_top = latching.model_copy(update={"joints": []})
+    assert ends_hazard([hc], marble, flapped, g) and ends_hazard([hc], marble, lidded, g)
+    assert not ends_hazard([hc], marble, open_top, g)
+    g = g.model_copy(update={"objects": [flapped if o is carton else o for o in g.objects]})
+    assert choose_container(hc, marble, g, kb) == "box_0"  # the nearest container that ends it
 
 
 def test_litter_is_done_with_once_in_the_nearest_bin():
@@ -36,13 +57,17 @@ def test_litter_is_done_with_once_in_the_nearest_bin():
 
 
 def test_stored_shears_go_where_no_other_class_fires_on_them():
-    """Inside an open carton, shears are stored (store_sharp_objects ends) yet within a child's reach."""
+    """Inside an open carton or a low cupboard, shears are stored (store_sharp_objects ends) yet within a
+    child's reach; shut in a safe they are neither."""
     kb, g = load_kb(), _scene()
     shears = obj("scissors_0", "Scissors", at="table", xy=(0.1, -0.2), size=(0.18, 0.06, 0.02))
     g = g.model_copy(update={"objects": [*g.objects, shears]})
     by = {o.name: o for o in g.objects}
     store = kb.hazard_classes["store_sharp_objects"]
     assert {"Box", "StorageFurniture"} <= set(kb.containers_for(store, "Scissors"))
-    assert choose_container(store, shears, g, kb) == "storagefurniture_0"  # the carton is nearer
+    # the class's own containers (boxes, cabinets) all leave them within reach: the nearest that stores them
+    assert "Safe" not in kb.containers_for(store, "Scissors")
+    assert choose_container(store, shears, g, kb) == "box_0"
     assert not ends_hazard(list(kb.hazard_classes.values()), shears, by["box_0"], g)
-    assert ends_hazard(list(kb.hazard_classes.values()), shears, by["storagefurniture_0"], g)
+    assert not ends_hazard(list(kb.hazard_classes.values()), shears, by["storagefurniture_0"], g)
+    assert ends_hazard(list(kb.hazard_classes.values()), shears, by["safe_0"], g)

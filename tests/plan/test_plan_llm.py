@@ -279,7 +279,7 @@ def _run(tmp_path) -> RunFolder:
 
 def _settings(srv, tmp_path, **over):
     # the oracle unless a test asks otherwise: these tests exercise the LLM planner on the task's own class
-    s = load_settings(None, {"quiet": True, "workers": 1, "learn.engine": "llm", "learn.plan_source": "ground_truth",
+    s = load_settings(None, {"quiet": True, "workers": 1, "plan.engine": "llm", "plan.source": "ground_truth",
                              **over})
     s.llm = llm_config_for(srv, tmp_path, cache=False)
     return s
@@ -320,7 +320,7 @@ def test_plan_stage_detected_source_shows_the_detection_not_the_task(scripted_se
                      hazard_class="close_open_refrigerator")
     write_jsonl(run.detections_path, [Detection(task_id="t-fridge", scene_id="t-fridge", detector="rules",
                                                 hypotheses=[hyp])])
-    summary = run_stage(run, _settings(srv, tmp_path, **{"learn.plan_source": "detected"}), only=["t-fridge"])
+    summary = run_stage(run, _settings(srv, tmp_path, **{"plan.source": "detected"}), only=["t-fridge"])
     assert summary.done == 1
     plan = read_model(run.plan_path("t-fridge"), Plan)
     assert plan.source == "detected" and plan.bindings == {"$target": "refrigerator_0"}
@@ -333,7 +333,7 @@ def test_plan_stage_llm_engine_without_an_llm_says_so(tmp_path):
 
     run = _run(tmp_path)
     with pytest.raises(UserError, match="needs an LLM"):
-        run_stage(run, load_settings(None, {"quiet": True, "learn.engine": "llm"}))
+        run_stage(run, load_settings(None, {"quiet": True, "plan.engine": "llm"}))
 
 
 # --------------------------------------------------------------------------- the real tiny model
@@ -345,8 +345,8 @@ def test_plan_stage_on_the_bundled_gguf_ends_each_item_cleanly(tmp_path):
     from anomalygen.config import LLMConfig
 
     run = _run(tmp_path)
-    settings = load_settings(None, {"quiet": True, "workers": 1, "learn.engine": "llm",
-                                    "learn.plan_source": "ground_truth"})
+    settings = load_settings(None, {"quiet": True, "workers": 1, "plan.engine": "llm",
+                                    "plan.source": "ground_truth"})
     settings.llm = LLMConfig(backend="llamacpp", cache=False, max_tokens=300, repair_retries=0)
     summary = run_stage(run, settings, only=["t-fridge"])
     assert summary.done + summary.failed == 1

@@ -45,7 +45,7 @@ def test_plan_stage_writes_plans_and_fails_one_item(tmp_path):
 
     run = RunFolder.create(tmp_path / "r")
     write_jsonl(run.tasks_path, [_task("a", "store_sharp_objects"), _task("b", "no_such_class")])
-    oracle = Settings(quiet=True, learn={"plan_source": "ground_truth"})
+    oracle = Settings(quiet=True, plan={"source": "ground_truth"})
     summary = run_stage(run, oracle)
     assert summary.done == 1 and summary.failed == 1 and "b" in summary.errors
     plan = read_model(run.plan_path("a"), Plan)

@@ -169,8 +169,8 @@ def test_plan_stage_honours_settings_sac_actions(tmp_path):
     write_model(run.scene_dir("box") / "scene.json", _spec([_lid(0.0)]))
 
     settings = Settings(quiet=True)
-    settings.learn.plan_source = "ground_truth"  # the oracle: these scenes have no detections
-    settings.learn.sac_actions = ["close_joint", "place_inside"]
+    settings.plan.source = "ground_truth"  # the oracle: these scenes have no detections
+    settings.plan.sac_actions = ["close_joint", "place_inside"]
     summary = run_stage(run, settings)
     assert summary.done == 2 and summary.failed == 0, summary.errors
 
@@ -185,7 +185,7 @@ def test_plan_stage_honours_settings_sac_actions(tmp_path):
         "s2_place_inside": SkillMethod.SAC, "s9_close_container": SkillMethod.PRIMITIVE}
 
     # the default settings keep every step scripted
-    again = run_stage(run, Settings(quiet=True, learn={"plan_source": "ground_truth"}), force=True)
+    again = run_stage(run, Settings(quiet=True, plan={"source": "ground_truth"}), force=True)
     assert again.done == 2
     assert all(s.method == SkillMethod.PRIMITIVE for s in read_model(run.plan_path("oven"), Plan).subtasks)
     assert all(s.method == SkillMethod.PRIMITIVE for s in read_model(run.plan_path("box"), Plan).subtasks)

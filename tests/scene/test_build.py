@@ -136,6 +136,7 @@ def test_build_is_deterministic(built_scenes, scene_settings, tmp_path):
     first = read_model(built_scenes["floor"] / "scene.json", SceneSpec)
     assert [o.name for o in spec.objects] == [o.name for o in first.objects]
     assert np.allclose([o.pos for o in spec.objects], [o.pos for o in first.objects], atol=1e-9)
+    assert spec.robot_base == first.robot_base  # the start pose is drawn from the scene's generator
 
 
 def test_unknown_placement_fails_with_one_line_reason(scene_settings, tmp_path):

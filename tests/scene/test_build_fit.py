@@ -15,7 +15,7 @@ import pytest
 from anomalygen.config import Settings
 from anomalygen.errors import ItemFailed
 from anomalygen.rng import item_rng
-from anomalygen.scene import build, instances, select
+from anomalygen.scene import asset_choice, build, instances
 from anomalygen.schema import TaskProposal
 
 ATTEMPTS = 4  # a build makes repair_attempts + 1 = 4 by default
@@ -77,14 +77,14 @@ def test_bag_and_bucket_fail_with_does_not_fit_after_redrawing_the_bucket(monkey
     task's target, so it keeps its draw; the bag is drawn smaller and the item fails saying so."""
     task = _litter("plastic_bag", "Bucket", "Bucket")
     drawn: list = []
-    real = select.pick_asset
+    real = asset_choice.pick_asset
 
     def counting(catalogue, **kw):
         asset = real(catalogue, **kw)
         drawn.append((catalogue, asset))
         return asset
 
-    monkeypatch.setattr(select, "pick_asset", counting)
+    monkeypatch.setattr(asset_choice, "pick_asset", counting)
     outcomes = _outcomes(task)
     _assert_fits_or_says_so(outcomes)
     assert all(o[0] == "failed" for o in outcomes)
@@ -117,3 +117,12 @@ def test_container_that_is_also_the_target_fits_the_hazard():
 
 def test_hazard_that_is_the_target_fits_or_fails():
     _assert_fits_or_says_so(_outcomes(_litter("plastic_bag", "TrashCan", "plastic_bag")))
+
+
+def test_a_named_container_is_never_swapped_for_a_roomier_kind():
+    """The task says "the bucket" and the bucket's target is a chair: no trash can stands in for the
+    bucket; every attempt fails, naming the bucket and the class's other containers."""
+    outcomes = _outcomes(_litter("plastic_bag", "Bucket", "Chair"))
+    assert all(o[0] == "failed" for o in outcomes), outcomes
+    for _, message in outcomes:
+        assert "does not fit" in message and "names the Bucket" in message and "TrashCan" in message

@@ -45,7 +45,8 @@ def test_llm_scene_engine_builds_from_the_replies_and_records_repairs(scripted_s
     srv = scripted_server(responder)
     settings = Settings(quiet=True, workers=1, llm=llm_config_for(srv, tmp_path, cache=False), build={"engine": "llm", "clutter": 2})
     run = RunFolder.create(tmp_path / "run", settings=settings)
-    task = TASKS["floor"]
+    task = TASKS["floor"].model_copy(deep=True)
+    task.scenario.container = "storage_box"  # the LLM sizes it (the class's first container is the safe)
     write_jsonl(run.tasks_path, [task])
     summary = run_stage(run, settings)
     assert summary.done == 1 and summary.failed == 0, summary.errors
@@ -92,7 +93,8 @@ def test_tiny_gguf_runs_the_llm_scene_engine(tmp_path):
         llm={"backend": "llamacpp", "cache_path": str(tmp_path / "c.sqlite"), "repair_retries": 1, "max_tokens": 160},
     )
     run = RunFolder.create(tmp_path / "run", settings=settings)
-    task = TASKS["floor"]
+    task = TASKS["floor"].model_copy(deep=True)
+    task.scenario.container = "storage_box"  # the LLM sizes it (the class's first container is the safe)
     write_jsonl(run.tasks_path, [task])
     summary = run_stage(run, settings)
     assert summary.done + summary.failed == 1

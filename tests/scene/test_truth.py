@@ -19,6 +19,8 @@ def test_every_built_scene_has_a_manifest_whose_first_hazard_is_the_one_the_buil
         first = truth.hazards[0]
         hc = kb.hazard_classes[task.hazard_class]
         assert truth.scene_id == spec.scene_id and first.hazard_class == task.hazard_class
+        assert first.source == "intended" and all(h.source in ("intended", "incidental") for h in truth.hazards)
+        assert all(n.kind in ("object", "borderline", "state") for n in truth.near_misses)
         assert first.object == spec.bindings[hc.hazard_variable] and first.variable == hc.hazard_variable
         assert first.category == graph.get(first.object).category
         assert all(c.args.get("object") == first.object for c in first.success), first.success

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 # skill tests run on the classic single-hazard scenes: no near-misses, second hazards or safe variants
 NO_MIX = {"near_misses": 0, "multi_hazard": 0.0, "hazard_free": 0.0}
+# ... with the robot already standing within reach of the hazard, facing it (``build.start = "reach"``):
+# they test the skills, not the first approach from the dock (the learn-stage tests start docked)
+SKILL_SCENES = {**NO_MIX, "start": "reach"}
 
 
 def build_with_kb_plans(tasks: dict, root, *, clutter: int, real_assets: bool = True) -> dict:
@@ -15,7 +18,7 @@ def build_with_kb_plans(tasks: dict, root, *, clutter: int, real_assets: bool = 
 
     out = {}
     for key, task in tasks.items():
-        settings = Settings(build={"clutter": clutter, "real_assets": real_assets, **NO_MIX})
+        settings = Settings(build={"clutter": clutter, "real_assets": real_assets, **SKILL_SCENES})
         spec = build_scene(task, seed=0, settings=settings, out_dir=root / key)
         out[key] = (root / key, spec, plan_from_kb(task.id, task.hazard_class, dict(spec.bindings), spec=spec))
     return out

@@ -1,10 +1,10 @@
-"""The learn test scene: the package's cabinet-door scene (``anomalygen.rl.door_scene``) furnished
+"""The learn test scene: the cabinet-door scene (``support/door_scene.py``) furnished
 with a table, a bin and two loose objects, optionally with a box obstacle for the motion tests."""
 
 from __future__ import annotations
 
-from anomalygen.rl import door_scene
-from anomalygen.rl.door_scene import add_box
+from support import door_scene
+from support.door_scene import add_box
 
 
 def furnish(wb) -> list[str]:
@@ -38,7 +38,7 @@ def scene_with_obstacle(obstacle_at=None, half=0.03):
     ``half``-sized box obstacle centred at ``obstacle_at``."""
     import mujoco
 
-    from anomalygen.scene.robot import set_home
+    from anomalygen.robot.agent import Agent
 
     spec, _ = door_scene.build_spec(furnish=furnish)
     if obstacle_at is not None:
@@ -46,7 +46,7 @@ def scene_with_obstacle(obstacle_at=None, half=0.03):
                                 pos=list(obstacle_at), rgba=[1, 0, 0, 1])
     m = spec.compile()
     d = mujoco.MjData(m)
-    set_home(m, d, (0.0, 0.0, 0.0))
+    Agent(m).set_home(d, (0.0, 0.0, 0.0))
     d.joint("cabinet_0:door_hinge").qpos[0] = 1.2
     mujoco.mj_forward(m, d)
     return m, d

@@ -12,7 +12,7 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 
-from anomalygen.brainstorm.grounding import usable_targets
+from anomalygen.brainstorm.idea_sampler import usable_targets
 from anomalygen.brainstorm.knowledge_engine import KnowledgeEngine, proposal_text
 from anomalygen.knowledge import load_kb
 from anomalygen.rng import item_rng

@@ -14,8 +14,8 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
-from anomalygen.brainstorm.grounding import Grounder, class_targets
 from anomalygen.brainstorm.idea import Texts, task_id, to_proposal
+from anomalygen.brainstorm.idea_sampler import IdeaSampler, class_targets
 from anomalygen.brainstorm.realise import realise
 from anomalygen.errors import UserError
 from anomalygen.knowledge import KnowledgeBase
@@ -45,7 +45,7 @@ class TextGrounder:
         self.kb = kb
         self.g = grounder or NameGrounder(kb)
         self.seed = seed
-        self.filler = Grounder(kb, None, rich=False)
+        self.filler = IdeaSampler(kb, None, rich=False)
 
     def hazard_and_class(self, line: str) -> tuple[str, str, list[GroundingMatch]]:
         """(class id, hazard object, matches); raises ValueError when no class fits the text."""
@@ -75,7 +75,7 @@ class TextGrounder:
         targets = class_targets(kb, hc)
         target = next((m for m in [hazard, *mentioned] if m in targets), targets[0])
         rng = item_rng(self.seed, "tasks-text", index)
-        idea = self.filler.ground(rng, hc, target, agent=None, agent_index=0, round_=1)
+        idea = self.filler.idea_for(rng, hc, target, agent=None, agent_index=0, round_=1)
         placements = kb.placements_for(hc, hazard)
         said = g.placements.mentions(line, placements)
         placement = said[0] if said else (g.placements.ranked(line, set(placements), 1) or [(placements[0], 0.0)])[0][0]

@@ -8,11 +8,12 @@ the knowledge base before any text is written.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, field
 
 from anomalygen.knowledge import KnowledgeBase
+from anomalygen.rng import stable_hash
 from anomalygen.schema import (
+    DOOR,
     ArticulationUse,
     AuxiliaryItem,
     BrainstormMode,
@@ -59,14 +60,13 @@ class Texts:
     extra: dict[str, str] = field(default_factory=dict)
 
 
-def slugify(text: str, limit: int = 40) -> str:
-    slug = re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-")
-    return slug[:limit].rstrip("-") or "task"
-
-
-def task_id(index: int, name: str) -> str:
-    """Stable, readable ids: ``t0001-store-the-knife-left-on-the-counter``."""
-    return f"t{index:04d}-{slugify(name)}"
+def task_id(index: int, text: str) -> str:
+    """``t0001-3fa2c1d9``: a counter, unique within a tasks file, and 8 hex digits of a hash of the
+    task's text. Why not a slug of the text: the id names the scene folder and every artefact of the
+    task, and none of them may carry the task's words to the robot. The hash tells two runs' task
+    0001 apart (a rebuilt tasks file never reuses an old task's folder); the name stays in tasks.jsonl.
+    """
+    return f"t{index:04d}-{stable_hash('task', text) & 0xFFFFFFFF:08x}"
 
 
 def articulations_for(idea: Idea, kb: KnowledgeBase) -> list[ArticulationUse]:
@@ -87,7 +87,7 @@ def articulations_for(idea: Idea, kb: KnowledgeBase) -> list[ArticulationUse]:
                 )
             )
     if idea.container and any(s.action == "open_joint" and s.args.get("object") == "$container" for s in hc.recipe):
-        part = next((s.args["label"] for s in hc.recipe if s.action == "open_joint"), "door")
+        part = next((s.args["label"] for s in hc.recipe if s.action == "open_joint"), DOOR)
         out.append(
             ArticulationUse(
                 object=idea.container,

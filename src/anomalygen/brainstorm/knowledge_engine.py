@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from anomalygen.brainstorm.grounding import Grounder
 from anomalygen.brainstorm.idea import Idea, Texts, task_id, to_proposal
+from anomalygen.brainstorm.idea_sampler import IdeaSampler
 from anomalygen.brainstorm.realise import realise
 from anomalygen.knowledge import KnowledgeBase, load_kb
 from anomalygen.rng import item_rng
@@ -91,8 +91,8 @@ class KnowledgeEngine:
         roles = agent_roles(self.kb, self.n_agents) if self.mode != BrainstormMode.PLAIN else [None]
         self.agents: list[str | None] = roles
         rich = self.mode != BrainstormMode.PLAIN
-        self.grounders = [
-            Grounder(self.kb, self.kb.roles[r] if r else None, targets=targets, rich=rich) for r in roles
+        self.samplers = [
+            IdeaSampler(self.kb, self.kb.roles[r] if r else None, targets=targets, rich=rich) for r in roles
         ]
         self.accepted: list[Accepted] = []
         self.rejected_near_duplicates = 0
@@ -132,16 +132,16 @@ class KnowledgeEngine:
             for i, need in enumerate(needs):
                 if need <= 0:
                     continue
-                grounder = self.grounders[i]
-                grounder.seen = seen
+                sampler = self.samplers[i]
+                sampler.seen = seen
                 others = [(a.id, a.idea) for a in previous if a.idea.agent_index != i]
                 rng = item_rng(self.seed, "brainstorm", self.mode.value, r, i, attempt)
                 for _ in range(need + (1 if attempt == 0 else 2)):
                     idea = None
                     if r >= 2 and others:
-                        idea = grounder.recombine(rng, others, agent=self.agents[i], agent_index=i, round_=r)
+                        idea = sampler.recombine(rng, others, agent=self.agents[i], agent_index=i, round_=r)
                     if idea is None:
-                        idea = grounder.fresh(rng, agent=self.agents[i], agent_index=i, round_=r)
+                        idea = sampler.fresh(rng, agent=self.agents[i], agent_index=i, round_=r)
                     # wording draws from its own stream, so changing phrase banks never changes scenarios
                     words = item_rng(self.seed, "realise", self.mode.value, r, i, attempt, len(drafts))
                     texts = realise(idea, self.kb, words, perspective=self.mode != BrainstormMode.PLAIN)

@@ -20,6 +20,7 @@ import numpy as np
 from anomalygen.brainstorm.idea import Idea, Texts
 from anomalygen.knowledge import KnowledgeBase
 from anomalygen.knowledge.base import KNOWLEDGE_DIR
+from anomalygen.schema import DOOR
 
 _NICE_NAMES = {
     "StorageFurniture": "cabinet",
@@ -170,10 +171,10 @@ def fix_phrase(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, part: st
                 part
                 or (kb.articulation_part(hc, idea.container) if idea.container else None)
                 or label.split("|")[0]
-                or "door"
+                or DOOR
             )
         if step.action == "open_joint" and step.args.get("object") == "$container":
-            label = "door"
+            label = DOOR
         obj_var = step.args.get("object")
         obj = names["container"] if obj_var == "$container" else names["object"]
         container = obj if step.action == "open_joint" else names["container"]
@@ -253,7 +254,7 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     container = nice(idea.container) if idea.container else "a safe place"
     support = nice(idea.support) if idea.support else "a raised surface"
     articulated = hc.articulation is not None and hc.hazard_variable == "$target"
-    part = (kb.articulation_part(hc, idea.hazard) or "door") if articulated else ""
+    part = (kb.articulation_part(hc, idea.hazard) or DOOR) if articulated else ""
     state = hc.articulation.initial_state if hc.articulation else ""
     person = idea.person or hc.at_risk
     if person == hc.at_risk:  # the class-level phrase reads as a list; its first part is the people

@@ -139,24 +139,17 @@ def _valid_existing(run: RunFolder) -> bool:
 
 
 def print_distribution(tasks: list[TaskProposal]) -> None:
-    """Category and class counts as a rich table on stderr."""
+    """Category and class counts as a rich table on stderr, each class under its own category."""
     from rich.console import Console
-    from rich.table import Table
 
     from anomalygen.knowledge import load_kb
+    from anomalygen.tables import group_table
 
     kb = load_kb()
-    table = Table(title=f"{len(tasks)} proposals", show_lines=False)
-    table.add_column("category")
-    table.add_column("hazard class")
-    table.add_column("paper", justify="center")
-    table.add_column("count", justify="right")
     by_class = Counter((t.category.value, t.hazard_class) for t in tasks)
     by_cat = Counter(t.category.value for t in tasks)
-    for cat in sorted(by_cat):
-        table.add_row(f"[bold]{cat}[/bold]", "", "", f"[bold]{by_cat[cat]}[/bold]")
-        for (c, hc), count in sorted(by_class.items(), key=lambda kv: (-kv[1], kv[0])):
-            if c == cat:
-                paper = "✓" if hc in kb.hazard_classes and kb.hazard_classes[hc].paper_class else ""
-                table.add_row("", hc, paper, str(count))
-    Console(stderr=True).print(table)
+    rows = {cat: [(hc, ["✓" if hc in kb.hazard_classes and kb.hazard_classes[hc].paper_class else "", str(n)])
+                  for (c, hc), n in sorted(by_class.items(), key=lambda kv: (-kv[1], kv[0])) if c == cat]
+            for cat in sorted(by_cat)}
+    totals = {cat: ["", str(n)] for cat, n in by_cat.items()}
+    Console(stderr=True).print(group_table(f"{len(tasks)} proposals", ("paper", "count"), rows, totals))

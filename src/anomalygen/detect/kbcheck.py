@@ -13,7 +13,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from anomalygen.schema import CHILD_REACH, GraphObject, JointState, Relation, SceneGraph
+from anomalygen.schema import (
+    CHILD_REACH,
+    DOOR,
+    DRAWER,
+    GraphObject,
+    JointState,
+    Relation,
+    SceneGraph,
+    part_labels,
+)
 
 #: Top-surface heights (m) per placement, inside the knowledge base's SUPPORT_HEIGHTS ranges.
 SURFACE_TOP = {"table": 0.75, "table_edge": 0.75, "counter": 0.9, "counter_edge": 0.9, "shelf": 1.4, "low_table": 0.42}
@@ -41,11 +50,11 @@ def furniture(kb) -> list[GraphObject]:
     return [
         _obj("counter_0", "counter", _props(kb, "counter"), pos=(0.5, 1.6, 0.45), size=(1.8, 0.6, 0.9), height=0.0, on_floor=True),
         _obj("table_0", "Table", _props(kb, "Table"), pos=(1.6, 0.5, 0.375), size=(1.0, 0.8, 0.75), height=0.0,
-             on_floor=True, joints=[_joint("table_0_drawer", "drawer", 0.0)]),
+             on_floor=True, joints=[_joint("table_0_drawer", DRAWER, 0.0)]),
         _obj("refrigerator_0", "Refrigerator", _props(kb, "Refrigerator"), pos=(-0.6, 1.6, 0.9), size=(0.7, 0.7, 1.8),
-             height=0.0, on_floor=True, joints=[_joint("refrigerator_0_door", "door", 0.0)]),
+             height=0.0, on_floor=True, joints=[_joint("refrigerator_0_door", DOOR, 0.0)]),
         _obj("storage_0", "StorageFurniture", _props(kb, "StorageFurniture"), pos=(2.6, 1.6, 0.45), size=(0.8, 0.5, 0.9),
-             height=0.0, on_floor=True, joints=[_joint("storage_0_door", "door", 0.0)]),
+             height=0.0, on_floor=True, joints=[_joint("storage_0_door", DOOR, 0.0)]),
     ]
 
 
@@ -78,7 +87,7 @@ def _hazard_objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObject]
     name = f"{obj.lower()}_0"
     props = _props(kb, obj)
     if hc.hazard_variable == "$target" and hc.articulation is not None:
-        label = kb.articulation_part(hc, obj) or hc.articulation.part.split("|")[0]
+        label = kb.articulation_part(hc, obj) or part_labels.alternatives(hc.articulation.part)[0]
         frac = 0.8 if hc.articulation.initial_state in ("open", "on") else 0.0
         objs = [_obj(name, obj, props, pos=(1.0, -0.8, 0.5), size=(0.6, 0.6, 1.0), height=0.0, on_floor=True,
                      joints=[_joint(f"{name}_{label}", label, frac)])]
@@ -97,7 +106,7 @@ def _hazard_objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObject]
             # a counter-top appliance (a microwave): it stands on the counter, door shut, the item inside
             holder = f"{parent.lower()}_0"
             box = _obj(holder, parent, _props(kb, parent), pos=(0.9, 1.6, 1.05), size=(0.5, 0.4, 0.3), height=0.9,
-                       on_floor=False, edge=0.1, joints=[_joint(f"{holder}_door", "door", 0.0)])
+                       on_floor=False, edge=0.1, joints=[_joint(f"{holder}_door", DOOR, 0.0)])
             o = _obj(name, obj, props, pos=(0.9, 1.6, 0.95), size=(0.18, 0.03, 0.02), height=0.92, on_floor=False)
             return [box, o], [Relation(subject=name, predicate="inside", object=holder),
                               Relation(subject=holder, predicate="on", object="counter_0")], name

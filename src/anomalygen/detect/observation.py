@@ -10,7 +10,6 @@ robot cannot tell which objects matter.
 from __future__ import annotations
 
 import json
-from pathlib import Path
 from typing import Any
 
 from anomalygen.schema import GraphObject, JointState, SceneGraph
@@ -18,21 +17,13 @@ from anomalygen.schema import GraphObject, JointState, SceneGraph
 # Below this distance to the edge of its support an object is called "near the edge" (same order as
 # the knowledge base's near-edge predicate; the exact number stays visible in the rendering anyway).
 NEAR_EDGE_M = 0.10
-_SWITCH_LABELS = {"knob", "button", "switch", "dial", "tap", "faucet"}
-
-
-def load_graph(path: str | Path) -> SceneGraph:
-    """Read ``scene_graph.json`` with validation (the only file detection is allowed to read)."""
-    from anomalygen.runfolder import read_model
-
-    return read_model(Path(path), SceneGraph)
 
 
 def joint_phrase(joint: JointState) -> str:
     """'door 80% open', 'drawer closed', 'knob on' — joint states as a person would say them."""
     frac = joint.open_fraction
-    if joint.label in _SWITCH_LABELS:
-        return f"{joint.label} {'on' if frac > 0.05 else 'off'}"
+    if joint.is_switch:
+        return f"{joint.label} {'off' if joint.is_off() else 'on'}"
     if frac <= 0.02:
         return f"{joint.label} closed"
     return f"{joint.label} {round(frac * 100)}% open"

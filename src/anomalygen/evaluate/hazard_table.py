@@ -2,9 +2,10 @@
 
 Every figure is counted against the builder's hidden truth (``truth.json``), hazard by hazard, over
 every class: a hazard is *detected* when a claim of the scene's detection names it, *planned* when the
-scene's plan acts on its object, *resolved* when the referee found it fixed at the end of a run (over
-the runs of its scene). Harm is counted per run: runs that created a new hazard, and runs that acted
-on a near-miss (an object that was already safe).
+scene's plan acts on its object, *resolved* when the referee's verdict found it fixed at the end of a
+run — no hazard class still fires on its object — in a run that created no new hazard (over the runs
+of its scene). Harm is counted per run: runs that created a new hazard, and runs that acted on a
+near-miss (an object that was already safe).
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from collections import defaultdict
 from pydantic import Field
 
 from anomalygen.runfolder import RunFolder, try_read_model
-from anomalygen.schema import Detection, Plan, SkillResult, Strict
+from anomalygen.schema import Detection, Plan, Strict
 
 
 class ClassRow(Strict):
@@ -22,7 +23,8 @@ class ClassRow(Strict):
     detected: int = 0
     planned: int = 0
     runs: int = Field(0, description="(hazard, seed) executions judged")
-    resolved: int = Field(0, description="of those, the hazard was fixed at the end")
+    resolved: int = Field(0, description="of those, the hazard was fixed at the end (no hazard class fires on its "
+                          "object) and the run created no new hazard")
 
 
 class HazardTable(Strict):
@@ -37,8 +39,8 @@ class HazardTable(Strict):
 
 def hazard_table(run: RunFolder, task_ids: list[str], seeds: int) -> HazardTable:
     """The table over ``task_ids`` (every scene with a truth.json), ``seeds`` runs per scene."""
-    from anomalygen.detect.score import claim_matches
-    from anomalygen.scene.truth import load_manifest
+    from anomalygen.evaluate.detection_scores import finds, load_manifest
+    from anomalygen.evaluate.verdicts import verdict_of
 
     rows: dict[str, ClassRow] = defaultdict(ClassRow)
     table = HazardTable()
@@ -51,24 +53,22 @@ def hazard_table(run: RunFolder, task_ids: list[str], seeds: int) -> HazardTable
         det = try_read_model(run.detections_dir / f"{tid}.json", Detection)
         plan = try_read_model(run.plan_path(tid), Plan)
         acted = {str(st.params.get("object")) for st in plan.subtasks} if plan is not None else set()
-        results = [r for s in range(seeds) if (r := try_read_model(run.skill_dir(tid, s) / "result.json", SkillResult))]
+        results = [v for s in range(seeds) if (v := verdict_of(run, tid, s)) is not None]
         for r in results:
-            if r.outcome is None:
-                continue
             table.runs += 1
-            table.runs_with_new_hazards += int(bool(r.outcome.new_hazards))
-            table.runs_acting_on_safe += int(bool(r.outcome.interventions_on_safe))
+            table.runs_with_new_hazards += int(bool(r.new_hazards))
+            table.runs_acting_on_safe += int(bool(r.interventions_on_safe))
         for h in manifest.hazards:
             row = rows[h.hazard_class]
             row.hazards += 1
             hyps = det.hypotheses if det is not None else []
-            row.detected += int(any(claim_matches(x, h.object, h.hazard_class, h.category) for x in hyps))
+            row.detected += int(finds(hyps, h))
             row.planned += int(h.object in acted)
             for r in results:
-                outcome = next((o for o in (r.outcome.hazards if r.outcome else []) if o.object == h.object), None)
+                outcome = next((o for o in r.hazards if o.object == h.object), None)
                 if outcome is not None:
                     row.runs += 1
-                    row.resolved += int(outcome.resolved)
+                    row.resolved += int(outcome.resolved and not r.new_hazards)  # new hazards count against the run
     table.by_class = dict(sorted(rows.items()))
     for row in table.by_class.values():
         for key in ("hazards", "detected", "planned", "runs", "resolved"):

@@ -41,8 +41,8 @@ def category_pie(categories: dict[str, int]) -> str | None:
     return _encode(fig)
 
 
-def success_bars(rates: dict[str, tuple[int, int]], title: str = "Success by category") -> str | None:
-    """``rates``: label -> (successes, n)."""
+def success_bars(rates: dict[str, tuple[int, int]], title: str, ylabel: str = "rate") -> str | None:
+    """``rates``: label -> (successes, n); ``title`` says whose verdict and which runs."""
     if not rates:
         return None
     plt = _pyplot()
@@ -51,15 +51,17 @@ def success_bars(rates: dict[str, tuple[int, int]], title: str = "Success by cat
     fig, ax = plt.subplots(figsize=(max(4.5, 0.9 * len(labels) + 2), 3.5))
     bars = ax.bar(labels, values, color="#4c72b0")
     for bar, (s, n) in zip(bars, rates.values(), strict=False):
-        ax.text(bar.get_x() + bar.get_width() / 2, bar.get_height() + 0.02, f"{s}/{n}", ha="center", fontsize=9)
+        ax.text(bar.get_x() + bar.get_width() / 2, bar.get_height() + 0.02, f"{s}/{n}" if n else "no runs",
+                ha="center", fontsize=9)
     ax.set_ylim(0, 1.12)
-    ax.set_ylabel("success rate")
+    ax.set_ylabel(ylabel)
     ax.set_title(title)
     ax.tick_params(axis="x", labelrotation=20)
     return _encode(fig)
 
 
-def hit_at_k_plot(hit_at_k: dict[int, float]) -> str | None:
+def hit_at_k_plot(hit_at_k: dict[int, float], subset: str) -> str | None:
+    """hit@k against the truth; ``subset`` names the scenes it covers (single-hazard ones)."""
     if not hit_at_k:
         return None
     plt = _pyplot()
@@ -71,5 +73,5 @@ def hit_at_k_plot(hit_at_k: dict[int, float]) -> str | None:
     ax.set_ylim(0, 1.12)
     ax.set_xlabel("k")
     ax.set_ylabel("fraction of scenes")
-    ax.set_title("Detection hit@k")
+    ax.set_title(f"Detection hit@k against the truth\n({subset})")
     return _encode(fig)

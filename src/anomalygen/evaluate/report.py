@@ -9,7 +9,6 @@ when it is missing the metrics are computed here (without printing) so ``report`
 from __future__ import annotations
 
 import base64
-import html
 import shutil
 import time
 from pathlib import Path
@@ -19,8 +18,24 @@ from pydantic import Field
 
 from anomalygen.evaluate import plots
 from anomalygen.evaluate import run_metrics as rm
-from anomalygen.evaluate.baselines import PAPER_ABLATION, PAPER_DETECTION
+from anomalygen.evaluate.baselines import PAPER_ABLATION
+from anomalygen.evaluate.html_parts import NOT_RUN
+from anomalygen.evaluate.html_parts import esc as _e
+from anomalygen.evaluate.html_parts import fmt as _f
+from anomalygen.evaluate.html_parts import html_table as _table
+from anomalygen.evaluate.html_parts import img as _img
+from anomalygen.evaluate.html_parts import not_run as _not_run
+from anomalygen.evaluate.html_parts import section as _section
 from anomalygen.evaluate.results import Evaluation
+from anomalygen.evaluate.scored_sections import (
+    detection_html,
+    detection_markdown,
+    hazard_table_html,
+    overview_tiles,
+    success_html,
+    success_markdown,
+)
+from anomalygen.evaluate.verdicts import STATUS_LABELS
 from anomalygen.runfolder import RunFolder, atomic_write_text, now_iso, write_model
 from anomalygen.runner import StageSummary
 from anomalygen.schema import Artefact, StageRecord, Strict
@@ -29,7 +44,6 @@ if TYPE_CHECKING:
     from anomalygen.config import Settings
 
 SECTIONS = ("overview", "diversity", "categories", "detection", "success", "gallery", "timings", "llm")
-NOT_RUN = "not run"
 
 
 class GalleryItem(Strict):
@@ -40,9 +54,11 @@ class GalleryItem(Strict):
     description: str
     render: str | None = Field(None, description="render file, relative to the run folder")
     videos: list[str] = Field(default_factory=list, description="copied videos, relative to report/")
-    hit_rank: int | None = None
-    detected: bool | None = None
-    success: bool | None = None
+    hazards: int | None = Field(None, description="hazards in the scene's truth; None without truth.json")
+    found: int | None = Field(None, description="of those, named by the detection; None without a detection")
+    verdicts: dict[str, int] = Field(default_factory=dict, description="referee's status -> runs")
+    robot_check: int | None = Field(None, description="runs whose plan's own final condition held")
+    runs: int = 0
 
 
 class Report(Artefact):
@@ -55,11 +71,17 @@ class Report(Artefact):
 
 
 def collect_gallery(run: RunFolder) -> list[GalleryItem]:
-    """One entry per task (or per built scene when there is no tasks.jsonl), renders and videos attached."""
+    """One entry per task (or per built scene when there is no tasks.jsonl), renders and videos attached,
+    each with what the detection found of its truth and the referee's verdict per run."""
+    from anomalygen.evaluate.detection_scores import finds
+
     tasks = rm.load_tasks(run)
     detections = {d.task_id: d for d in rm.load_detections(run)}
+    manifests = rm.load_manifests(run, tasks)
     results: dict[str, list] = {}
-    for r in rm.load_skill_results(run):
+    all_results = rm.load_skill_results(run)
+    verdicts = rm.load_verdicts(run, all_results)
+    for r in all_results:
         results.setdefault(r.task_id, []).append(r)
     ids = [t.id for t in tasks] or sorted(p.parent.name for p in rm.scene_renders(run))
     by_id = {t.id: t for t in tasks}
@@ -71,8 +93,12 @@ def collect_gallery(run: RunFolder) -> list[GalleryItem]:
         for res in sorted(results.get(tid, []), key=lambda r: r.seed):
             if _find_video(run, tid, res.seed, res.video) is not None:
                 videos.append(f"videos/{tid}_seed{res.seed}.mp4")
-        det = detections.get(tid)
+        det, truth = detections.get(tid), manifests.get(tid)
         seeds = results.get(tid, [])
+        statuses: dict[str, int] = {}
+        for r in seeds:
+            if (v := verdicts.get((tid, r.seed))) is not None:
+                statuses[v.status] = statuses.get(v.status, 0) + 1
         items.append(GalleryItem(
             task_id=tid,
             name=t.name if t else tid,
@@ -81,9 +107,11 @@ def collect_gallery(run: RunFolder) -> list[GalleryItem]:
             description=t.description if t else "",
             render=str(render.relative_to(run.root)) if render.is_file() else None,
             videos=videos,
-            hit_rank=det.hit_rank if det else None,
-            detected=(det.hit_rank is not None) if det else None,
-            success=(sum(r.success for r in seeds) * 2 >= len(seeds)) if seeds else None,
+            hazards=len(truth.hazards) if truth else None,
+            found=sum(finds(det.hypotheses, z) for z in truth.hazards) if truth and det else None,
+            verdicts=statuses,
+            robot_check=sum(r.success for r in seeds) if seeds else None,
+            runs=len(seeds),
         ))
     return items
 
@@ -133,35 +161,6 @@ tr.paper td{color:#666;font-style:italic}.notrun{color:#999;font-style:italic}
 """
 
 
-def _e(x) -> str:
-    return html.escape(str(x))
-
-
-def _f(x: float | None, digits: int = 3) -> str:
-    return "—" if x is None else f"{x:.{digits}f}"
-
-
-def _table(headers: list[str], rows: list[list], row_classes: list[str] | None = None) -> str:
-    head = "".join(f"<th>{_e(h)}</th>" for h in headers)
-    body = []
-    for i, row in enumerate(rows):
-        cls = f' class="{row_classes[i]}"' if row_classes and row_classes[i] else ""
-        body.append(f"<tr{cls}>" + "".join(f"<td>{_e(c)}</td>" for c in row) + "</tr>")
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
-
-
-def _img(b64: str | None, alt: str) -> str:
-    return f'<img alt="{_e(alt)}" src="data:image/png;base64,{b64}">' if b64 else ""
-
-
-def _section(sid: str, title: str, body: str) -> str:
-    return f'<section id="{sid}"><h2>{_e(title)}</h2>{body}</section>'
-
-
-def _not_run(stage: str) -> str:
-    return f'<p class="notrun">{NOT_RUN}: the {_e(stage)} stage has produced no artefacts yet.</p>'
-
-
 ABLATION_HEADERS = ["mode", "source", "tasks", "Self-BLEU ↓", "SBERT sim ↓", "WMD ↑ (ours)", "WMD ↓ (paper, as published)"]
 
 
@@ -179,41 +178,12 @@ def ablation_rows(ev: Evaluation) -> tuple[list[str], list[list], list[str]]:
     return ABLATION_HEADERS, rows, classes
 
 
-def detection_rows(d) -> tuple[list[str], list[list], list[str]]:
-    """hit@k measured per detector (and over all scenes when mixed) beside the paper's human-judged rates."""
-    ks = sorted(d.hit_at_k)
-    rows: list[list] = [[f"measured: {name}", d.detectors.get(name, 0), *[_f(v.get(k), 2) for k in ks]] for name, v in d.by_detector.items()]
-    if len(d.by_detector) > 1:
-        rows.append([f"measured: all ({d.detector_label})", d.scenes, *[_f(d.hit_at_k.get(k), 2) for k in ks]])
-    rows.append(["paper (human-judged)", "—", *[_f(PAPER_DETECTION.get(k), 2) for k in ks]])
-    return ["detector", "scenes", *[f"hit@{k}" for k in ks]], rows, [""] * (len(rows) - 1) + ["paper"]
-
-
-def _hazard_table_html(t) -> str:
-    """Per class, against the hidden truth: hazards present, detected, planned, resolved; then the harm."""
-    def pct(a: int, b: int) -> str:
-        return f"{a} ({a / b:.0%})" if b else "-"
-
-    rows = [[name, r.hazards, pct(r.detected, r.hazards), pct(r.planned, r.hazards), f"{pct(r.resolved, r.runs)} of {r.runs}"]
-            for name, r in [*t.by_class.items(), ("all classes", t.total)]]
-    table = _table(["hazard class", "hazards present", "detected", "planned", "resolved (runs)"], rows)
-    return (f"<p>Every hazard in every scene's hidden truth, by class: {t.scenes} scenes, "
-            f"{t.hazard_free_scenes} of them hazard-free. Runs that created a new hazard: "
-            f"{pct(t.runs_with_new_hazards, t.runs)}; runs that acted on an already-safe object: "
-            f"{pct(t.runs_acting_on_safe, t.runs)}.</p>{table}")
-
-
 def render_html(report: Report, run: RunFolder) -> str:
     ev = report.evaluation
     parts = []
 
     # overview
-    kpis = [("tasks", ev.tasks), ("scenes built", ev.scenes_built)]
-    if ev.detection:
-        kpis.append(("hit@1", _f(ev.detection.hit_at_k.get(1), 2)))
-        kpis.append((f"hit@{ev.detection.k}", _f(ev.detection.hit_at_k.get(ev.detection.k), 2)))
-    if ev.success:
-        kpis.append(("success", f"{ev.success.overall.successes}/{ev.success.overall.n}"))
+    kpis = overview_tiles(ev)
     kpi_html = '<div class="kpi">' + "".join(f"<div><b>{_e(v)}</b>{_e(k)}</div>" for k, v in kpis) + "</div>"
     missing = f'<p class="notrun">{NOT_RUN}: {_e(", ".join(ev.not_run))}</p>' if ev.not_run else ""
     parts.append(_section("overview", "Overview", kpi_html + missing))
@@ -246,58 +216,23 @@ def render_html(report: Report, run: RunFolder) -> str:
         parts.append(_section("categories", "Categories and classes", _not_run("brainstorm")))
 
     # detection
-    if ev.detection:
-        d = ev.detection
-        ks = sorted(d.hit_at_k)
-        by_cat = _table(["category", *[f"hit@{k}" for k in ks]],
-                        [[c, *[_f(v.get(k), 2) for k in ks]] for c, v in d.by_category.items()])
-        scored = ""
-        if d.scores is not None:
-            sc = d.scores
-            alarms = "no hazard-free scenes" if sc.false_alarm_rate is None else (
-                f"{_f(sc.false_alarm_rate, 2)} over {sc.hazard_free_scenes} hazard-free scenes")
-            scored = _table(
-                ["against the hidden truth", "value"],
-                [["hazards found (recall)", f"{sc.found}/{sc.hazards} ({_f(sc.recall, 2)})"],
-                 ["claims that were right (precision)", f"{sc.true_claims}/{sc.claims} ({_f(sc.precision, 2)})"],
-                 ["F1", _f(sc.f1, 2)],
-                 ["false alarms", alarms],
-                 *[[f"hit@{j} on {sc.single_hazard_scenes} single-hazard scenes", _f(v, 2)]
-                   for j, v in sorted(sc.hit_at_k.items())]])
-        headers, rows, classes = detection_rows(d)
-        by_detector = _table(headers, rows, classes)
-        body = (f'<div class="plots">{_img(plots.hit_at_k_plot(d.hit_at_k), "hit at k")}<div>'
-                f"<p>{d.scenes} scenes, detector: {_e(d.detector_label)}, {d.errors} detector errors.</p>"
-                f"{scored}{by_detector}{by_cat}</div></div>")
-        parts.append(_section("detection", "Detection hit@k", body))
+    if ev.detection and ev.detection.overall is not None:
+        parts.append(_section("detection", "Detection against the truth", detection_html(ev.detection)))
+    elif ev.detection:
+        parts.append(_section("detection", "Detection against the truth",
+                              f"<p>{ev.detection.scenes} scenes detected, but no scene has a truth.json to score "
+                              "against.</p>"))
     else:
-        parts.append(_section("detection", "Detection hit@k", _not_run("detect")))
+        parts.append(_section("detection", "Detection against the truth", _not_run("detect")))
 
     # success
     if ev.success:
-        s = ev.success
-        bars = _img(plots.success_bars({k: (v.successes, v.n) for k, v in s.by_category.items()}), "success by category")
-        def truth(k: str) -> str:
-            r = s.resolved_by_class.get(k)
-            return f"{r.successes}/{r.n} ({_f(r.rate, 2)})" if r and r.n else "no truth"
-
-        cls_rows = [[k, v.n, f"{v.successes} ({_f(v.rate, 2)})", truth(k)] for k, v in s.by_class.items()]
-        meth_rows = [[k, v.successes, v.n, _f(v.rate, 2)] for k, v in s.by_method.items()]
-        headers = ["hazard class", "runs", "robot: plan done", "truth: hazard resolved"]
-        resolved = (f"{s.resolved.successes}/{s.resolved.n} ({_f(s.resolved.rate, 2)})" if s.resolved.n
-                    else "not judged (no truth.json)")
-        body = (f'<div class="plots">{bars}<div>{_table(headers, cls_rows)}'
-                f'{_table(["sub-task method", "successes", "runs", "rate"], meth_rows)}</div></div>'
-                f"<p>Hazards resolved, judged against the builder's hidden truth on every class: <b>{resolved}</b>. "
-                f"The robot's own verdict (its plan's final condition held): {s.overall.successes}/{s.overall.n} "
-                f"({_f(s.overall.rate, 2)}) over {s.tasks} tasks. Runs that created a new hazard: {s.new_hazards}; "
-                f"runs that acted on an already-safe object: {s.on_safe}; {s.errors} runs ended with an error. "
-                "Paper: 83% (human-judged).</p>")
+        body = success_html(ev.success)
         if ev.hazards is not None:
-            body = _hazard_table_html(ev.hazards) + body
-        parts.append(_section("success", "Resolution success", body))
+            body = hazard_table_html(ev.hazards) + body
+        parts.append(_section("success", "Resolution (referee's verdict)", body))
     else:
-        parts.append(_section("success", "Resolution success", _not_run("learn")))
+        parts.append(_section("success", "Resolution (referee's verdict)", _not_run("learn")))
 
     # gallery
     if report.gallery:
@@ -312,10 +247,14 @@ def render_html(report: Report, run: RunFolder) -> str:
             for v in g.videos:
                 media += f'<video controls muted preload="metadata" src="{_e(v)}"></video>'
             tags = f'<span class="tag">{_e(g.category)}</span><span class="tag">{_e(g.hazard_class)}</span>'
-            if g.detected is not None:
-                tags += f'<span class="tag {"ok" if g.detected else "bad"}">detected: {_e(g.hit_rank or "miss")}</span>'
-            if g.success is not None:
-                tags += f'<span class="tag {"ok" if g.success else "bad"}">{"resolved" if g.success else "failed"}</span>'
+            if g.hazards is not None and g.found is not None:
+                ok = g.found == g.hazards
+                tags += f'<span class="tag {"ok" if ok else "bad"}">found {g.found}/{g.hazards} hazards</span>'
+            for status, n in sorted(g.verdicts.items()):
+                good = status in ("resolved", "no_action_needed")
+                tags += f'<span class="tag {"ok" if good else "bad"}">{_e(STATUS_LABELS[status])} ×{n}</span>'
+            if g.robot_check is not None:
+                tags += f'<span class="tag">robot\'s own check {g.robot_check}/{g.runs}</span>'
             cards.append(f'<div class="card">{media}<h3>{_e(g.name)}</h3>{tags}<p>{_e(g.description)}</p></div>')
         parts.append(_section("gallery", "Scene gallery", f'<div class="gallery">{"".join(cards)}</div>'))
     else:
@@ -366,20 +305,8 @@ def render_markdown(report: Report) -> str:
         lines.append(NOT_RUN)
     if ev.diversity:
         lines += ["", "### Brainstorming ablation", "", *_md_table(*ablation_rows(ev)[:2])]
-    lines += ["", "## Detection", ""]
-    if ev.detection:
-        lines.append(", ".join(f"hit@{k} = {v:.2f}" for k, v in sorted(ev.detection.hit_at_k.items()))
-                     + f" over {ev.detection.scenes} scenes (detector: {ev.detection.detector_label})")
-        lines += ["", *_md_table(*detection_rows(ev.detection)[:2])]
-    else:
-        lines.append(NOT_RUN)
-    lines += ["", "## Success by category", ""]
-    if ev.success:
-        lines += ["| category | successes | runs | rate |", "|---|---:|---:|---:|"]
-        lines += [f"| {k} | {v.successes} | {v.n} | {v.rate:.2f} |" for k, v in ev.success.by_category.items()]
-        lines.append(f"| **all** | {ev.success.overall.successes} | {ev.success.overall.n} | {ev.success.overall.rate:.2f} |")
-    else:
-        lines.append(NOT_RUN)
+    lines += ["", "## Detection against the truth", "", *detection_markdown(ev.detection)]
+    lines += ["", "## Resolved by category (referee's verdict)", "", *success_markdown(ev.success)]
     lines += ["", "## Timings", ""]
     lines += [f"- {k}: {v.wall_s:.1f} s ({v.done} done, {v.skipped} skipped, {v.failed} failed)" for k, v in ev.timings.items()] or [NOT_RUN]
     u = ev.llm_usage

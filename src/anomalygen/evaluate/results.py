@@ -10,7 +10,7 @@ from typing import Literal
 
 from pydantic import Field
 
-from anomalygen.detect.score import DetectionScores
+from anomalygen.evaluate.detection_report import DetectionReport
 from anomalygen.evaluate.hazard_table import HazardTable
 from anomalygen.schema import Artefact, LLMUsage, StageRecord, Strict
 
@@ -38,35 +38,45 @@ class Rate(Strict):
         return self.successes / self.n if self.n else 0.0
 
 
-class DetectionSummary(Strict):
-    scenes: int
-    k: int
-    hit_at_k: dict[int, float] = Field(description="k -> fraction of scenes whose first hit has rank <= k")
-    errors: int = 0
-    by_category: dict[str, dict[int, float]] = Field(default_factory=dict)
-    detectors: dict[str, int] = Field(default_factory=dict, description="detector -> scenes it produced")
-    by_detector: dict[str, dict[int, float]] = Field(default_factory=dict, description="detector -> hit@k of its scenes")
+class VerdictCounts(Strict):
+    """The referee's verdicts over a group of runs (``evaluate/verdicts.py``)."""
+
+    runs: int = Field(0, description="runs the referee judged")
+    resolved: int = 0
+    unresolved: int = 0
+    no_action_needed: int = Field(0, description="hazard-free scenes the robot left alone")
+    acted_on_safe: int = Field(0, description="hazard-free scenes the robot acted on or made hazardous")
+    new_hazards: int = Field(0, description="runs that left a hazard the scene did not have at the start")
+    on_safe: int = Field(0, description="runs that acted on a near-miss (an object that was already safe)")
 
     @property
-    def detector_label(self) -> str:
-        from anomalygen.detect.report import detector_label
+    def hazard_runs(self) -> int:
+        """Runs on scenes that held a hazard: the denominator of the resolved rate."""
+        return self.resolved + self.unresolved
 
-        return detector_label(self.detectors)
-    scores: DetectionScores | None = Field(None, description="per-hazard scores against truth.json")
+    @property
+    def hazard_free_runs(self) -> int:
+        return self.no_action_needed + self.acted_on_safe
+
+    @property
+    def rate(self) -> float:
+        return self.resolved / self.hazard_runs if self.hazard_runs else 0.0
 
 
 class SuccessSummary(Strict):
+    """Headlines from the referee's verdicts; the robot's own check only beside them, labelled."""
+
     results: int = Field(description="(task, seed) results read")
     tasks: int
-    overall: Rate
-    by_category: dict[str, Rate] = Field(default_factory=dict)
-    by_class: dict[str, Rate] = Field(default_factory=dict)
-    by_method: dict[str, Rate] = Field(default_factory=dict, description="sub-task success per skill method")
+    verdicts: VerdictCounts = Field(default_factory=VerdictCounts, description="every class, the referee")
+    by_category: dict[str, VerdictCounts] = Field(default_factory=dict)
+    by_class: dict[str, VerdictCounts] = Field(default_factory=dict)
+    class_category: dict[str, str] = Field(default_factory=dict, description="hazard class -> its category")
+    unjudged: int = Field(0, description="results the referee has no verdict on (no truth.json)")
+    robot_check: Rate = Field(default_factory=Rate, description="robot's own check: its plan's final condition held")
+    robot_check_by_class: dict[str, Rate] = Field(default_factory=dict)
+    by_method: dict[str, Rate] = Field(default_factory=dict, description="robot's own check per sub-task method")
     errors: int = 0
-    resolved: Rate = Field(default_factory=Rate, description="runs whose every truth-manifest hazard was fixed")
-    resolved_by_class: dict[str, Rate] = Field(default_factory=dict)
-    new_hazards: int = Field(0, description="runs that left a hazard the scene did not have at the start")
-    on_safe: int = Field(0, description="runs that acted on a near-miss (an object that was already safe)")
 
 
 class AblationRow(Strict):
@@ -90,7 +100,7 @@ class Evaluation(Artefact):
     target_assets: dict[str, int] = Field(default_factory=dict)
     scenes_built: int = 0
     scenes_failed: int = 0
-    detection: DetectionSummary | None = None
+    detection: DetectionReport | None = Field(None, description="against the truth (also detections_summary.json)")
     success: SuccessSummary | None = None
     hazards: HazardTable | None = Field(None, description="per class: present, detected, planned, resolved (truth)")
     timings: dict[str, StageRecord] = Field(default_factory=dict)

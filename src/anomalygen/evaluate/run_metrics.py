@@ -1,4 +1,4 @@
-"""Counting metrics over a run's artefacts: distributions, detection hit@k, success by class.
+"""Counting metrics over a run's artefacts: distributions, the referee's verdicts by class, loaders.
 
 Pure functions of typed artefacts, so they are tested on hand-built runs and reused by the report.
 """
@@ -6,10 +6,11 @@ Pure functions of typed artefacts, so they are tested on hand-built runs and reu
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
-from anomalygen.evaluate.results import DetectionSummary, Rate, SuccessSummary
+from anomalygen.evaluate.results import Rate, SuccessSummary, VerdictCounts
+from anomalygen.evaluate.verdicts import RunVerdict, verdict_of
 from anomalygen.runfolder import RunFolder, read_jsonl, try_read_model
 from anomalygen.schema import Detection, SceneSpec, SkillResult, TaskProposal
 
@@ -28,83 +29,49 @@ def class_distribution(tasks: Sequence[TaskProposal]) -> dict[str, int]:
     return distribution(t.hazard_class for t in tasks)
 
 
-def hit_at_k(detections: Sequence[Detection], k: int) -> dict[int, float]:
-    """Fraction of scenes whose first correct hypothesis has rank <= j, for j = 1..k (errors are misses;
-    hazard-free scenes have nothing to hit and are left out)."""
-    detections = [d for d in detections if not d.hazard_free]
-    n = len(detections)
-    return {j: (sum(1 for d in detections if d.hit_rank is not None and d.hit_rank <= j) / n if n else 0.0)
-            for j in range(1, k + 1)}
-
-
-def detection_summary(
-    detections: Sequence[Detection], tasks: Sequence[TaskProposal], k: int, manifests=None
-) -> DetectionSummary:
-    """hit@k over every scene, by category; with ``manifests`` (task id -> truth) per-hazard scores too."""
-    from anomalygen.detect.score import score_detections
-
-    k = max([k, *(len(d.hypotheses) for d in detections)]) if detections else k
-    category = {t.id: str(t.category) for t in tasks}
-    groups: dict[str, list[Detection]] = {}
-    by_detector: dict[str, list[Detection]] = {}
-    for d in detections:
-        groups.setdefault(category.get(d.task_id, "unknown"), []).append(d)
-        by_detector.setdefault(d.detector, []).append(d)
-    return DetectionSummary(
-        scenes=len(detections),
-        k=k,
-        hit_at_k=hit_at_k(detections, k),
-        errors=sum(1 for d in detections if d.error),
-        by_category={c: hit_at_k(ds, k) for c, ds in sorted(groups.items())},
-        detectors={name: len(ds) for name, ds in sorted(by_detector.items())},
-        by_detector={name: hit_at_k(ds, k) for name, ds in sorted(by_detector.items())},
-        scores=score_detections(detections, manifests, k) if manifests else None,
-    )
-
-
-def success_summary(results: Sequence[SkillResult], tasks: Sequence[TaskProposal]) -> SuccessSummary:
-    """Success over every (task, seed) result, grouped by the task's category and hazard class."""
+def success_summary(results: Sequence[SkillResult], tasks: Sequence[TaskProposal],
+                    verdicts: Mapping[tuple[str, int], RunVerdict | None]) -> SuccessSummary:
+    """The referee's verdicts over every (task, seed) result, by the task's category and hazard class,
+    with the robot's own check beside them (``verdicts``: (task id, seed) -> verdict, None if unjudged)."""
     by_id = {t.id: t for t in tasks}
-    overall = Rate()
-    by_category: dict[str, Rate] = {}
-    by_class: dict[str, Rate] = {}
+    out = SuccessSummary(results=len(results), tasks=len({r.task_id for r in results}),
+                         errors=sum(1 for r in results if r.error))
+    by_category: dict[str, VerdictCounts] = {}
+    by_class: dict[str, VerdictCounts] = {}
+    robot_by_class: dict[str, Rate] = {}
     by_method: dict[str, Rate] = {}
-
-    def bump(table: dict[str, Rate], key: str, ok: bool) -> None:
-        cell = table.setdefault(key, Rate())
-        cell.n += 1
-        cell.successes += int(ok)
-
-    resolved = Rate()
-    resolved_by_class: dict[str, Rate] = {}
-    harm = {"new": 0, "safe": 0}
     for r in results:
         task = by_id.get(r.task_id)
-        overall.n += 1
-        overall.successes += int(r.success)
-        bump(by_category, str(task.category) if task else "unknown", r.success)
-        bump(by_class, task.hazard_class if task else "unknown", r.success)
+        category, hazard_class = (str(task.category), task.hazard_class) if task else ("unknown", "unknown")
+        out.class_category[hazard_class] = category
+        _bump(out.robot_check, r.success)
+        _bump(robot_by_class.setdefault(hazard_class, Rate()), r.success)
         for sub in r.subtasks:
-            bump(by_method, str(sub.method), sub.success)
-        if r.outcome is not None:  # the referee's verdict against truth.json
-            resolved.n += 1
-            resolved.successes += int(r.outcome.resolved)
-            bump(resolved_by_class, task.hazard_class if task else "unknown", r.outcome.resolved)
-            harm["new"] += int(bool(r.outcome.new_hazards))
-            harm["safe"] += int(bool(r.outcome.interventions_on_safe))
-    return SuccessSummary(
-        resolved=resolved,
-        resolved_by_class=dict(sorted(resolved_by_class.items())),
-        new_hazards=harm["new"],
-        on_safe=harm["safe"],
-        results=len(results),
-        tasks=len({r.task_id for r in results}),
-        overall=overall,
-        by_category=dict(sorted(by_category.items())),
-        by_class=dict(sorted(by_class.items())),
-        by_method=dict(sorted(by_method.items())),
-        errors=sum(1 for r in results if r.error),
-    )
+            _bump(by_method.setdefault(str(sub.method), Rate()), sub.success)
+        verdict = verdicts.get((r.task_id, r.seed))
+        if verdict is None:
+            out.unjudged += 1
+            continue
+        for counts in (out.verdicts, by_category.setdefault(category, VerdictCounts()),
+                       by_class.setdefault(hazard_class, VerdictCounts())):
+            count_verdict(counts, verdict)
+    out.by_category = dict(sorted(by_category.items()))
+    out.by_class = dict(sorted(by_class.items()))
+    out.robot_check_by_class = dict(sorted(robot_by_class.items()))
+    out.by_method = dict(sorted(by_method.items()))
+    return out
+
+
+def count_verdict(counts: VerdictCounts, verdict: RunVerdict) -> None:
+    counts.runs += 1
+    setattr(counts, verdict.status, getattr(counts, verdict.status) + 1)
+    counts.new_hazards += int(bool(verdict.new_hazards))
+    counts.on_safe += int(bool(verdict.interventions_on_safe))
+
+
+def _bump(rate: Rate, ok: bool) -> None:
+    rate.n += 1
+    rate.successes += int(ok)
 
 
 # --------------------------------------------------------------------------- reading a run
@@ -116,7 +83,7 @@ def load_tasks(run: RunFolder) -> list[TaskProposal]:
 
 def load_manifests(run: RunFolder, tasks: Sequence[TaskProposal]) -> dict:
     """Task id -> the builder's truth manifest, for scenes that have one (the answer key: metrics only)."""
-    from anomalygen.scene.truth import load_manifest
+    from anomalygen.evaluate.detection_scores import load_manifest
 
     return {t.id: m for t in tasks if (m := load_manifest(run.scene_dir(t.id))) is not None}
 
@@ -127,6 +94,11 @@ def load_detections(run: RunFolder) -> list[Detection]:
     if run.detections_dir.is_dir():  # per-item files before the stage merges them
         return [d for p in sorted(run.detections_dir.glob("*.json")) if (d := try_read_model(p, Detection))]
     return []
+
+
+def load_verdicts(run: RunFolder, results: Sequence[SkillResult]) -> dict[tuple[str, int], RunVerdict | None]:
+    """(task id, seed) -> the referee's verdict, for every result read."""
+    return {(r.task_id, r.seed): verdict_of(run, r.task_id, r.seed) for r in results}
 
 
 def load_skill_results(run: RunFolder) -> list[SkillResult]:

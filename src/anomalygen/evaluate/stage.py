@@ -1,6 +1,9 @@
-"""``anomalygen evaluate``: compute every metric of a run into ``evaluation.json`` and print the diversity table.
+"""``anomalygen evaluate``: compute every metric of a run into ``evaluation.json`` and print the tables.
 
 Works on whatever the run holds: a missing stage leaves its section empty and is listed in ``not_run``.
+This is where the robot's work is scored, after its items finished: detections against each scene's
+truth (also written as ``detections_summary.json``), runs by the referee's verdict. Tables go to
+stderr; stdout stays free for ``--json``.
 """
 
 from __future__ import annotations
@@ -38,6 +41,7 @@ def evaluate_run(run: RunFolder, settings: Settings) -> Evaluation:
     scenes = rm.built_scenes(run)
     detections = rm.load_detections(run)
     results = rm.load_skill_results(run)
+    manifests = rm.load_manifests(run, tasks)
     manifest = run.load_manifest()
     timings: dict[str, float] = {}
 
@@ -77,9 +81,8 @@ def evaluate_run(run: RunFolder, settings: Settings) -> Evaluation:
         target_assets=rm.distribution(t.target_asset for t in tasks),
         scenes_built=sum(1 for s in scenes if s.validation is None or s.validation.ok),
         scenes_failed=len(run.errors("build")),
-        detection=(rm.detection_summary(detections, tasks, settings.detect.k, rm.load_manifests(run, tasks))
-                   if detections else None),
-        success=rm.success_summary(results, tasks) if results else None,
+        detection=_detection(run, detections, tasks, manifests, settings) if detections else None,
+        success=rm.success_summary(results, tasks, rm.load_verdicts(run, results)) if results else None,
         hazards=_hazards(run, tasks, settings),
         timings=dict(manifest.stages),
         llm_usage=manifest.llm_usage,
@@ -88,12 +91,36 @@ def evaluate_run(run: RunFolder, settings: Settings) -> Evaluation:
     )
 
 
+def _detection(run: RunFolder, detections, tasks, manifests, settings: Settings):
+    """Detections scored against the truth, with the text judge's diagnostic beside them."""
+    from anomalygen.evaluate.detection_report import summarise
+    from anomalygen.evaluate.text_judge import text_judge_diagnostic
+    from anomalygen.knowledge import load_kb
+
+    kb = load_kb()
+    report = summarise(detections, tasks, manifests, settings.detect.k,
+                       category_of={c: str(h.category) for c, h in kb.hazard_classes.items()})
+    report.text_judge = text_judge_diagnostic(run, detections, tasks, manifests, report.k, settings)
+    return report
+
+
 def _hazards(run: RunFolder, tasks, settings: Settings):
     """The loop table, when the scenes carry truth manifests (None for runs built before them)."""
     from anomalygen.evaluate.hazard_table import hazard_table
 
     table = hazard_table(run, [t.id for t in tasks], settings.learn.seeds)
     return table if table.scenes else None
+
+
+def print_scores(evaluation: Evaluation, console) -> None:
+    """Detection against the truth, then the referee's verdicts by category and class."""
+    from anomalygen.evaluate.detection_report import print_report
+    from anomalygen.evaluate.verdict_table import verdict_table
+
+    if evaluation.detection is not None:
+        print_report(evaluation.detection, console=console)
+    if evaluation.success is not None:
+        console.print(verdict_table(evaluation.success))
 
 
 def measured_ablation(run_name: str, rows: list[DiversityRow], group_of: dict[str, tuple[str, str]]) -> list[AblationRow]:
@@ -111,12 +138,18 @@ def run_stage(run: RunFolder, settings: Settings) -> StageSummary:
     started, record = time.perf_counter(), StageRecord(started=now_iso())
     evaluation = evaluate_run(run, settings)
     write_model(evaluation_path(run), evaluation)
+    if evaluation.detection is not None:
+        from anomalygen.evaluate.detection_report import summary_path
+
+        write_model(summary_path(run), evaluation.detection)
     if not settings.quiet:
         from rich.console import Console
 
-        Console(width=max(Console().width, 120)).print(rich_table(evaluation.diversity))
+        console = Console(stderr=True)
+        console.print(rich_table(evaluation.diversity))
+        print_scores(evaluation, console)
         if evaluation.not_run:
-            Console(stderr=True).print(f"not run yet: {', '.join(evaluation.not_run)}", highlight=False)
+            console.print(f"not run yet: {', '.join(evaluation.not_run)}", highlight=False)
     summary = StageSummary("evaluate", done=1, wall_s=time.perf_counter() - started)
     summary.results["evaluation"] = str(evaluation_path(run))
     record.finished, record.wall_s, record.done = now_iso(), round(summary.wall_s, 3), 1

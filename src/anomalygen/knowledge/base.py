@@ -22,7 +22,7 @@ from anomalygen.knowledge.models import (
     ObjectInfo,
     RoleProfile,
 )
-from anomalygen.schema import HazardCategory, PredicateCall
+from anomalygen.schema import LATCHING_PROPERTY, HazardCategory, PredicateCall
 
 #: Placement -> the support kind an object must usually rest on for it to be plausible.
 PLACEMENT_SUPPORT: dict[str, str] = {
@@ -52,10 +52,13 @@ def vocabulary() -> dict[str, Any]:
 class KnowledgeBase:
     """Hazard classes, object knowledge and role profiles, validated and indexed."""
 
-    def __init__(self, hazard_classes: list[HazardClass], objects: list[ObjectInfo], roles: list[RoleProfile]):
+    def __init__(self, hazard_classes: list[HazardClass], objects: list[ObjectInfo], roles: list[RoleProfile],
+                 lookalike_groups: list[list[str]] | None = None):
         self.hazard_classes: dict[str, HazardClass] = {hc.id: hc for hc in hazard_classes}
         self.objects: dict[str, ObjectInfo] = {o.name: o for o in objects}
         self.roles: dict[str, RoleProfile] = {r.id: r for r in roles}
+        #: groups of objects a perceiver can mistake for one another (``lookalikes.json``)
+        self.lookalike_groups: list[list[str]] = [list(g) for g in lookalike_groups or []]
         self._candidates: dict[tuple[str, str], list[str]] = {}
 
     # ------------------------------------------------------------------ simple views
@@ -77,6 +80,11 @@ class KnowledgeBase:
         """Perceived properties of a catalogue object (what the scene builder puts in GraphObject.properties)."""
         info = self.objects.get(name)
         return list(info.properties) if info else []
+
+    def lookalikes(self, name: str) -> list[str]:
+        """The other members of ``name``'s look-alike group (empty when it has none)."""
+        group = next((g for g in self.lookalike_groups if name in g), [])
+        return [n for n in group if n != name]
 
     def benign_objects(self) -> list[str]:
         """Household objects with no hazard-relevant property: safe clutter that triggers no class."""
@@ -119,6 +127,26 @@ class KnowledgeBase:
         own = self.objects[obj].containers if obj in self.objects else []
         both = [c for c in hc.default_containers if c in own]
         return both or list(hc.default_containers)
+
+    def guards_a_child(self, hc: HazardClass) -> bool:
+        """Is the class's danger a small child reaching the object (a ``child_reachable`` precondition)?"""
+        return any(c.name == "child_reachable" and not c.negate for c in hc.preconditions)
+
+    def latches(self, name: str) -> bool:
+        """Does a container of this kind latch shut (a toddler opens a box or a cupboard, not a safe)?"""
+        return LATCHING_PROPERTY in self.properties_of(name)
+
+    def latching_containers_for(self, hc: HazardClass, obj: str) -> list[str]:
+        """The kinds of ``containers_for`` that latch, in class order."""
+        return [k for k in self.containers_for(hc, obj) if self.latches(k)]
+
+    def safe_containers_for(self, hc: HazardClass, obj: str) -> list[str]:
+        """``containers_for``, kept to the kinds that latch when the class guards a child and any of
+        them is on the list: storing a knife in a box a toddler opens does not end its hazard."""
+        kinds = self.containers_for(hc, obj)
+        if not self.guards_a_child(hc):
+            return kinds
+        return self.latching_containers_for(hc, obj) or kinds
 
     def placements_for(self, hc: HazardClass, obj: str) -> list[str]:
         """Class placements that are plausible for ``obj`` given where it usually rests."""
@@ -193,6 +221,9 @@ class KnowledgeBase:
                 out.append(f"{where}: hazard_objects {bad} do not meet the class's intrinsic preconditions")
             if not self.hazard_candidates(hc):
                 out.append(f"{where}: no catalogue object can be its hazard")
+        grouped = [n for g in self.lookalike_groups for n in g]
+        out += [f"look-alikes: unknown object {n}" for n in grouped if n not in names]
+        out += [f"look-alikes: {n} is in more than one group" for n in sorted({n for n in grouped if grouped.count(n) > 1})]
         for r in self.roles.values():
             out += [f"role {r.id}: unknown class {c}" for c in r.class_interests if c not in self.hazard_classes]
             out += [f"role {r.id}: unknown object {o}" for o in r.object_interests if o not in names]
@@ -235,4 +266,4 @@ def load_kb() -> KnowledgeBase:
     classes = [HazardClass.model_validate(c) for c in _data("hazard_classes.json")["classes"]]
     objects = [ObjectInfo.model_validate({"name": n, **o}) for n, o in _data("objects.json")["objects"].items()]
     roles = [RoleProfile.model_validate(r) for r in _data("roles.json")["roles"]]
-    return KnowledgeBase(classes, objects, roles)
+    return KnowledgeBase(classes, objects, roles, _data("lookalikes.json")["groups"])

@@ -33,6 +33,7 @@ PROPERTIES: tuple[str, ...] = (
     "furniture",
     "appliance",
     "soft",
+    "lockable",
 )
 
 #: Properties that make an object part of *some* hazard; objects with none of them are safe clutter.

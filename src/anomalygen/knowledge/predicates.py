@@ -175,8 +175,10 @@ def _near_edge(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
 @_predicate(
     "child_reachable",
     {"object": "variable or instance"},
-    "A small child could reach the object: at most 1.0 m up and not inside a closed container "
-    "(computed by the scene builder into GraphObject.child_reachable).",
+    "A small child could reach the object: its bottom at most 1.0 m up (CHILD_REACH) and not shut inside a "
+    "closed container that latches (a knowledge-base 'lockable' object: a safe, a medicine cabinet); a "
+    "cupboard door or a box lid a toddler opens does not keep it out. Computed from the simulated state "
+    "into GraphObject.child_reachable (schema.within_child_reach).",
 )
 def _child_reachable(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
     obj = ctx.obj(call)

@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 
 from anomalygen.errors import ItemFailed
-from anomalygen.schema import CHILD_REACH, GraphObject, Relation, SceneGraph
+from anomalygen.schema import LATCHING_PROPERTY, GraphObject, Relation, SceneGraph, within_child_reach
 
 REACH_BOTTOM_M = 1.2  # a container standing higher than this is out of the arm's comfortable reach
 AFTER_PLACE_LIFT_M = 0.02  # predicted height of a placed object above its container's base
@@ -76,11 +76,11 @@ def ends_hazard(classes, obj: GraphObject, container: GraphObject, graph: SceneG
     from anomalygen.knowledge.predicates import PredicateError, match_class
 
     bottom = container.height_above_floor + AFTER_PLACE_LIFT_M
-    shuts = any(j.encloses for j in container.joints)
+    latches = any(j.encloses for j in container.joints) and LATCHING_PROPERTY in container.properties
     moved = obj.model_copy(update={
         "position": [container.position[0], container.position[1], bottom + obj.size[2] / 2],
         "height_above_floor": bottom, "on_floor": False, "distance_to_edge": None,
-        "child_reachable": bottom <= CHILD_REACH and not shuts,
+        "child_reachable": within_child_reach(bottom, latches),
     })
     after = graph.model_copy(update={
         "objects": [moved if o.name == obj.name else o for o in graph.objects],

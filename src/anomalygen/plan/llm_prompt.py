@@ -14,7 +14,7 @@ from importlib import resources
 
 from anomalygen.schema import JointState, ObjectRole, PlacedObject, SceneSpec
 
-#: The executor's primitives (learn/execute.py ``run_subtask``) and the params each one needs.
+#: The registered scripted skills' actions (skills/scripted/actions.py) and the params each one needs.
 PRIMITIVES: dict[str, tuple[str, str]] = {
     "grasp": ("object", "suction-grasp the object and lift it `lift` metres (default 0.12)"),
     "approach": ("object", "bring the gripper next to the object"),

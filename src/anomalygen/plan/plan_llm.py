@@ -92,7 +92,7 @@ class ReplySubTask(BaseModel):
 
     id: str = Field(description="s<position>_<verb>, e.g. s1_pick")
     description: str = Field(min_length=1)
-    # CEM (rl/cem.py) plans a legged body's motion and runs only on the Gymnasium Ant: not offered here
+    # CEM plans a legged body's motion and runs only on the Gymnasium Ant: not offered here
     method: Literal["primitive", "sac"]
     primitive: str | None = Field(None, description="a primitive from the menu (required for method primitive)")
     params: ReplyParams = Field(default_factory=ReplyParams)

@@ -11,6 +11,11 @@ from __future__ import annotations
 
 from anomalygen.errors import ItemFailed
 from anomalygen.schema import (
+    DOOR,
+    DRAWER,
+    ENCLOSING_LABELS,
+    LID_LABELS,
+    SWITCH_LABELS,
     Engine,
     Plan,
     PredicateCall,
@@ -20,11 +25,12 @@ from anomalygen.schema import (
     SkillMethod,
     SubTask,
     SuccessSpec,
+    part_labels,
 )
 
 LIFT_HEIGHT = 0.12  # metres above the start height for a pick
-CLOSURES = ("lid", "flap", "drawer", "door")  # part labels that can shut a container
-LID_LABELS = "lid|flap"  # the parts close_lid / open_lid act on (a cardboard box has flaps, not a lid)
+CLOSURES = ENCLOSING_LABELS  # part labels that can shut a container, in the order a plan lists them
+LID_PARTS = part_labels.any_of(LID_LABELS)  # the parts close_lid / open_lid act on (a cardboard box has flaps)
 _LIFTED_OUT = 1.0  # m: reward target height for an object taken out of a counter-top appliance
 
 
@@ -102,14 +108,11 @@ def step_to_subtask(index: int, action: str, args: dict[str, str], bindings: dic
     raise ItemFailed(f"recipe action {action!r} has no sub-task mapping")
 
 
-SWITCH_LABELS = ("knob", "switch")  # the parts a switch_off step turns (KB labels: a button is a switch)
-
-
 def switch_off_subtasks(index: int, args: dict[str, str], bindings: dict[str, str], spec: SceneSpec | None,
                         final_success: list[PredicateCall], method: SkillMethod) -> list[SubTask]:
     """A switch_off step -> one sub-task per knob or switch of the appliance that is on, most on first.
 
-    The learned skill turns one part (``rl/part_skill.py``), and an oven has up to five knobs on; the
+    The learned skill turns one part (``skills/learned/part_skill.py``), and an oven has up to five knobs on; the
     scene spec (perceived joint values) says which. Each sub-task's reward is the part's travel to off
     as a fraction (the joint term scaled by 1 / travel, so a 4.7 rad knob and a 4 mm button weigh the
     same) plus the cup near the part; the class's predicates check the last one, earlier ones are
@@ -117,11 +120,10 @@ def switch_off_subtasks(index: int, args: dict[str, str], bindings: dict[str, st
     part is planned, as for the other joint steps.
     """
     target_obj = _resolve(args.get("object", "$target"), bindings)
-    label = args.get("label", "|".join(SWITCH_LABELS))
-    wanted = {x.strip() for x in label.split("|")}
+    wanted = set(part_labels.alternatives(args["label"]) if "label" in args else SWITCH_LABELS)
     joints = [js for obj in (spec.objects if spec else []) if obj.name == target_obj
               for js in obj.joint_states if js.label in wanted]
-    on = sorted([js for js in joints if js.open_fraction > 0.05], key=lambda js: -js.open_fraction)
+    on = sorted([js for js in joints if not js.is_off()], key=lambda js: -js.open_fraction)
     chosen = on or joints[:1]
     vars_here = set(args.values())
     own = [p for p in final_success if vars_here & {str(v) for v in p.args.values()}]
@@ -154,7 +156,7 @@ def _handling_subtask(sid: str, action: str, obj: str, args: dict[str, str], bin
     if action in ("close_lid", "open_lid"):
         verb = "close" if action == "close_lid" else "open"
         return SubTask(id=sid, description=f"{verb} the lid of {obj}", method=SkillMethod.PRIMITIVE, primitive=action,
-                       params={"object": obj, "part": LID_LABELS},
+                       params={"object": obj, "part": LID_PARTS},
                        reward=RewardSpec(terms=[RewardTerm(kind="distance", a="ee", b=obj, weight=0.5),
                                                 RewardTerm(kind="action_penalty", weight=0.01)]),
                        success=SuccessSpec(predicates=own))
@@ -190,7 +192,7 @@ def access_steps(container: str, labels: list[str], *, contents: str | None = No
     shut it again after the place: a drawer left open is a hazard of its own. With ``contents`` the
     container is the one the object comes out of: the door or drawer in front of it is opened (the
     executor finds which from the scene) and shut again at the end."""
-    part = "|".join(labels)
+    part = part_labels.any_of(labels)
     which = "source" if contents else "container"
     why = f"to take {contents} out" if contents else "to put something inside"
     params = {"object": container, "part": part, "access": True, **({"contents": contents} if contents else {})}
@@ -217,7 +219,7 @@ def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, s
         raise ItemFailed(f"hazard class {hazard_class!r} is not in the knowledge base; no recipe to plan from")
     # A step goes to SAC when the knowledge base says so (``"method": "sac"``: a contact-rich part
     # motion with a shipped warm start, such as switch_off) or the user lists its action in
-    # ``learn.sac_actions``; it keeps its reward spec either way.
+    # ``plan.sac_actions``; it keeps its reward spec either way.
     subtasks = []
     for i, step in enumerate(cls.recipe):
         method = SkillMethod.SAC if step.method == "sac" or step.action in sac_actions else SkillMethod.PRIMITIVE
@@ -254,7 +256,7 @@ def _take_out_first(subtasks: list[SubTask], cls, bindings: dict[str, str], spec
     obj = _resolve(cls.recipe[0].args.get("object", "$hazard"), bindings)
     source = next((o.inside for o in spec.objects if o.name == obj), None)
     labels = sorted({js.label for o in spec.objects if o.name == source for js in o.joint_states
-                     if js.label in ("drawer", "door")}, key=CLOSURES.index)
+                     if js.label in (DRAWER, DOOR)}, key=CLOSURES.index)
     picks = [i for i, st in enumerate(subtasks) if st.primitive == "grasp"]
     if not labels or not picks:
         return subtasks

@@ -1,16 +1,16 @@
 """Stage 4a: one ``plans/<task_id>.json`` per scene, from the detection (default) or from the oracle.
 
-With ``plan_source = detected`` (the default) the robot plans from what it perceived: every
-hypothesis worth acting on (a known class, score at least ``learn.min_score``, one per object, most
-severe first, up to ``learn.max_fixes``) becomes a fix whose roles (container, support, ...) are
+With ``plan.source = detected`` (the default) the robot plans from what it perceived: every
+hypothesis worth acting on (a known class, score at least ``plan.min_score``, one per object, most
+severe first, up to ``plan.max_fixes``) becomes a fix whose roles (container, support, ...) are
 chosen from the perceived scene graph (``plan.bind``); the scene spec it reads has the answer key
 removed (``anomalygen.perception``). A scene where nothing was detected gets an empty plan: acting
 there would be an unnecessary intervention. A wrong detection gives a wrong plan, as it should.
 
-With ``plan_source = ground_truth`` the task's class and the builder's bindings are used: the oracle
+With ``plan.source = ground_truth`` the task's class and the builder's bindings are used: the oracle
 ablation, for comparison only.
 
-The learn engine picks the planner: ``knowledge`` turns the class's recipe into sub-tasks
+The plan engine (``plan.engine``) picks the planner: ``knowledge`` turns the class's recipe into sub-tasks
 (``planner.plan_from_kb``); ``llm`` asks the configured LLM for the decomposition
 (``plan_llm.plan_from_llm``), validated against the built scene, and counts its tokens in the manifest.
 """
@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 from anomalygen.errors import ItemFailed, UserError
 from anomalygen.runfolder import RunFolder, read_jsonl, try_read_model, write_model
-from anomalygen.runner import StageContext, StageSummary, run_items
+from anomalygen.runner import StageContext, StageSummary, check_only, config_section, run_items
 from anomalygen.schema import Detection, Plan, SceneSpec, SuccessSpec, TaskProposal
 
 if TYPE_CHECKING:
@@ -32,7 +32,7 @@ STAGE = "plan"
 
 def plan_item(task_id: str, payload: dict, ctx: StageContext) -> str:
     run, settings = ctx.run, ctx.settings
-    if settings.learn.plan_source == "detected":
+    if settings.plan.source == "detected":
         plan = _plan_from_perception(task_id, payload, ctx)
     else:
         plan = _plan_from_oracle(task_id, payload, ctx)
@@ -49,12 +49,12 @@ def _plan_from_oracle(task_id: str, payload: dict, ctx: StageContext) -> Plan:
     bindings = dict(spec.bindings) if spec is not None else {}
     hazard_class = payload["hazard_class"]
     if spec is not None and not spec.bindings:  # a hazard-free scene: the oracle knows there is nothing to fix
-        return Plan(task_id=task_id, source="ground_truth", engine=settings.engine_for("learn"), subtasks=[],
+        return Plan(task_id=task_id, source="ground_truth", engine=settings.engine_for("plan"), subtasks=[],
                     success=SuccessSpec(predicates=[]), bindings={})
-    if settings.engine_for("learn").value == "llm":
+    if settings.engine_for("plan").value == "llm":
         return _plan_with_llm(task_id, payload, ctx, hazard_class, bindings, spec, None)
     return plan_from_kb(task_id, hazard_class, bindings, spec=spec, source="ground_truth",
-                        sac_actions=settings.learn.sac_actions)
+                        sac_actions=settings.plan.sac_actions)
 
 
 def _plan_from_perception(task_id: str, payload: dict, ctx: StageContext) -> Plan:
@@ -73,12 +73,12 @@ def _plan_from_perception(task_id: str, payload: dict, ctx: StageContext) -> Pla
     if spec is None or graph is None:
         raise ItemFailed(f"no built scene in {ctx.run.scene_dir(task_id)}")
     kb = load_kb()
-    chosen = fixes_to_make(det["hypotheses"], kb, max_fixes=settings.learn.max_fixes,
-                           min_score=settings.learn.min_score)
+    chosen = fixes_to_make(det["hypotheses"], kb, max_fixes=settings.plan.max_fixes,
+                           min_score=settings.plan.min_score)
     if not chosen:  # nothing detected worth acting on: the right plan is to leave the scene alone
-        return Plan(task_id=task_id, source="detected", engine=settings.engine_for("learn"), subtasks=[],
+        return Plan(task_id=task_id, source="detected", engine=settings.engine_for("plan"), subtasks=[],
                     success=SuccessSpec(predicates=[]), bindings={})
-    if settings.engine_for("learn").value == "llm":
+    if settings.engine_for("plan").value == "llm":
         top = chosen[0]
         bindings = bind_fix(kb.hazard_classes[top["hazard_class"]], top["target_object"], graph, kb)
         return _plan_with_llm(task_id, payload, ctx, top["hazard_class"], bindings, spec, top)
@@ -91,7 +91,7 @@ def _plan_from_perception(task_id: str, payload: dict, ctx: StageContext) -> Pla
             problems.append(f"{hc.id} on {hyp['target_object']}: {exc}")
             continue
         plans.append(plan_from_kb(task_id, hc.id, bindings, spec=spec, source="detected",
-                                  sac_actions=settings.learn.sac_actions))
+                                  sac_actions=settings.plan.sac_actions))
     if not plans:
         raise ItemFailed("; ".join(problems))
     return merge_plans(plans)
@@ -139,26 +139,31 @@ def _plan_with_llm(task_id: str, payload: dict, ctx: StageContext, hazard_class:
 
 
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
-    engine = settings.engine_for("learn")
+    engine = settings.engine_for("plan")
     if engine.value == "llm" and not settings.llm.configured:
-        raise UserError("the llm learn engine needs an LLM: pass --backend openai|anthropic|llamacpp "
+        raise UserError("the llm plan engine needs an LLM: pass --backend openai|anthropic|llamacpp "
                         "(or use --engine knowledge)")
     tasks = run.load_tasks()
+    check_only(only, [t.id for t in tasks])
     detections = {}
-    if settings.learn.plan_source == "detected" and run.detections_path.is_file():
+    if settings.plan.source == "detected" and run.detections_path.is_file():
         detections = {d.task_id: d for d in read_jsonl(run.detections_path, Detection, strict=False)}
     items = []
     for t in tasks:
         if only and t.id not in only:
             continue
         det = detections.get(t.id)
-        if settings.learn.plan_source == "detected":  # the robot's side: its detection, never the task
-            items.append((t.id, {"detection": det.model_dump(mode="json") if det else None}))
+        if settings.plan.source == "detected":  # the robot's side: its detection, never the task
+            # what the detector claimed, never how the referee judged it
+            items.append((t.id, {"detection": det.model_dump(mode="json", include={"task_id", "hypotheses"})
+                                 if det else None}))
         else:
             items.append((t.id, {"hazard_class": t.hazard_class, "task": t.model_dump(mode="json")}))
 
     def done(task_id: str) -> bool:
         plan = try_read_model(run.plan_path(task_id), Plan)
-        return plan is not None and plan.source == settings.learn.plan_source and plan.engine == engine
+        return plan is not None and plan.source == settings.plan.source and plan.engine == engine
 
-    return run_items(run, STAGE, items, plan_item, settings=settings, is_done=done, force=force, workers=1)
+    return run_items(run, STAGE, items, plan_item, settings=settings, is_done=done, force=force, workers=1,
+                     inputs=lambda tid: [run.scene_dir(tid) / "scene.json", run.scene_dir(tid) / "scene_graph.json"],
+                     config=config_section(settings, "learn", exclude=("seeds",), llm=engine.value == "llm"))

@@ -3,12 +3,12 @@
 This module runs the attempts and writes the outputs; each step has a module of its own. Pipeline of
 one attempt (all randomness from ``item_rng(seed, task.id, attempt)``):
 
-1. select assets (selection.py, with select.py for each asset): hazard, target, the object the hazard
+1. select assets (casting.py, with asset_choice.py for each asset): hazard, target, the object the hazard
    sits in/on, the container of the fix, task co-objects, unrelated clutter; sizes from the knowledge
    base, clamped by spatial rules; initial joint states that make the hazard real;
 2. place them (placement.py on layout.py; instances.py for holders' surfaces and cavities;
    judgement.py for near-misses, a second hazard and hazard-free scenes) and move the robot base
-   within reach; bind the role variables to instance names (selection.py);
+   within reach; bind the role variables to instance names (casting.py);
 3. compose one MjSpec (compose.py: robot + room + objects), compile, reject initial interpenetration;
 4. settle the physics for ``settings.build.settle_s``;
 5. validate (validate.py): interpenetration <= 1 mm, velocities settled, and the hazard class's
@@ -23,7 +23,7 @@ from __future__ import annotations
 import logging
 import os
 import shutil
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -33,13 +33,15 @@ from anomalygen.assets.real.files import relocate_meshes
 from anomalygen.errors import ItemFailed
 from anomalygen.knowledge import load_kb
 from anomalygen.rng import item_rng, stable_hash
+from anomalygen.robot.agent import Agent
 from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
-from anomalygen.scene import robot, robot_model, select
+from anomalygen.scene.casting import bind_roles, select_objects, set_initial_joints
+from anomalygen.scene.cavities import placed_cavities
 from anomalygen.scene.compose import compose_scene, hold_gravity_hinges, latch_switched_on, set_joints
+from anomalygen.scene.instances import renumber_by_position
 from anomalygen.scene.judgement import check_hazard_free
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.placement import place
-from anomalygen.scene.selection import bind_roles, select_objects, set_initial_joints
 from anomalygen.schema import (
     AssetRef,
     AssetSource,
@@ -49,6 +51,7 @@ from anomalygen.schema import (
     TaskProposal,
     ValidationCheck,
     ValidationReport,
+    part_labels,
 )
 
 if TYPE_CHECKING:
@@ -68,6 +71,7 @@ class Built:
     data: object
     report: ValidationReport
     graph: object
+    intents: dict = field(default_factory=dict)  # instance -> referee.truth.Intent of the judgement mix
 
 
 def _plan(task: TaskProposal, settings: Settings, rng, hints=None,
@@ -79,7 +83,8 @@ def _plan(task: TaskProposal, settings: Settings, rng, hints=None,
     sel.hazard_free = hazard_free
     set_initial_joints(sel)
     lay, placed, support = place(sel, settings)
-    return lay, ({} if hazard_free else bind_roles(sel, support)), placed
+    placed, bindings = renumber_by_position(lay, placed, {} if hazard_free else bind_roles(sel, support))
+    return lay, bindings, placed
 
 
 # ============================================================================ attempt
@@ -101,7 +106,7 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
     data = mujoco.MjData(model)
     hold_gravity_hinges(model, placed, mjspec)
     latch_switched_on(model, placed, mjspec)
-    robot.set_home(model, data, tuple(lay.base))
+    Agent(model).set_home(data, tuple(lay.base))
     set_joints(model, data, placed)
     mujoco.mj_forward(model, data)
     spec = _scene_spec(task, seed, lay, placed, bindings, model, data)
@@ -121,7 +126,7 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
     if hazard_free and report.ok:
         report = check_hazard_free(report, graph, task.hazard_class)
     report.checks = notes + report.checks
-    return Built(spec, mjspec, model, data, report, graph)
+    return Built(spec, mjspec, model, data, report, graph, {p.name: p.intent for p in placed.values() if p.intent})
 
 
 def _hint_notes(hints, lay: Layout) -> list[ValidationCheck]:
@@ -148,7 +153,7 @@ def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, mo
             joints = [
                 JointState(
                     name=f"{p.name}/{j.name}",
-                    label=select.kb_label(j.label),
+                    label=part_labels.canonical(j.label),
                     type=j.type,
                     value=float(data.joint(f"{p.name}/{j.name}").qpos[0]),
                     range=(float(j.range[0]), float(j.range[1])),
@@ -166,6 +171,7 @@ def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, mo
             )
             size = s.size
             joints = []
+        cavities = placed_cavities(model, p.name, p.asset) if p.asset is not None else []
         objects.append(
             PlacedObject(
                 name=p.name,
@@ -178,6 +184,7 @@ def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, mo
                 inside=p.inside,
                 joint_states=joints,
                 fixed=p.fixed,
+                cavities=cavities,
             )
         )
     return SceneSpec(
@@ -250,8 +257,8 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_cla
     """scene.xml, renders, scene_graph.json, the hidden truth.json, scene.json last.
 
     ``hazard_class`` is the hazard the builder set up (None for a hazard-free scene)."""
+    from anomalygen.referee.truth import TRUTH_FILE, hazard_manifest
     from anomalygen.scene.render import SceneRenderer, png_bytes
-    from anomalygen.scene.truth import TRUTH_FILE, hazard_manifest
 
     out_dir.mkdir(parents=True, exist_ok=True)
     model, data, mjspec = built.model, built.data, built.mjspec
@@ -270,7 +277,7 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_cla
             files[f"render_{cam}"] = f"render_{cam}.png"
     spec = built.spec.model_copy(update={"validation": built.report, "files": files})
     write_model(out_dir / "scene_graph.json", built.graph)
-    write_model(out_dir / TRUTH_FILE, hazard_manifest(spec, hazard_class, built.graph, load_kb()))
+    write_model(out_dir / TRUTH_FILE, hazard_manifest(spec, hazard_class, built.graph, load_kb(), built.intents))
     write_model(out_dir / "scene.json", spec)  # last: its presence marks the scene done
     return spec
 
@@ -278,9 +285,9 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_cla
 def _write_xml(mjspec, out_dir: Path) -> None:
     """scene.xml with robot meshes under assets/franka (real models' under assets/real), loadable
     from any working directory."""
-    src = robot_model.franka_assets_dir() / "meshes"
+    src, files = Agent.mesh_files()
     dst = out_dir / "assets" / "franka"
-    for rel in robot_model.mesh_files():
+    for rel in files:
         target = dst / rel
         if target.exists():
             continue

@@ -11,17 +11,23 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from anomalygen.scene import furniture, layout, robot, robot_model
+from anomalygen.robot.agent import Agent
+from anomalygen.scene import furniture, layout
 from anomalygen.scene.graph import FLOOR_GEOM
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.sensors import add_observation_sensors
-from anomalygen.schema import ObjectRole
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
 
 
 LOOSE_SOLREF = 0.005  # s: contact time constant of loose objects (2.5 physics steps)
+CAMERA_FOVY = 55.0  # degrees, both room cameras
+FRAME_MARGIN = 0.1  # m of floor kept around the objects' footprints in the room cameras
+FRAME_TOP = 1.0  # m: the room cameras see the furnished floor whole up to this height (table and counter tops)
+FOCUS_HEIGHT = 0.4  # m: the cameras aim at this height above the middle of the furnished floor
+FRONT_PITCH = math.radians(45)  # the front camera looks down this much
+VIEW_FROM = np.array([-1.0, -0.7])  # horizontal direction from the room's middle to the front camera
 
 
 def look_at_xyaxes(eye, target) -> list[float]:
@@ -39,7 +45,7 @@ def look_at_xyaxes(eye, target) -> list[float]:
 def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rng):
     import mujoco
 
-    spec = robot_model.build_robot_spec(tuple(lay.base))
+    spec = Agent.build_spec(tuple(lay.base))
     spec.modelname = "anomalygen_scene"
     spec.option.timestep = 0.002
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
@@ -94,26 +100,11 @@ def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rn
         name="fill", pos=[-1.0, -1.0, 2.5], dir=[0.5, 0.4, -0.6], diffuse=[0.35, 0.35, 0.35], castshadow=False
     )
 
-    focus = np.mean(
-        [p.world_center() for p in placed.values() if p.role != ObjectRole.CLUTTER]
-        or [np.array([1.0, 0, 0.4])],
-        axis=0,
-    )
-    focus[2] = min(max(focus[2], 0.2), 0.8)
-    # Front camera: behind the robot as seen from the task objects, raised, turned 30 degrees, so
-    # the robot stands in the foreground and the scene behind it.
-    away = lay.base[:2] - focus[:2]
-    dist = float(np.linalg.norm(away))
-    away = away / dist if dist > 1e-6 else np.array([-1.0, 0.0])
-    c, s = math.cos(0.5), math.sin(0.5)
-    away = np.array([c * away[0] - s * away[1], s * away[0] + c * away[1]])
-    eye = np.r_[focus[:2] + away * (dist + 1.0), 1.9]
-    spec.worldbody.add_camera(name="front", pos=eye.tolist(), xyaxes=look_at_xyaxes(eye, focus), fovy=60)
-    top_eye = np.array([focus[0], focus[1] - 0.01, 3.3])
-    spec.worldbody.add_camera(name="top", pos=top_eye.tolist(), xyaxes=[0, -1, 0, 1, 0, 0], fovy=55)
+    add_room_cameras(spec, list(placed.values()), settings.build.render_width / settings.build.render_height)
 
+    objects = sorted(placed.values(), key=lambda p: p.name)  # name order: no role shows in the model
     loose, parts = [], []
-    for p in placed.values():
+    for p in objects:
         body = spec.worldbody.add_body(name=p.name, pos=p.pos.tolist(), quat=p.quat)
         if p.support_geom is not None:
             furniture.emit(p.support_geom, body, rng)
@@ -136,16 +127,48 @@ def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rn
                 geom.priority = 1
                 geom.solref = [LOOSE_SOLREF, 1.0]
     # Suction can also hold a door, lid or drawer, so primitives can pull parts open or lift them shut.
-    robot_model.add_suction_welds(spec, [n for n, _ in loose] + parts, [r for _, r in loose] + parts)
-    task_objects = [p for p in placed.values() if p.role != ObjectRole.CLUTTER]
-    add_observation_sensors(
+    Agent.add_suction_welds(spec, [n for n, _ in loose] + parts, [r for _, r in loose] + parts)
+    add_observation_sensors(  # every object alike: the sensor list must not tell the task's objects apart
         spec,
-        list(robot.ROBOT_JOINTS),
-        [p.name for p in task_objects],
-        [f"{p.name}/{j.name}" for p in task_objects if p.asset is not None for j in p.asset.joints],
+        list(Agent.ROBOT_JOINTS),
+        [p.name for p in objects],
+        [f"{p.name}/{j.name}" for p in objects if p.asset is not None for j in p.asset.joints],
     )
     spec.add_key(name="init")
     return spec
+
+
+def add_room_cameras(spec, objects: list[Placed], aspect: float) -> None:
+    """The ``front`` and ``top`` cameras, framed on the furnished part of the room: the box around
+    every object's footprint, each object alike, up to ``FRAME_TOP`` high.
+
+    Why not the task's objects: cameras aimed at their mean pointed the robot at the hazard. The
+    front camera looks in from the room's open corner (the walls stand at +x and +y), pitched down
+    ``FRONT_PITCH``, just far enough back for the box to fit its view (``aspect``: width / height);
+    the top camera looks straight down from just high enough."""
+    boxes = [p.footprint() for p in objects] or [(np.r_[layout.ROOM_CENTER - 1.0, 0.0], np.r_[layout.ROOM_CENTER + 1.0, 1.0])]
+    lo = np.min([b[0][:2] for b in boxes], axis=0) - FRAME_MARGIN
+    hi = np.max([b[1][:2] for b in boxes], axis=0) + FRAME_MARGIN
+    focus = np.r_[(lo + hi) / 2, FOCUS_HEIGHT]
+    tan_v = math.tan(math.radians(CAMERA_FOVY) / 2)
+    tan_h = tan_v * aspect
+    away = VIEW_FROM / np.linalg.norm(VIEW_FROM)
+    fwd = -np.r_[away * math.cos(FRONT_PITCH), math.sin(FRONT_PITCH)]
+    right = np.cross(fwd, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, fwd)
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (0.0, FRAME_TOP)]) - focus
+    # a point stays in view when its sideways and upward offsets fit the view's half-angles at its
+    # depth; the depth grows one for one as the eye moves back along the viewing direction
+    depth = corners @ fwd
+    back = max(float(np.max(np.abs(corners @ right) / tan_h - depth)), float(np.max(np.abs(corners @ up) / tan_v - depth)))
+    eye = focus - fwd * back
+    spec.worldbody.add_camera(name="front", pos=eye.tolist(), xyaxes=look_at_xyaxes(eye, focus), fovy=CAMERA_FOVY)
+    # top view: image up is world +x, image right is world -y
+    half = (hi - lo) / 2
+    top = max(half[0] / tan_v, half[1] / tan_h) + FRAME_TOP
+    top_eye = np.array([focus[0], focus[1] - 0.01, top])
+    spec.worldbody.add_camera(name="top", pos=top_eye.tolist(), xyaxes=[0, -1, 0, 1, 0, 0], fovy=CAMERA_FOVY)
 
 
 def _articulated_bodies(body) -> list[str]:

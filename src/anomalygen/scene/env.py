@@ -1,23 +1,35 @@
 """A Gymnasium environment for a built scene: end-effector delta actions plus suction.
 
 Action (Box [-1, 1]^7), as in the paper: a delta translation (3) and a delta axis-angle rotation (3,
-in the cup frame) of the end effector, scaled by ``max_delta_pos`` / ``max_delta_rot`` per step, plus
-suction (> 0 on, <= 0 off); :meth:`~anomalygen.scene.robot.Robot.move_target` maps it, as for every
+in the cup frame) of the end effector, scaled by ``max_delta_pos`` / ``max_delta_rot`` per step (the
+agent's step size, ``Agent.STEP_POS`` / ``Agent.STEP_ROT``, unless a caller asks otherwise), plus
+suction (> 0 on, <= 0 off); :meth:`~anomalygen.robot.agent.Agent.apply_action` maps it, as for every
 env. The end effector follows a mocap target through the ``ee_track`` weld (MuJoCo solves it
 inside the physics step), so a step costs almost exactly ``frameskip`` raw ``mj_step`` calls: no
 Python IK loop. Arm actuators go limp in this mode (gravity compensation keeps the arm up); the base
 actuators hold the mobile base where the scene put it.
 
-Observation: a flat float64 vector of robot joint positions and velocities, end-effector position and
-quaternion, the suction state, and each task object's position and quaternion and articulated joint
-values (clutter left out). ``obs_layout`` names the slices.
+Observation: a flat float64 vector, the same groups in the same order for every scene (their sizes
+follow the scene's objects), named by ``obs_layout``:
+``robot_qpos`` and ``robot_qvel`` (the robot's joints, ``Agent.ROBOT_JOINTS`` order), ``ee_pos`` (3)
+and ``ee_quat`` (4, w x y z) of the end effector, then every object alike, in ``object_names`` order
+(instance names sorted; the scene builder numbers instances by where they stand, so neither the
+names nor their order say which object matters): ``object_pos`` (3 per object, its body origin),
+``object_quat`` (4 per object), ``object_joints`` (the value of every articulated joint, object by
+object, in the asset's joint order), and last ``suction`` (1.0 while something is held).
 
-Suction grabs an object whose geoms touch the cup (a contact, checked with numpy on MuJoCo's contact
-list) and welds it at the current relative pose; turning suction off releases it.
+The env perceives only (``anomalygen.perception``): ``env.scene`` is the scene spec with no bindings,
+roles, validation report or task id, and ``info`` carries no task words. ``info["is_success"]`` is
+there only when a ``success_fn`` is given (the caller's own check, as the skills pass theirs): the env
+itself cannot know success without the answer key. The referee's verdict comes from outside.
+
+Suction follows the agent's one grab rule (:meth:`~anomalygen.robot.agent.Agent.grab`): the nearest
+graspable body within ``Agent.SUCTION_RANGE`` of the cup is welded at its current relative pose
+(rigidly, or by position only for a door, lid or knob); turning suction off releases it.
 
 Hooks: ``reward_fn(env) -> float`` and ``success_fn(env) -> bool`` let the skills stage plug in
 RewardSpec/SuccessSpec evaluation (``info["is_success"]`` carries the latter, as SB3 reads it);
-``env.graph()`` gives the current SceneGraph. The loaded SceneSpec is ``env.scene``.
+``env.graph()`` gives the current SceneGraph. The perceived SceneSpec is ``env.scene``.
 
 Episode length: ``gym.make(ENV_ID, scene_dir=...)`` wraps the env in Gymnasium's ``TimeLimit``
 (``max_episode_steps=HORIZON``, set at registration); ``make_env`` returns the bare env, which
@@ -33,7 +45,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from anomalygen.scene import robot
+from anomalygen.robot.agent import Agent
 
 ENV_ID = "anomalygen/Scene-v0"
 HORIZON = 100  # control steps per episode
@@ -52,20 +64,20 @@ class SceneEnv(gym.Env):
         camera: str = "front",
         width: int = 320,
         height: int = 240,
-        max_delta_pos: float = 0.02,
-        max_delta_rot: float = 0.1,
+        max_delta_pos: float = Agent.STEP_POS,
+        max_delta_rot: float = Agent.STEP_ROT,
         init_noise: float = 0.0,
         reward_fn: Callable[[SceneEnv], float] | None = None,
         success_fn: Callable[[SceneEnv], bool] | None = None,
     ):
         import mujoco
 
-        from anomalygen.scene.graph import load_scene
+        from anomalygen.perception import load_perceived_scene
 
         self._mj = mujoco
         self.scene_dir = Path(scene_dir)
         # ``scene``, not ``spec``: Gymnasium keeps its EnvSpec in ``env.spec`` and ``gym.make`` sets it.
-        self.model, self.data, self.scene = load_scene(self.scene_dir)
+        self.model, self.data, self.scene = load_perceived_scene(self.scene_dir)
         self.frameskip = int(frameskip)
         self.horizon = None if horizon is None else int(horizon)  # None: TimeLimit ends episodes
         self.render_mode, self.camera = render_mode, camera
@@ -77,40 +89,31 @@ class SceneEnv(gym.Env):
 
         m = self.model
         name2id = mujoco.mj_name2id
-        self.robot = robot.Robot(m)
-        self._mocap, self._cup_body = self.robot.mocap, self.robot.cup
-        self._cup_geom, self._ee_site = self.robot.cup_geom, self.robot.ee_site
-        jids = [name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in robot.ROBOT_JOINTS]
+        self.agent = Agent(m)
+        self._mocap, self._cup_body = self.agent.mocap, self.agent.cup
+        self._ee_site = self.agent.ee_site
+        jids = [name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in Agent.ROBOT_JOINTS]
         self._robot_qpos = np.array([m.jnt_qposadr[j] for j in jids])
         self._robot_qvel = np.array([m.jnt_dofadr[j] for j in jids])
-        task_objects = [o for o in self.scene.objects if o.role.value != "clutter"]
-        self.task_objects = [o.name for o in task_objects]
+        objects = self.scene.objects  # every object alike, in name order (perception sorts them)
+        self.object_names = [o.name for o in objects]
         self._obj_bodies = np.array(
-            [name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in self.task_objects], dtype=int
+            [name2id(m, mujoco.mjtObj.mjOBJ_BODY, n) for n in self.object_names], dtype=int
         )
-        joint_names = [j.name for o in task_objects for j in o.joint_states]
+        joint_names = [j.name for o in objects for j in o.joint_states]
         self._obj_qpos = np.array(
             [m.jnt_qposadr[name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j)] for j in joint_names], dtype=int
         )
-        # Suction: geom -> object body with a suction weld, and that weld's id.
-        self._geom_to_eq = np.full(m.ngeom, -1, dtype=int)
-        self._eq_rel = {}
-        for name in self.robot.suction_objects:
-            eq = name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, robot.SUCTION_PREFIX + name)
-            body = name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
-            self._geom_to_eq[self.robot.subtree_geoms(body)] = eq
-            self._eq_rel[eq] = body
-        self._held_eq = -1
 
         sizes = {
             "robot_qpos": len(self._robot_qpos),
             "robot_qvel": len(self._robot_qvel),
             "ee_pos": 3,
             "ee_quat": 4,
-            "suction": 1,
             "object_pos": 3 * len(self._obj_bodies),
             "object_quat": 4 * len(self._obj_bodies),
             "object_joints": len(self._obj_qpos),
+            "suction": 1,
         }
         self.obs_layout: dict[str, slice] = {}
         start = 0
@@ -119,12 +122,15 @@ class SceneEnv(gym.Env):
             start += n
         self._obs = np.zeros(start)
         # Fast path: the scene compiled observation sensors (scene/sensors.py), read in one copy.
-        from anomalygen.scene.sensors import GROUPS, sensor_layout
+        from anomalygen.scene.sensors import GROUPS, sensor_items, sensor_layout
 
         layout = sensor_layout(m)
-        self._use_sensors = set(layout) == set(GROUPS) and all(
-            layout[g].stop - layout[g].start == sizes[g] for g in GROUPS
-        )
+        self._use_sensors = (
+            set(layout) == set(GROUPS)
+            and all(layout[g].stop - layout[g].start == sizes[g] for g in GROUPS)
+            and sensor_items(m, "object_pos") == self.object_names
+            and sensor_items(m, "object_joints") == joint_names
+        )  # scenes built before every object had sensors take the slow path
         if self._use_sensors:
             nsens = int(m.nsensordata)
             self.obs_layout = {**layout, "suction": slice(nsens, nsens + 1)}
@@ -133,7 +139,6 @@ class SceneEnv(gym.Env):
         self.observation_space = spaces.Box(-np.inf, np.inf, shape=(start,), dtype=np.float64)
         self.action_space = spaces.Box(-1.0, 1.0, shape=(7,), dtype=np.float32)
         self._cache_views()
-        self._action = np.zeros(7)
         self.t = 0
 
     # ------------------------------------------------------------------ gym API
@@ -149,37 +154,29 @@ class SceneEnv(gym.Env):
             )
             mj.mj_forward(m, d)
         # Start the mocap target at the cup's pose and switch on tracking (base held in place).
-        self.robot.enable_ee_tracking(d)
-        self._held_eq = -1
+        self.agent.set_control_mode(d, "ee_delta_pose")
         self.t = 0
-        return self._observe(), {"is_success": False}
+        return self._observe(), self._info(False)
 
     def step(self, action):
-        d, a = self.data, self._action
-        try:
-            raw = action.tolist()
-        except AttributeError:
-            raw = list(action)
-        a[:] = [v if -1.0 <= v <= 1.0 else (1.0 if v > 0 else -1.0) for v in raw]  # np.clip's values, cheaper
-        self.robot.move_target(d, a, dp=self.max_delta_pos, dr=self.max_delta_rot)
-        if a[6] > 0.0:
-            if self._held_eq < 0:
-                self._try_grab()
-        elif self._held_eq >= 0:
-            d.eq_active[self._held_eq] = 0
-            self._held_eq = -1
+        d = self.data
+        a = self.agent.apply_action(d, action, dp=self.max_delta_pos, dr=self.max_delta_rot)
         self._mj.mj_step(self.model, d, self.frameskip)
         self.t += 1
-        if self._use_sensors:  # inlined _observe fast path
+        if self._use_sensors:  # inlined _observe fast path; suction off releases, so only 'on' asks
             self._o_sens[:] = self._v_sens
-            self._obs[-1] = 1.0 if self._held_eq >= 0 else 0.0
+            self._obs[-1] = 0.0 if a[6] <= 0.0 or self.agent.held(d) is None else 1.0
             obs = self._obs.copy()
         else:
             obs = self._observe()
         reward = float(self.reward_fn(self)) if self.reward_fn is not None else 0.0
         success = bool(self.success_fn(self)) if self.success_fn is not None else False
         truncated = self.horizon is not None and self.t >= self.horizon
-        return obs, reward, success, truncated, {"is_success": success}
+        return obs, reward, success, truncated, self._info(success)
+
+    def _info(self, success: bool) -> dict:
+        """``is_success`` only from the caller's own check: without one the env cannot know it."""
+        return {"is_success": success} if self.success_fn is not None else {}
 
     def render(self):
         if self.render_mode != "rgb_array":
@@ -210,54 +207,26 @@ class SceneEnv(gym.Env):
         self._hi = np.zeros(3)
 
     def _observe(self) -> np.ndarray:
+        held = 0.0 if self.agent.held(self.data) is None else 1.0
         if self._use_sensors:
             self._o_sens[:] = self._v_sens
-            self._obs[-1] = 1.0 if self._held_eq >= 0 else 0.0
+            self._obs[-1] = held
             return self._obs.copy()
         o = self._o
         np.take(self._v_qpos, self._robot_qpos, out=o["robot_qpos"])
         np.take(self._v_qvel, self._robot_qvel, out=o["robot_qvel"])
         o["ee_pos"][:] = self._v_site
         o["ee_quat"][:] = self._v_xquat[self._cup_body]
-        o["suction"][0] = 1.0 if self._held_eq >= 0 else 0.0
+        o["suction"][0] = held
         np.take(self._v_xpos, self._obj_bodies, axis=0, out=self._o_obj_pos)
         np.take(self._v_xquat, self._obj_bodies, axis=0, out=self._o_obj_quat)
         np.take(self._v_qpos, self._obj_qpos, out=o["object_joints"])
         return self._obs.copy()
 
-    def _try_grab(self) -> bool:
-        """Weld the object whose geom touches the cup (if any) at the current relative pose."""
-        d = self.data
-        n = d.ncon
-        if n == 0:
-            return False
-        g1 = d.contact.geom1[:n]
-        g2 = d.contact.geom2[:n]
-        hit = np.flatnonzero((g1 == self._cup_geom) | (g2 == self._cup_geom))
-        for k in hit:
-            other = int(g2[k] if g1[k] == self._cup_geom else g1[k])
-            eq = int(self._geom_to_eq[other])
-            if eq < 0 or d.contact.dist[k] > robot.SUCTION_RANGE:
-                continue
-            body = self._eq_rel[eq]
-            relpos, relquat = robot.relative_pose(
-                d.xpos[self._cup_body], d.xquat[self._cup_body], d.xpos[body], d.xquat[body]
-            )
-            self.model.eq_data[eq, 0:3] = 0.0
-            self.model.eq_data[eq, 3:6] = relpos
-            self.model.eq_data[eq, 6:10] = relquat
-            self.model.eq_data[eq, 10] = 1.0
-            d.eq_active[eq] = 1
-            self._held_eq = eq
-            return True
-        return False
-
     @property
     def held(self) -> str | None:
         """Name of the object held by suction, if any."""
-        if self._held_eq < 0:
-            return None
-        return self._mj.mj_id2name(self.model, self._mj.mjtObj.mjOBJ_BODY, self._eq_rel[self._held_eq])
+        return self.agent.held(self.data)
 
     def graph(self):
         """The SceneGraph of the current state (for success predicates)."""

@@ -1,6 +1,6 @@
 """One chosen object as a placed instance, and where other things can go on it.
 
-A ``select.Chosen`` becomes a ``layout.Placed`` (its box, front and the sweep of open doors); a holder's
+An ``asset_choice.Chosen`` becomes a ``layout.Placed`` (its box, front and the sweep of open doors); a holder's
 top surface and biggest cavity are given in world coordinates, and a container's room says what lies
 flat in it. The margins every placement keeps from a support's edge are defined here too.
 """
@@ -12,9 +12,9 @@ import math
 import numpy as np
 
 from anomalygen.errors import ItemFailed
-from anomalygen.scene import furniture, layout, select
+from anomalygen.scene import asset_choice, furniture, layout
 from anomalygen.scene.layout import Placed
-from anomalygen.schema import CLOSURE_LABELS, SWINGING_CLOSURES, ObjectRole
+from anomalygen.schema import DOOR, DRAWER, ObjectRole, part_labels
 
 INWARD = 0.13  # m kept from a support's edge by things that are not the edge hazard
 HAZARD_NEAR_SIDE = 0.4  # m: the hazard's centre at most this far from the robot-facing edge (arm's reach)
@@ -30,12 +30,45 @@ def instance_name(catalogue: str, used: set[str]) -> str:
     return name
 
 
+def renumber_by_position(lay: layout.Layout, placed: dict[str, Placed],
+                         bindings: dict[str, str]) -> tuple[dict[str, Placed], dict[str, str]]:
+    """Number each category's instances by where they stand (x, then y, then z), not in the order the
+    builder chose them; returns the instances in name order and the bindings renamed.
+
+    Why: names are handed out as objects are chosen, the hazard first, so ``kitchen_knife_0`` beside a
+    near-miss ``kitchen_knife_1`` told the robot which knife was at fault, and the order of the objects
+    (in scene.json, the scene graph, the model's bodies and sensors) told it which was the support.
+    """
+    groups: dict[str, list[Placed]] = {}
+    for p in placed.values():
+        groups.setdefault(p.name.rsplit("_", 1)[0], []).append(p)
+    rename: dict[str, str] = {}
+    for base, members in groups.items():
+        members.sort(key=lambda p: tuple(np.round(p.world_center(), 4)))
+        rename.update({p.name: f"{base}_{i}" for i, p in enumerate(members)})
+
+    def new(ref: str | None) -> str | None:
+        if ref is None:
+            return None
+        name, colon, rest = ref.partition(":")
+        return rename.get(name, name) + colon + rest
+
+    for p in placed.values():
+        p.name, p.support, p.inside = rename[p.name], new(p.support), new(p.inside)
+    lay.preferred = {rename.get(k, k): v for k, v in lay.preferred.items()}
+    for check in lay.corrections:
+        kind, _, name = check.name.partition(":")
+        check.name = f"{kind}:{rename.get(name, name)}"
+    return {p.name: p for p in sorted(placed.values(), key=lambda p: p.name)}, {
+        var: rename.get(name, name) for var, name in bindings.items()}
+
+
 def _front(asset) -> np.ndarray | None:
     """Local direction the asset's doors/drawers open to (the catalogue convention is -y), or the
     side the asset declares it is worked from (a stove's control knobs)."""
     if getattr(asset, "front", None) is not None:
         return np.asarray(asset.front, float)
-    if any(j.label in CLOSURE_LABELS for j in asset.joints) or asset.cavities:
+    if any(part_labels.is_closure(j.label) for j in asset.joints) or asset.cavities:
         return np.array([0.0, -1.0])
     return None
 
@@ -50,7 +83,7 @@ def _sweep(asset, values: dict[str, float]) -> float:
             continue
         if j.type == "slide":
             out = max(out, abs(v - j.closed_value) + 0.02)
-        elif j.label in SWINGING_CLOSURES:
+        elif part_labels.swings(j.label):
             out = max(out, min(float(max(ext[0], ext[2] if abs(j.axis[2]) < 0.5 else ext[0])), 1.0))
     return out
 
@@ -65,10 +98,10 @@ def _swing(asset) -> float:
     width (the asset's width shared among its side-hinged doors), a door hinged at its foot its
     height; capped at ``SWING_MAX``."""
     ext = asset.aabb[1] - asset.aabb[0]
-    side = [j for j in asset.joints if j.type == "hinge" and j.label == "door" and abs(j.axis[2]) >= 0.5]
+    side = [j for j in asset.joints if j.type == "hinge" and j.label == DOOR and abs(j.axis[2]) >= 0.5]
     out = 0.0
     for j in asset.joints:
-        if j.label not in ("door", "drawer"):
+        if j.label not in (DOOR, DRAWER):
             continue
         if j.type == "slide":
             out = max(out, abs(j.range[1] - j.range[0]) + 0.02)
@@ -79,7 +112,7 @@ def _swing(asset) -> float:
     return min(out, SWING_MAX)
 
 
-def placed_instance(chosen: select.Chosen) -> Placed:
+def placed_instance(chosen: asset_choice.Chosen) -> Placed:
     lo, hi = (np.asarray(v, float) for v in chosen.asset.aabb)
     p = Placed(
         name=chosen.name,

@@ -1,7 +1,10 @@
 """The builder's part of the judgement mix (``mix.py`` chooses what; this places and checks it).
 
-Near-misses go well inside a table top, a second hazard on the floor with its bin; a hazard-free
-scene puts the task's object where it is no hazard and, once settled, checks that it really is none.
+Near-misses go on a table top, well clear of its edges or on the borderline of the edge rule; a state
+near-miss stands on a table with its part safe (a switch off, a lid ajar two degrees); a second
+hazard goes on the floor with its bin. Each carries its intent (``referee.truth.Intent``) to the truth
+manifest. A hazard-free scene puts the task's object where it is no hazard and, once settled, checks
+that it really is none.
 """
 
 from __future__ import annotations
@@ -9,42 +12,90 @@ from __future__ import annotations
 from anomalygen.errors import ItemFailed
 from anomalygen.knowledge import load_kb
 from anomalygen.knowledge.predicates import ROOM_FIXTURES
-from anomalygen.scene import mix, select
+from anomalygen.referee.truth import Intent
+from anomalygen.scene import asset_choice, mix
+from anomalygen.scene.casting import CONTAINER_REDRAWS, Selection
 from anomalygen.scene.instances import (
     HAZARD_NEAR_SIDE,
     INWARD,
     cavity_world,
+    container_room,
     instance_name,
     placed_instance,
     surface_of,
 )
 from anomalygen.scene.layout import Layout, Placed
-from anomalygen.scene.selection import Selection
-from anomalygen.schema import ENCLOSING_LABELS, ObjectRole, ValidationCheck, ValidationReport
+from anomalygen.schema import ObjectRole, ValidationCheck, ValidationReport, part_labels
 
 
 def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed], surfaces: list[Placed],
                           items: mix.JudgementItems) -> None:
-    """Near-misses well inside a table top (any that find no room are left out); the second hazard
-    on the floor, with its bin when the scene has none."""
+    """Near-misses on a table top (any that find no room are left out): well clear of its edges, or
+    the chosen distance from the edge facing the robot; the state near-miss likewise, its part set safe;
+    the second hazard on the floor, with its bin when the scene has none."""
     rng = items.rng
-    for cat in items.near_misses if surfaces else []:
-        asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng,
-                                  real=sel.real_assets)
-        p = placed_instance(select.Chosen(instance_name(cat, sel.used), cat, ObjectRole.CLUTTER, asset))
+    for pick in items.near_misses if surfaces else []:
+        p = _chosen(sel, pick.category, rng)
         holder = surfaces[int(rng.integers(len(surfaces)))]
-        try:
-            lay.place_on_surface(p, holder, surface_of(holder), inward=INWARD)
-        except ItemFailed:
+        if not _on_surface_clear_of_edges(lay, p, holder, pick.edge_gap):
             continue
+        if pick.edge_gap is not None:
+            rule = f"{pick.edge_gap:.2f} m from the edge, just {pick.kind.split('_')[1]} {pick.hazard_class}'s rule"
+            p.intent = Intent("hazard" if pick.kind == "just_inside" else "borderline", pick.hazard_class, rule)
         placed[p.name] = p
+    if items.state is not None and surfaces:
+        _place_state_near_miss(sel, lay, placed, surfaces, items.state, rng)
     for cat, role, face in ((items.second_hazard, ObjectRole.HAZARD, False), (items.bin, ObjectRole.CONTAINER, True)):
         if cat is None:
             continue
-        asset = select.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng, real=sel.real_assets)
-        p = placed_instance(select.Chosen(instance_name(cat, sel.used), cat, role, asset))
+        asset = asset_choice.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng,
+                                        real=sel.real_assets)
+        p = placed_instance(asset_choice.Chosen(instance_name(cat, sel.used), cat, role, asset))
         lay.place_on_floor(p, relevant=True, face=face)
+        if role == ObjectRole.HAZARD:
+            p.intent = Intent("hazard", mix.SECOND_HAZARD_CLASS, "the judgement mix's second hazard")
         placed[p.name] = p
+
+
+def _on_surface_clear_of_edges(lay: Layout, p: Placed, holder: Placed, edge_gap: float | None = None) -> bool:
+    """Rest ``p`` on ``holder``'s top ``FAR_M`` from its edges (the robot-facing one ``edge_gap`` away
+    when given), else ``NEAR_FAR_M`` when the top is too crowded for that; False when it finds no room."""
+    for inward in (mix.FAR_M, mix.NEAR_FAR_M):
+        try:
+            lay.place_on_surface(p, holder, surface_of(holder), inward=inward, edge_gap=edge_gap)
+            return True
+        except ItemFailed:
+            continue
+    return False
+
+
+def _chosen(sel: Selection, category: str, rng) -> Placed:
+    asset = asset_choice.pick_asset(category, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng,
+                                    real=sel.real_assets)
+    return placed_instance(asset_choice.Chosen(instance_name(category, sel.used), category, ObjectRole.CLUTTER, asset))
+
+
+def _place_state_near_miss(sel: Selection, lay: Layout, placed: dict[str, Placed], surfaces: list[Placed],
+                           pick: mix.StatePick, rng) -> None:
+    """An object whose class is about a part's state, on a table top with that part safe: its doors,
+    lids and drawers ``AJAR_RAD`` (``AJAR_M``) open, its knobs and switches exactly off."""
+    p = _chosen(sel, pick.category, rng)
+    wanted = part_labels.alternatives(pick.labels)
+    parts = [j for j in p.asset.joints if part_labels.canonical(j.label) in wanted or "*" in wanted]
+    if not parts:
+        sel.used.discard(p.name)
+        return
+    for j in parts:
+        step = (mix.AJAR_M if j.type == "slide" else mix.AJAR_RAD) if pick.ajar else 0.0
+        far = j.range[1] if abs(j.range[1] - j.closed_value) >= abs(j.range[0] - j.closed_value) else j.range[0]
+        p.joint_values[j.name] = float(j.closed_value + step * (1 if far >= j.closed_value else -1))
+    holder = surfaces[int(rng.integers(len(surfaces)))]
+    if not _on_surface_clear_of_edges(lay, p, holder):
+        sel.used.discard(p.name)
+        return
+    state = "ajar" if pick.ajar else "off"
+    p.intent = Intent("state", pick.hazard_class, f"its {'/'.join(sorted({part_labels.canonical(j.label) for j in parts}))} {state}")
+    placed[p.name] = p
 
 
 def room_fixtures(kb, lay: Layout) -> list[Placed]:
@@ -55,8 +106,10 @@ def room_fixtures(kb, lay: Layout) -> list[Placed]:
 
 def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None) -> None:
     """The task's object where it is no hazard: shut inside its container, else well inside the
-    surface, else on the floor beside a piece of furniture, out of the walkway."""
-    hazard, container = sel.hazard, sel.container
+    surface, else on the floor beside a piece of furniture, out of the walkway. For a class whose
+    danger is a child reaching it, only a container that latches keeps it safe (a toddler opens a
+    cupboard or a box): such a container is added when the task's own does not latch."""
+    hazard, container = sel.hazard, child_safe_container(sel) or sel.container
     hp = placed[hazard.name] = placed_instance(hazard)
     if container is not None and container is not hazard and container.asset.cavities:
         holder = placed.get(container.name)
@@ -66,7 +119,7 @@ def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], 
         lo, hi, _ = cavity_world(holder)
         lay.place_in_cavity(hp, holder, (lo, hi))
         for joint in container.asset.joints:  # shut every lid, door and drawer of the container
-            if select.kb_label(joint.label) in ENCLOSING_LABELS:
+            if part_labels.encloses(joint.label):
                 holder.joint_values[joint.name] = float(joint.closed_value)
         holder.sweep = 0.0
         return
@@ -76,9 +129,55 @@ def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], 
     lay.place_beside(hp, room_fixtures(sel.kb, lay))
 
 
+def child_safe_container(sel: Selection) -> asset_choice.Chosen | None:
+    """For a class whose danger is a child reaching the object, a container that latches and that the
+    object fits: the task's own when it latches, else one of the knowledge base's ``lockable`` kinds.
+    None for any other class, or when no latching kind fits."""
+    if sel.hc is None or not sel.kb.guards_a_child(sel.hc) or sel.hazard.fixed:  # a window the child leans out of is shut, not stored
+        return None
+    if sel.container is not None and sel.kb.latches(sel.container.catalogue):
+        return sel.container
+    return _latching_container(sel, sel.hazard)
+
+
+def offer_child_safe_container(sel: Selection, lay: Layout, placed: dict[str, Placed]) -> None:
+    """Stand a latching container on the floor, facing the robot, in a scene whose hazard endangers a
+    child and whose task names no container that latches (a toddler opens a box or a cupboard): an
+    extra object, the task's own container stays. Left out, with the scene as it was, when none fits."""
+    extra = child_safe_container(sel)
+    if extra is None or extra is sel.container or extra.name in placed:
+        return
+    p = placed_instance(extra)
+    try:
+        lay.place_on_floor(p, relevant=True, face=True)
+    except ItemFailed:
+        sel.forget(extra)
+        return
+    placed[extra.name] = p
+
+
+def _latching_container(sel: Selection, hazard) -> asset_choice.Chosen | None:
+    """A container of a kind that latches (the knowledge base's ``lockable`` objects) and that the
+    class stores this object in (``containers_for``: what the robot's planner will look for), drawn
+    again in other sizes until the object fits."""
+    for name in sel.kb.latching_containers_for(sel.hc, hazard.catalogue):
+        chosen_before = [id(c) for c in sel.by_catalogue.values()]
+        for _ in range(CONTAINER_REDRAWS + 1):
+            try:
+                cand = sel.choose(name, ObjectRole.CONTAINER)
+            except (ItemFailed, KeyError):
+                break
+            if cand.asset.cavities and hazard.size <= container_room(cand.asset):
+                return cand
+            if id(cand) in chosen_before:  # the scene's own safe (the task's target) keeps its size
+                break
+            sel.forget(cand)
+    return None
+
+
 def check_hazard_free(report: ValidationReport, graph, hazard_class: str) -> ValidationReport:
     """A hazard-free variant must not show the task's hazard anywhere once settled."""
-    from anomalygen.scene.truth import class_matches
+    from anomalygen.referee.truth import class_matches
 
     still = sorted(obj for cls, obj, _ in class_matches(graph, load_kb()) if cls == hazard_class)
     check = ValidationCheck(name="hazard_free", passed=not still,

@@ -1,12 +1,13 @@
 """Placement: proposals in a unit cube, then a solver for support, non-overlap and reach.
 
 As in the paper, task-relevant objects are proposed at (x, y, z) inside the cube (0..1)^3 and
-unrelated clutter outside it. The cube is mapped onto the floor area in front of the robot
+unrelated clutter outside it. The cube is mapped onto the floor area in front of the robot's home
 (``REGION_ORIGIN`` .. + ``REGION_SIZE``). The solver then snaps each proposal onto its support (the
 floor, a support's top surface, a container's cavity, an edge band for ``*_edge`` placements),
 rejects proposals whose footprints overlap already placed objects (oriented boxes in the plane plus a
-height test), and moves the robot base so the hazard is within the arm's reach. MuJoCo contacts
-re-check the result after compiling (build.py), so this solver only has to be conservative.
+height test), checks that some free base pose has the hazard within the arm's reach, and starts the
+robot at its dock, the same pose in every scene. MuJoCo contacts re-check the result after compiling (build.py), so
+this solver only has to be conservative.
 """
 
 from __future__ import annotations
@@ -17,8 +18,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from anomalygen.errors import ItemFailed
+from anomalygen.robot.agent import Agent
 from anomalygen.scene.furniture import Support
-from anomalygen.scene.robot import BASE_RADIUS
 from anomalygen.schema import ObjectRole, ValidationCheck
 
 REGION_ORIGIN = np.array([0.8, -0.6, 0.0])  # world position of the cube corner (0, 0, 0)
@@ -29,8 +30,12 @@ DROP_GAP = 0.002  # objects start this far above their support and settle onto i
 EDGE_BAND = (0.015, 0.07)  # metres from the edge for *_edge placements (KB threshold: 0.12)
 WALKWAY_CLEAR = 0.42  # > the KB's 0.3 m walkway clearance, with margin
 TUCK_GAP = (0.03, 0.12)  # metres from a fixture's side for an item tucked out of the walkway (KB: 0.3)
-ARM_REACH = 0.95  # horizontal reach from the base centre to an object, with the arm's offset
 TRIES = 60
+# Clearance kept round the robot at its start pose (its shape is the agent's: BASE_RADIUS, HOME_ARM_BOXES)
+BASE_CLEAR_TOP = 0.35  # m: a box whose bottom is lower than this (the base's 0.30 m top, plus 5 cm) can hit the base
+BASE_CLEAR_SIDE = 0.08  # m kept between such a box and the base disc
+ARM_CLEAR = 0.03  # m kept between any box and the arm's boxes at the home pose
+DOCK_YAW = math.pi / 2  # rad: the docked robot faces along the room's open front (+y), not into the room
 
 
 @dataclass
@@ -56,6 +61,7 @@ class Placed:
     # (a counter 2 cm in front of a cabinet's doors keeps them shut); unlike ``sweep`` the base may
     # stand in it, and it does not push the base back from the front
     swing: float = 0.0
+    intent: object = None  # what the judgement mix meant it to be (a referee.truth.Intent), for truth.json
 
     def world_half(self) -> np.ndarray:
         c, s = abs(math.cos(self.yaw)), abs(math.sin(self.yaw))
@@ -120,7 +126,7 @@ class Layout:
         for _ in range(100):
             p = ROOM_CENTER + self.rng.uniform(-1, 1, size=2) * ROOM_HALF
             u = (p - REGION_ORIGIN[:2]) / REGION_SIZE[:2]
-            if not np.all((u >= 0) & (u <= 1)) and np.linalg.norm(p - self.base[:2]) > BASE_RADIUS + 0.4:
+            if not np.all((u >= 0) & (u <= 1)) and np.linalg.norm(p - self.base[:2]) > Agent.BASE_RADIUS + 0.4:
                 return p
         return ROOM_CENTER + np.array([1.2, 0.0])
 
@@ -141,25 +147,18 @@ class Layout:
 
     def _hits_base(self, box) -> bool:
         """Does a world AABB intrude on the robot: its base disc, or the arm's box at the home pose?"""
-        if box[0][2] < 0.35:
+        if box[0][2] < BASE_CLEAR_TOP:
             closest = np.clip(self.base[:2], box[0][:2], box[1][:2])
-            if float(np.linalg.norm(closest - self.base[:2])) < BASE_RADIUS + 0.08:
+            if float(np.linalg.norm(closest - self.base[:2])) < Agent.BASE_RADIUS + BASE_CLEAR_SIDE:
                 return True
-        return any(overlaps(box, arm, margin=0.03) for arm in self.arm_boxes())
+        return any(overlaps(box, arm, margin=ARM_CLEAR) for arm in self.arm_boxes())
 
     def arm_boxes(self) -> list[tuple[np.ndarray, np.ndarray]]:
-        """World AABBs of the arm at its home pose: the column above the base and the forearm with
-        the cup, which hangs 0.3 m forward with its lowest point at ~1.01 m (above counters)."""
+        """World AABBs of the arm at its home pose (``Agent.HOME_ARM_BOXES``, turned with the base)."""
         c, s = math.cos(self.base[2]), math.sin(self.base[2])
         out = []
-        for (x0, x1), (z0, z1) in (((-0.2, 0.12), (0.3, 1.35)), ((0.12, 0.42), (0.98, 1.35))):
-            xy = np.array(
-                [
-                    [self.base[0] + c * x - s * y, self.base[1] + s * x + c * y]
-                    for x in (x0, x1)
-                    for y in (-0.15, 0.15)
-                ]
-            )
+        for (x0, x1), (y0, y1), (z0, z1) in Agent.HOME_ARM_BOXES:
+            xy = np.array([[self.base[0] + c * x - s * y, self.base[1] + s * x + c * y] for x in (x0, x1) for y in (y0, y1)])
             out.append((np.r_[xy.min(0), z0], np.r_[xy.max(0), z1]))
         return out
 
@@ -250,11 +249,13 @@ class Layout:
         label: str | None = None,
         near_side: float | None = None,
         yaw: float | None = None,
+        edge_gap: float | None = None,
     ) -> None:
         """Rest ``obj`` on a rectangle (world lo_xy, hi_xy, top z) of ``holder``.
 
         ``edge``: the footprint ends 1.5-7 cm from the surface edge that faces the robot (the
-        knowledge base counts <= 12 cm as "near the edge"). ``inward``: keep this far from all edges
+        knowledge base counts <= 12 cm as "near the edge"); ``edge_gap``: exactly this far from that
+        edge instead (a near-miss just either side of the rule). ``inward``: keep this far from all edges
         (less when the object is too big for that). ``near_side``: the object's centre at most this
         far from the robot-facing edge, so the arm reaches it from beside the support. ``yaw``: stand
         it at this yaw (an appliance whose door faces out over the edge) instead of a random one.
@@ -280,9 +281,9 @@ class Layout:
             room = np.where(slack - inward >= 0, slack - inward, 0.0)
             center = (lo_xy + hi_xy) / 2 + self.rng.uniform(-1, 1, size=2) * room
             bound = hi_xy[axis] if sign > 0 else lo_xy[axis]
-            if edge:
+            if edge or edge_gap is not None:
                 # The robot-facing edge of the surface: the side whose outward normal points to the base.
-                gap = self.rng.uniform(*EDGE_BAND)
+                gap = edge_gap if edge_gap is not None else self.rng.uniform(*EDGE_BAND)
                 center[axis] = bound - sign * (half[axis] + gap)
             elif near_side is not None:
                 depth = abs(center[axis] - bound)
@@ -322,36 +323,37 @@ class Layout:
     def fit_base(self, focus: Placed, holder: Placed | None = None) -> None:
         """Move the base so ``focus`` is within reach, facing it, clear of every footprint.
 
-        Loose objects: the base centre within 0.35-0.85 m (horizontally) of the object's centre.
-        Furniture: 0.45-0.9 m from its footprint (doors swept open included), so the arm's home
-        pose clears it and the arm still reaches the door edge or handle. An object inside
-        furniture (``holder``): the furniture rule, and the object within 1.05 m. Among valid poses the one
-        closest to the room's robot home (the origin) wins, so scenes look alike.
+        The distances are the agent's reach envelope (``Agent.REACH``, robot/reach.py): loose objects
+        within its ``object_band`` of the base centre (horizontally); furniture with its footprint
+        (doors swept open included) within ``furniture_band``, so the arm's home pose clears it and
+        the arm still reaches the door edge or handle; an object inside furniture (``holder``): the
+        furniture rule, and the object within ``inside_max``. Among valid poses the one closest to the
+        room's robot home (the origin) wins, so scenes look alike.
         """
         target = focus.world_center()
-        if target[2] > 1.45 and not focus.fixed:
+        if target[2] > Agent.REACH.max_height and not focus.fixed:
             raise ItemFailed(f"the robot cannot reach {focus.name} at {target[2]:.2f} m")
         inner = None
         if holder is not None and holder.fixed:
             inner, focus = target, holder
         box = focus.footprint()
         best, best_cost = None, np.inf
-        lo = ROOM_CENTER - ROOM_HALF + BASE_RADIUS
-        hi = ROOM_CENTER + ROOM_HALF - BASE_RADIUS
+        lo = ROOM_CENTER - ROOM_HALF + Agent.BASE_RADIUS
+        hi = ROOM_CENTER + ROOM_HALF - Agent.BASE_RADIUS
         for x in np.arange(lo[0], hi[0] + 1e-9, 0.1):
             for y in np.arange(lo[1], hi[1] + 1e-9, 0.1):
                 xy = np.array([x, y])
                 if focus.fixed:
                     closest = np.clip(xy, box[0][:2], box[1][:2])
                     gap = float(np.linalg.norm(closest - xy))
-                    if not 0.45 <= gap <= 0.9:
+                    if not Agent.REACH.furniture_band[0] <= gap <= Agent.REACH.furniture_band[1]:
                         continue
-                    if inner is not None and np.linalg.norm(inner[:2] - xy) > 1.05:
+                    if inner is not None and np.linalg.norm(inner[:2] - xy) > Agent.REACH.inside_max:
                         continue
                     aim = closest if inner is None else inner[:2]
                 else:
                     d = float(np.linalg.norm(target[:2] - xy))
-                    if not 0.35 <= d <= 0.85:
+                    if not Agent.REACH.object_band[0] <= d <= Agent.REACH.object_band[1]:
                         continue
                     aim = target[:2]
                 cost = float(np.linalg.norm(xy))
@@ -365,13 +367,31 @@ class Layout:
         self.base = np.array([xy[0], xy[1], math.atan2(aim[1] - xy[1], aim[0] - xy[0])])
 
     def _base_ok(self, xy: np.ndarray, aim: np.ndarray) -> bool:
+        return self._pose_free(xy, math.atan2(aim[1] - xy[1], aim[0] - xy[0]))
+
+    def _pose_free(self, xy: np.ndarray, yaw: float, *, swing: bool = False) -> bool:
+        """Would the robot at (xy, yaw) clear every placed footprint (``swing``: and the room kept
+        in front of shut doors and drawers)?"""
         old = self.base.copy()
-        self.base = np.array([xy[0], xy[1], math.atan2(aim[1] - xy[1], aim[0] - xy[0])])
+        self.base = np.array([xy[0], xy[1], yaw])
         try:
-            return not any(self._hits_base(o.footprint()) for o in self.items)
+            return not any(self._hits_base(o.footprint(swing=swing)) for o in self.items)
         finally:
             self.base = old
 
+    def dock_pose(self) -> np.ndarray:
+        """Where the robot starts (x, y, yaw): its dock at the room's home (the origin), the same in
+        every scene, turned along the room's open front (``DOCK_YAW``) rather than into it.
+
+        Why: the base used to start 0.35-0.85 m from the hazard and facing it, which told the robot
+        what to look at. The dock aims at no object, so it cannot depend on which one is the hazard;
+        the skills move the base to each target themselves, choosing among the poses around it the
+        one nearest the dock, as the old start pose was the one nearest it. Every object was placed
+        clear of the robot standing there facing into the room (yaw 0), which is used when the arm
+        turned along the front would touch something."""
+        if self._pose_free(np.zeros(2), DOCK_YAW, swing=True):
+            return np.array([0.0, 0.0, DOCK_YAW])
+        return np.zeros(3)
 
 def _h_gap(a, b) -> float:
     gap = np.maximum(0.0, np.maximum(a[0][:2] - b[1][:2], b[0][:2] - a[1][:2]))

@@ -20,8 +20,8 @@ from pydantic import BaseModel, ConfigDict, Field
 from anomalygen.knowledge import KnowledgeBase
 from anomalygen.knowledge.grounding import NameGrounder, words_of
 from anomalygen.llm.schema_tools import reply_token_budget
+from anomalygen.scene.casting import is_dressing
 from anomalygen.scene.hints import SceneHints
-from anomalygen.scene.selection import is_dressing
 from anomalygen.schema import TaskProposal
 
 MAX_AUXILIARIES = 3

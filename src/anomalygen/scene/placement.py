@@ -1,7 +1,8 @@
 """Where every chosen object stands: supports, furniture, the hazard, loose task objects, clutter.
 
 ``place`` lays out a ``selection.Selection`` with ``layout.Layout`` (the hazard where its scenario says,
-or safely for a hazard-free scene) and moves the robot base within reach of the hazard.
+or safely for a hazard-free scene), checks that the robot can reach the hazard from some free base
+pose, and then starts the robot at its dock, which does not depend on the hazard (``build.start``).
 """
 
 from __future__ import annotations
@@ -11,7 +12,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from anomalygen.errors import ItemFailed
-from anomalygen.scene import furniture, mix, select
+from anomalygen.scene import asset_choice, furniture, mix
+from anomalygen.scene.casting import Selection, clutter_names
 from anomalygen.scene.instances import (
     HAZARD_NEAR_SIDE,
     INWARD,
@@ -21,9 +23,13 @@ from anomalygen.scene.instances import (
     placed_support,
     surface_of,
 )
-from anomalygen.scene.judgement import place_hazard_safely, place_judgement_items, room_fixtures
+from anomalygen.scene.judgement import (
+    offer_child_safe_container,
+    place_hazard_safely,
+    place_judgement_items,
+    room_fixtures,
+)
 from anomalygen.scene.layout import Layout, Placed, face_robot_yaw
-from anomalygen.scene.selection import Selection, clutter_names
 from anomalygen.schema import ObjectRole
 
 if TYPE_CHECKING:
@@ -92,6 +98,9 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
         p = placed[hazard.name] = placed_instance(hazard)
         lay.place_on_floor(p, relevant=True, face=True)
 
+    if not sel.hazard_free:
+        offer_child_safe_container(sel, lay, placed)
+
     if hazard.name not in placed:
         if sel.hazard_free:
             place_hazard_safely(sel, lay, placed, support)
@@ -118,9 +127,9 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
     if side is not None:
         for cat in clutter:
             want = sel.hints.size_for(cat) if sel.hints is not None else None
-            asset = select.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng,
+            asset = asset_choice.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng,
                                       size=want, real=sel.real_assets)
-            ch = select.Chosen(instance_name(cat, used), cat, ObjectRole.CLUTTER, asset)
+            ch = asset_choice.Chosen(instance_name(cat, used), cat, ObjectRole.CLUTTER, asset)
             p = placed_instance(ch)
             try:
                 lay.place_on_surface(p, side, surface_of(side), inward=INWARD)
@@ -143,6 +152,11 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
             raise
         _floor_the_holder(lay, holder, focus)  # a deep counter put the appliance out of reach
         lay.fit_base(focus, holder=holder)
+    # fit_base proved the hazard reachable from a free base pose; the robot starts at its dock, a
+    # pose that does not depend on which object is the hazard, unless the settings ask for the
+    # reach pose (the answer key as a start: skill tests and ablations only)
+    if settings.build.start == "dock":
+        lay.base = lay.dock_pose()
     return lay, placed, support
 
 

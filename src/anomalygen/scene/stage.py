@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from anomalygen.runfolder import RunFolder, atomic_write_bytes, try_read_model, write_model
-from anomalygen.runner import StageContext, StageSummary, run_items
+from anomalygen.runner import StageContext, StageSummary, check_only, config_section, run_items
 from anomalygen.schema import Engine, SceneSpec, TaskProposal
 
 if TYPE_CHECKING:
@@ -69,6 +69,7 @@ def run_stage(
     run: RunFolder, settings, *, force: bool = False, only: list[str] | None = None
 ) -> StageSummary:
     tasks = run.load_tasks()
+    check_only(only, [t.id for t in tasks])
     if only:
         wanted = set(only)
         tasks = [t for t in tasks if t.id in wanted]
@@ -82,6 +83,7 @@ def run_stage(
         is_done=lambda task_id: scene_ok(run.scene_dir(task_id)),
         force=force,
         description="build scenes",
+        config=config_section(settings, "build", llm=settings.build.engine == Engine.LLM),
     )
     try:
         write_contact_sheet(run, seed=settings.seed)
@@ -136,6 +138,8 @@ def revalidate_run(run: RunFolder, settings: Settings | None = None) -> dict[str
             continue
         model, data, spec = load_scene(folder)
         graph = scene_graph(model, data, spec)
-        report = validate(model, data, spec, graph, kb.hazard_classes.get(task.hazard_class))
+        # a hazard-free scene (no bindings) has no class preconditions to hold, as when it was built
+        hc = kb.hazard_classes.get(task.hazard_class) if spec.bindings else None
+        report = validate(model, data, spec, graph, hc)
         out[task.id] = None if report.ok else report.reason
     return out

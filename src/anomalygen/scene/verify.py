@@ -1,7 +1,7 @@
 """Optional VLM check of a built scene, as in the paper: a render plus the task, answered yes/no.
 
 Runs only when ``settings.llm.vision`` is set (an endpoint that takes images); the knowledge-based
-checks of select.py and validate.py always run. The reply is untrusted: it must validate as
+checks of asset_choice.py and validate.py always run. The reply is untrusted: it must validate as
 ``SceneVerdict`` (the LLM client repairs it with the error), and a rejection or an LLM failure makes
 the attempt fail with a one-line reason, which the build's repair loop then handles.
 """

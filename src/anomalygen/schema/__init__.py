@@ -3,8 +3,9 @@
 Every artefact is a file in the run folder, so each class is strict (unknown fields are errors, not
 silently dropped) and carries a ``schema_version`` so old runs can be detected rather than misread.
 Stages depend on these classes, never on each other's internals. One module per stage owns its
-artefacts (``tasks``, ``scenes``, ``detection``, ``skills``, ``run``) over the shared ``base`` and
-``vocabulary``; import every name from ``anomalygen.schema``.
+artefacts (``tasks``, ``scenes``, ``detection``, ``skills``, ``verdicts``, ``run``) over the shared
+``base`` and ``vocabulary``; import every name from ``anomalygen.schema``. ``part_labels`` is the one
+table of joint labels (what shuts, encloses, switches) that every stage decides by.
 """
 
 from __future__ import annotations
@@ -24,6 +25,29 @@ from anomalygen.schema.detection import (
     Detection,
     Hypothesis,
     Judgement,
+    PerceptionNoise,
+)
+from anomalygen.schema.part_labels import (
+    BUTTON,
+    CLOSED_TOL,
+    CLOSURE_LABELS,
+    DIAL,
+    DOOR,
+    DRAWER,
+    ENCLOSING_LABELS,
+    FAUCET,
+    FLAP,
+    KNOB,
+    LID,
+    LID_LABELS,
+    SASH,
+    SWINGING_CLOSURES,
+    SWITCH,
+    SWITCH_LABELS,
+    TAP,
+    WINDOW,
+    PartKind,
+    PartLabel,
 )
 from anomalygen.schema.run import (
     ItemError,
@@ -33,22 +57,21 @@ from anomalygen.schema.run import (
 )
 from anomalygen.schema.scenes import (
     CHILD_REACH,
-    CLOSED_TOL,
-    CLOSURE_LABELS,
-    ENCLOSING_LABELS,
-    SWINGING_CLOSURES,
+    LATCHING_PROPERTY,
     AssetRef,
     GraphObject,
     HazardManifest,
     JointState,
     ManifestHazard,
     NearMiss,
+    PlacedCavity,
     PlacedObject,
     Relation,
     SceneGraph,
     SceneSpec,
     ValidationCheck,
     ValidationReport,
+    within_child_reach,
 )
 from anomalygen.schema.skills import (
     FixOutcome,
@@ -69,6 +92,7 @@ from anomalygen.schema.tasks import (
     Scenario,
     TaskProposal,
 )
+from anomalygen.schema.verdicts import HazardVerdict, Verdict, VerdictStatus
 from anomalygen.schema.vocabulary import (
     AssetSource,
     BrainstormMode,
@@ -97,6 +121,7 @@ ARTEFACTS: dict[str, type[BaseModel]] = {
         RewardSpec,
         SuccessSpec,
         SkillResult,
+        Verdict,
         RunManifest,
         ItemError,
     )
@@ -125,12 +150,31 @@ __all__ = [
     "GroundingMatch",
     "TaskProposal",
     "AssetRef",
+    "PartKind",
+    "PartLabel",
     "CLOSURE_LABELS",
     "ENCLOSING_LABELS",
     "SWINGING_CLOSURES",
+    "LID_LABELS",
+    "SWITCH_LABELS",
     "CLOSED_TOL",
+    "DOOR",
+    "DRAWER",
+    "LID",
+    "FLAP",
+    "WINDOW",
+    "SASH",
+    "KNOB",
+    "DIAL",
+    "SWITCH",
+    "BUTTON",
+    "TAP",
+    "FAUCET",
     "CHILD_REACH",
+    "LATCHING_PROPERTY",
+    "within_child_reach",
     "JointState",
+    "PlacedCavity",
     "PlacedObject",
     "ValidationCheck",
     "ValidationReport",
@@ -144,6 +188,7 @@ __all__ = [
     "Hypothesis",
     "Judgement",
     "Detection",
+    "PerceptionNoise",
     "RewardTerm",
     "RewardSpec",
     "SuccessSpec",
@@ -153,6 +198,9 @@ __all__ = [
     "HazardOutcome",
     "FixOutcome",
     "SkillResult",
+    "HazardVerdict",
+    "Verdict",
+    "VerdictStatus",
     "StageRecord",
     "LLMUsage",
     "RunManifest",

@@ -1,8 +1,7 @@
 """Stage 2 (build): the scene, its hidden answer key (truth.json) and the scene graph detection sees.
 
-The closure concepts (which joint labels shut something, when a joint counts as closed, how high a
-child reaches) are defined once here, for the builder, the scene graph, the predicates, the planners
-and the skills.
+What each joint label means (closure, enclosing, switch) and when a joint counts as closed or off
+is the table in ``part_labels.py``; ``JointState`` asks it. How high a child reaches is defined here.
 """
 
 from __future__ import annotations
@@ -11,7 +10,9 @@ from typing import Any, Literal
 
 from pydantic import Field
 
+import anomalygen.schema.part_labels as part_labels
 from anomalygen.schema.base import Artefact, Quat, Strict, Vec3
+from anomalygen.schema.part_labels import CLOSED_TOL
 from anomalygen.schema.vocabulary import AssetSource, ObjectRole, PredicateCall
 
 
@@ -28,13 +29,17 @@ class AssetRef(Artefact):
     licence: str | None = Field(None, description="SPDX licence of a packaged model's files")
 
 
-# One definition of the closure concepts, shared by the scene builder, the scene graph, the
-# predicates, the planners and the skills.
-CLOSURE_LABELS = ("door", "drawer", "lid", "window", "sash")  # joint labels of parts that shut something
-ENCLOSING_LABELS = ("door", "drawer", "lid")  # closures behind which an object is out of reach
-SWINGING_CLOSURES = ("door", "lid", "window", "sash")  # closures on a hinge: they sweep out when open
-CLOSED_TOL = 0.05  # open fraction at or below which a joint counts as closed (``joint_closed``'s default)
 CHILD_REACH = 1.0  # m: the highest a small child reaches (``child_reachable``, the detectors' checks)
+# Property of a container whose shut door or lid latches (a safe's lock, a medicine cabinet's catch). The
+# simulator models no latch mechanism, so the knowledge base declares it per object; only a shut
+# latching container keeps a child out of something low (a plain cupboard door a toddler opens).
+LATCHING_PROPERTY = "lockable"
+
+
+def within_child_reach(bottom_m: float, shut_in_latched: bool) -> bool:
+    """A small child can get at an object whose bottom is at most ``CHILD_REACH`` up, unless it is shut
+    inside a closed latching container. One rule for the scene graph and every prediction of it."""
+    return bottom_m <= CHILD_REACH and not shut_in_latched
 
 
 class JointState(Artefact):
@@ -59,12 +64,37 @@ class JointState(Artefact):
 
     @property
     def encloses(self) -> bool:
-        """A door, drawer or lid: shut, what is behind it is out of reach."""
-        return any(lbl in self.label for lbl in ENCLOSING_LABELS)
+        """A door, drawer, lid or flap: shut, what is behind it is out of reach."""
+        return part_labels.encloses(self.label)
+
+    @property
+    def is_switch(self) -> bool:
+        """An on/off control: its closed value is off."""
+        return part_labels.is_switch(self.label)
 
     def is_closed(self, tol: float = CLOSED_TOL, value: float | None = None) -> bool:
         """At most ``tol`` of its travel away from closed (at ``value`` if given, else its own)."""
         return self.open_fraction_at(self.value if value is None else value) <= tol
+
+    def is_off(self, tol: float = CLOSED_TOL, value: float | None = None) -> bool:
+        """A switch's word for closed: at most ``tol`` of its travel from off, its closed value."""
+        return self.is_closed(tol, value)
+
+
+class PlacedCavity(Strict):
+    """A declared interior of a placed object, as a box in the frame of the body it moves with.
+
+    Why recorded: "inside" means inside a container's declared cavity, not inside its bounding box (a
+    knife under a table is not in the table). A drawer's bin moves with the drawer body, a cupboard's
+    space with the cabinet; the scene graph turns these boxes into world boxes from live body poses.
+    """
+
+    name: str
+    body: str = Field(description="the simulator body the cavity moves with, e.g. 'cabinet_0/drawer_0_0'")
+    center: Vec3 = Field(description="box centre in that body's frame, metres")
+    half_extents: Vec3 = Field(description="box half sizes along that body's axes, metres")
+    opening: str = Field("top", description="top | front")
+    joint: str | None = Field(None, description="the scene joint that closes it (None: always open)")
 
 
 class PlacedObject(Artefact):
@@ -78,6 +108,9 @@ class PlacedObject(Artefact):
     inside: str | None = Field(None, description="instance it is contained in, if any")
     joint_states: list[JointState] = Field(default_factory=list)
     fixed: bool = Field(False, description="welded to the world (furniture) rather than free")
+    cavities: list[PlacedCavity] | None = Field(
+        None, description="declared interiors ([]: nothing can be inside it; None: a scene built before they were recorded)"
+    )
 
 
 class ValidationCheck(Strict):
@@ -111,6 +144,12 @@ class ManifestHazard(Strict):
     """A hazard the builder put in the scene, bound to instances (the answer key for one hazard)."""
 
     hazard_class: str
+    source: Literal["intended", "incidental"] | None = Field(
+        None,
+        description="intended: what the builder set out to build (its bindings and class), confirmed on the "
+        "settled scene; incidental: found on the settled scene by the knowledge base's matcher; None: an "
+        "old manifest that did not say",
+    )
     object: str = Field(description="instance name of the object at fault")
     category: str
     severity: float = Field(ge=0, le=1)
@@ -129,6 +168,12 @@ class NearMiss(Strict):
     category: str
     looks_like: str = Field(description="the hazard class it resembles")
     why_safe: str
+    kind: Literal["object", "borderline", "state"] | None = Field(
+        None,
+        description="object: a hazard-class object nowhere near any threshold; borderline: placed just "
+        "outside a class's threshold (just-inside ones are hazards); state: a part left in its safe state "
+        "(a knob at off, a door ajar a few degrees); None: an old manifest",
+    )
 
 
 class HazardManifest(Artefact):
@@ -153,6 +198,7 @@ class GraphObject(Strict):
     distance_to_edge: float | None = Field(None, description="to the edge of the surface it rests on")
     child_reachable: bool
     joints: list[JointState] = Field(default_factory=list)
+    held: bool = Field(False, description="attached to the robot's suction cup: on, in and under nothing")
 
 
 class Relation(Strict):

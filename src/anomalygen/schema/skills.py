@@ -56,6 +56,13 @@ class Plan(Artefact):
 
 
 class SubTaskResult(Strict):
+    """One sub-task's execution. ``method`` is the method the plan asked for; ``executed_by`` is the
+    skill that actually executed it, as ``method:action`` of the skill registry (``*``: the method's
+    skill for any action, as SAC learns whatever the reward asks). They differ when a SAC sub-task
+    failed and the primitive of its action ran in its place (``method`` "sac", ``executed_by``
+    "primitive:push"). None when no skill executed it: CEM on a wheeled robot, the episode budget
+    spent, no skill registered for its action, or a skill that reported "not executed"."""
+
     id: str
     method: SkillMethod
     success: bool
@@ -63,6 +70,10 @@ class SubTaskResult(Strict):
     wall_s: float = 0.0
     detail: str = ""
     attempts: int = Field(1, ge=1, description="executions of the sub-task: retried when its check failed")
+    executed_by: str | None = Field(
+        None, description="registry key (method:action) of the skill that executed the sub-task, e.g. "
+                          "'sac:switch_off', 'primitive:push'; None when none did"
+    )
 
 
 class HazardOutcome(Strict):
@@ -75,7 +86,7 @@ class HazardOutcome(Strict):
 
 
 class FixOutcome(Strict):
-    """The hidden-truth verdict on one execution (written by the referee, never read by the robot)."""
+    """An old run's hidden-truth verdict, kept readable (new runs: ``schema.Verdict`` in verdict.json)."""
 
     hazards: list[HazardOutcome] = Field(default_factory=list)
     resolved: bool = Field(description="every manifest hazard is resolved (a hazard-free scene: True)")
@@ -96,4 +107,6 @@ class SkillResult(Artefact):
     video: str | None = None
     timings: dict[str, float] = Field(default_factory=dict)
     error: str | None = None
-    outcome: FixOutcome | None = Field(None, description="the referee's verdict against truth.json; None without one")
+    outcome: FixOutcome | None = Field(
+        None, description="read only for old runs: the referee's verdict is now written after the robot's items, "
+        "by the judge stage, to verdict.json (schema.Verdict); new results leave this None")

@@ -27,9 +27,10 @@ from anomalygen.assets.generators.parts_lib import knob, side_door, top_lid
 from anomalygen.assets.model import Cavity, Draft, Surface
 from anomalygen.assets.parts import Part, axis_angle
 from anomalygen.assets.registry import register
+from anomalygen.schema import BUTTON, DRAWER, FLAP, LID
 
 
-def button(parent: Part, name, pos, half, rgba, axis=(0, 0, -1), travel=0.004, label="button"):
+def button(parent: Part, name, pos, half, rgba, axis=(0, 0, -1), travel=0.004, label=BUTTON):
     """A spring-returned push button moving ``travel`` along ``axis`` when pressed."""
     b = parent.child(name, pos)
     b.slide(f"{name}_press", axis, (0, travel), label, 0.0, spring=True)
@@ -49,7 +50,7 @@ def coffee_machine(rng):
     r.box((hx, hy * 0.5, 0.04), (0, -hy * 0.2, h - 0.04), c, D_HOLLOW)  # head
     r.cyl(0.012, 0.02, (0, -hy * 0.4, h - 0.1), METAL[1], D_METAL)  # spout
     tray = r.child("drip_tray", (0, -hy + 0.005, 0.045))
-    tray.slide("drip_tray_slide", (0, -1, 0), (0, hy * 0.6), "drawer", 0.0)
+    tray.slide("drip_tray_slide", (0, -1, 0), (0, hy * 0.6), DRAWER, 0.0)
     tray.box((hx * 0.8, hy * 0.4, 0.006), (0, hy * 0.4, 0.006), METAL[0], D_METAL)
     lid = top_lid(r, "lid", hx * 0.8, hy * 0.3, h, DARK, 900)
     lid.pos = (0, hy * 0.95, h)
@@ -151,7 +152,7 @@ def kettle(rng):
     r.segment((-rad - 0.05, 0, h * 0.85), (-rad - 0.05, 0, h * 0.3), 0.012, DARK, 1100)
     r.segment((-rad - 0.05, 0, h * 0.3), (-rad, 0, h * 0.25), 0.012, DARK, 1100)
     lid = r.child("lid", (-rad * 0.8, 0, h + 0.002))
-    lid.hinge("lid_hinge", (0, 1, 0), (-1.7, 0), "lid", 0.0)
+    lid.hinge("lid_hinge", (0, 1, 0), (-1.7, 0), LID, 0.0)
     lid.cyl(rad * 0.75, 0.006, (rad * 0.8, 0, 0.006), c, 1500)
     lid.box((0.012, 0.008, 0.01), (rad * 1.3, 0, 0.018), DARK, 1100)
     button(r, "switch", (-rad - 0.05, 0, h * 0.3 - 0.02), (0.008, 0.006, 0.004), (0.9, 0.4, 0.1, 1))
@@ -175,7 +176,7 @@ def kitchen_pot(rng):
     else:
         r.box((0.08, 0.012, 0.008), (rad + 0.08, 0, h * 0.85), DARK, 1100)
     lid = r.child("lid", (0, 0, h + 0.001))
-    lid.slide("lid_lift", (0, 0, 1), (0, 0.12), "lid", 0.0)
+    lid.slide("lid_lift", (0, 0, 1), (0, 0.12), LID, 0.0)
     lid.cyl(rad + 0.004, 0.003, (0, 0, 0.003), GLASS if rng.random() < 0.5 else c, 2500)
     lid.cyl(0.015, 0.01, (0, 0, 0.016), DARK, 1100)
     cav = [Cavity("inside", (0, 0, h / 2 + 0.004), (rad * 0.7, rad * 0.7, h / 2 - 0.01), "top", "lid_lift")]
@@ -184,7 +185,7 @@ def kitchen_pot(rng):
         {"two_handles": two},
         [],
         cav,
-        [colour_name(c), "lid", "two side handles" if two else "long handle", "hot when cooking"],
+        [colour_name(c), LID, "two side handles" if two else "long handle", "hot when cooking"],
     )
 
 
@@ -361,7 +362,7 @@ def box(rng):
     if cardboard:
         for s, name in ((-1, "flap_front"), (1, "flap_back")):
             f = r.child(name, (0, s * hy, 2 * hz))
-            f.hinge(f"{name}_hinge", (1, 0, 0), (-2.2, 0) if s > 0 else (0, 2.2), "flap", 0.0)
+            f.hinge(f"{name}_hinge", (1, 0, 0), (-2.2, 0) if s > 0 else (0, 2.2), FLAP, 0.0)
             f.box((hx - 0.002, hy / 2 - 0.002, t / 2), (0, -s * hy / 2, t / 2 + s * 0.0), c, 700)
         joint = "flap_front_hinge"
         feats = ["cardboard", "two top flaps"]
@@ -386,8 +387,8 @@ def suitcase(rng):
     c = colour(rng, FABRIC + PLASTIC[:3] + [DARK])
     open_box(r, hx, hy, hz, t, c, 400, top=True, front=False)
     side_door(r, "lid", -hx, hx, 0.004, 2 * hz - 0.002, -hy + 0.002, True, c, 400, thick=0.05, handle=False)
-    r.children[-1].joint.label = "lid"
-    r.children[-1].label = "lid"
+    r.children[-1].joint.label = LID
+    r.children[-1].label = LID
     hd = r.child("handle", (0, hy * 0.6, 2 * hz - 0.1))
     hd.slide("handle_slide", (0, 0, 1), (0, 0.3), "handle", 0.0)
     for s in (-1, 1):

@@ -31,6 +31,7 @@ from anomalygen.assets.generators.parts_lib import drawer, drop_door, knob, side
 from anomalygen.assets.model import Cavity, Draft, Surface
 from anomalygen.assets.parts import Part
 from anomalygen.assets.registry import register
+from anomalygen.schema import DIAL, DOOR, DRAWER, LID, SASH
 
 
 def _cells(r: Part, hx, hy, z0, z1, cols: int, rows: int, t: float, rgba, density, rng, prefix=""):
@@ -44,11 +45,11 @@ def _cells(r: Part, hx, hy, z0, z1, cols: int, rows: int, t: float, rgba, densit
         za, zb = z0 + i * row_h, z0 + (i + 1) * row_h
         if i > 0:
             r.box((hx - t, hy - t, t / 2), (0, 0, za), rgba, density)
-        kind = "drawer" if (row_h < 0.35 and rng.random() < 0.7) or rng.random() < 0.25 else "door"
+        kind = DRAWER if (row_h < 0.35 and rng.random() < 0.7) or rng.random() < 0.25 else DOOR
         for j in range(cols):
             xa, xb = -hx + 2 * hx * j / cols, -hx + 2 * hx * (j + 1) / cols
             name = f"{prefix}{kind}_{i}_{j}"
-            if kind == "drawer":
+            if kind == DRAWER:
                 _, cav = drawer(
                     r,
                     name,
@@ -402,7 +403,7 @@ def safe(rng):
     c = colour(rng, [DARK, METAL[2], (0.25, 0.3, 0.25, 1), APPLIANCE[1]])
     open_box(r, hx, hy, hz, t, c, 1500, top=True, front=False)
     d = side_door(r, "door", -hx + 0.004, hx - 0.004, 0.004, 2 * hz - 0.004, -hy, True, c, 2000, thick=0.04)
-    knob(d, "dial", (hx, -0.04, hz * 0.3), min(hx, hz) * 0.2, METAL[0], label="dial")
+    knob(d, "dial", (hx, -0.04, hz * 0.3), min(hx, hz) * 0.2, METAL[0], label=DIAL)
     cav = [Cavity("inside", (0, 0, hz), (hx - 1.5 * t, hy - 1.5 * t, hz - 1.5 * t), "front", "door_hinge")]
     return Draft(
         r,
@@ -464,14 +465,14 @@ def window(rng):
         r.box((w / 4, 0.012, h / 2 - 0.01), (w / 4, 0.02, zc), GLASS, 300)  # fixed pane at the back track
         r.box((0.01, 0.015, h / 2 - 0.01), (w / 2 - 0.01, 0.02, zc), fc, D_WOOD)
         s = r.child("sash", (-w / 4, -0.02, zc))
-        s.slide("sash_slide", (1, 0, 0), (0, w / 2 - 0.02), "sash", 0.0)
+        s.slide("sash_slide", (1, 0, 0), (0, w / 2 - 0.02), SASH, 0.0)
         s.box((w / 4 - 0.004, 0.012, h / 2 - 0.01), (0, 0, 0), GLASS, 300)
         for sx in (-1, 1):
             s.box((0.012, 0.016, h / 2 - 0.01), (sx * (w / 4 - 0.012), 0, 0), fc, D_WOOD)
         feats = ["sliding sash"]
     else:
         s = r.child("sash", (-w / 2, -depth / 2 + 0.012, zc))
-        s.hinge("sash_hinge", (0, 0, 1), (-1.5, 0), "sash", 0.0)
+        s.hinge("sash_hinge", (0, 0, 1), (-1.5, 0), SASH, 0.0)
         s.box((w / 2 - 0.004, 0.012, h / 2 - 0.004), (w / 2, 0, 0), GLASS, 300)
         for sz in (-1, 1):
             s.box((w / 2 - 0.004, 0.016, 0.02), (w / 2, 0, sz * (h / 2 - 0.02)), fc, D_WOOD)
@@ -584,7 +585,7 @@ def toilet(rng):
     r.box((tank_w, 0.09, 0.2), (0, bd + 0.05, bh + 0.12), c, 800)
     r.box((tank_w + 0.01, 0.1, 0.012), (0, bd + 0.05, bh + 0.33), c, 800)
     lid = r.child("lid", (0, bd - 0.05, bh + 0.025))
-    lid.hinge("lid_hinge", (1, 0, 0), (-1.75, 0), "lid", 0.0)
+    lid.hinge("lid_hinge", (1, 0, 0), (-1.75, 0), LID, 0.0)
     lid.ellipsoid((bw * 0.95, bd * 0.92, 0.01), (0, -bd * 0.92, 0), c, 900)
     seat = r.child("seat", (0, bd - 0.05, bh + 0.008))
     seat.hinge("seat_hinge", (1, 0, 0), (-1.65, 0), "seat", 0.0)
@@ -617,7 +618,7 @@ def trash_can(rng):
     r.ring(rad, 0.012, h, 0.008, 14, c, 1200)
     pedal = rng.random() < 0.6
     lid = r.child("lid", (0, rad + 0.005, h + 0.002))
-    lid.hinge("lid_hinge", (1, 0, 0), (-1.6, 0), "lid", 0.0)
+    lid.hinge("lid_hinge", (1, 0, 0), (-1.6, 0), LID, 0.0)
     # a moulded shell, not 12 mm of solid plastic (which made a 2 kg lid on a 7 kg bin)
     lid.cyl(rad + 0.006, 0.006, (0, -rad - 0.005, 0.006), c, D_HOLLOW)
     feats = [colour_name(c), "hinged lid"]

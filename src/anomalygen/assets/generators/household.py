@@ -34,6 +34,7 @@ from anomalygen.assets.generators.common import (
 from anomalygen.assets.model import Cavity, Draft, Surface
 from anomalygen.assets.parts import Part, axis_angle
 from anomalygen.assets.registry import register
+from anomalygen.schema import DOOR, LID
 
 
 def _d(root, features=(), **params):
@@ -865,7 +866,7 @@ def storage_box(rng):
     c = colour(rng, PLASTIC + WOOD[:2])
     open_box(r, hx, hy, hz, t, c, 900)
     lid = r.child("lid", (0, hy, 2 * hz + 0.002))
-    lid.hinge("lid_hinge", (1, 0, 0), (-1.9, 0), "lid", 0.0)
+    lid.hinge("lid_hinge", (1, 0, 0), (-1.9, 0), LID, 0.0)
     # a 6 mm plastic lid: the 12 mm one weighed 1.5 kg and its holding friction tipped the box
     lid.box((hx + 0.004, hy + 0.002, 0.003), (0, -hy, 0.003), c, 900)
     return Draft(
@@ -951,7 +952,7 @@ def medicine_cabinet(rng):
     open_box(r, hx, hy, hz, t, c, D_WOOD, top=True, front=False)
     r.box((hx - t, hy - t, t / 2), (0, 0, hz), c, D_WOOD)  # shelf
     door = r.child("door", (-hx, -hy - 0.003, hz))
-    door.hinge("door_hinge", (0, 0, 1), (-2.0, 0), "door", 0.0)
+    door.hinge("door_hinge", (0, 0, 1), (-2.0, 0), DOOR, 0.0)
     door.box((hx - 0.002, 0.006, hz - 0.002), (hx, -0.003, 0), c, D_WOOD)
     door.box((hx * 0.8, 0.001, hz * 0.8), (hx, -0.0095, 0), (0.8, 0.88, 0.92, 1), D_GLASS, collide=False)
     door.box((0.006, 0.01, 0.03), (2 * hx - 0.03, -0.018, 0), METAL[0], D_METAL)

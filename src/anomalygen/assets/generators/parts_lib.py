@@ -12,6 +12,7 @@ from __future__ import annotations
 from anomalygen.assets.generators.common import D_METAL, METAL, open_box
 from anomalygen.assets.model import Cavity
 from anomalygen.assets.parts import Part
+from anomalygen.schema import DOOR, DRAWER, KNOB, LID
 
 
 def side_door(
@@ -33,11 +34,11 @@ def side_door(
     w, hz, zc = x1 - x0, (z1 - z0) / 2, (z0 + z1) / 2
     if hinge_left:
         d = parent.child(name, (x0, y - 0.002, zc))
-        d.hinge(f"{name}_hinge", (0, 0, 1), (-open_angle, 0), "door", 0.0)
+        d.hinge(f"{name}_hinge", (0, 0, 1), (-open_angle, 0), DOOR, 0.0)
         sx = 1
     else:
         d = parent.child(name, (x1, y - 0.002, zc))
-        d.hinge(f"{name}_hinge", (0, 0, 1), (0, open_angle), "door", 0.0)
+        d.hinge(f"{name}_hinge", (0, 0, 1), (0, open_angle), DOOR, 0.0)
         sx = -1
     d.box((w / 2 - 0.002, thick / 2, hz - 0.002), (sx * w / 2, -thick / 2, 0), rgba, density)
     if handle:
@@ -52,7 +53,7 @@ def drop_door(
     """A door hinged along its bottom edge that falls open forward (oven, dishwasher)."""
     w, h = x1 - x0, z1 - z0
     d = parent.child(name, ((x0 + x1) / 2, y - 0.002, z0))
-    d.hinge(f"{name}_hinge", (1, 0, 0), (0, 1.55), "door", 0.0)
+    d.hinge(f"{name}_hinge", (1, 0, 0), (0, 1.55), DOOR, 0.0)
     d.box((w / 2 - 0.002, thick / 2, h / 2 - 0.002), (0, -thick / 2, h / 2), rgba, density)
     if window is not None:
         d.box((w * 0.35, 0.001, h * 0.25), (0, -thick - 0.001, h * 0.5), window, 100, collide=False)
@@ -80,7 +81,7 @@ def drawer(parent: Part, name: str, x0, x1, z0, z1, y, depth, rgba, density, t=0
     w, h = x1 - x0, z1 - z0
     dr = parent.child(name, ((x0 + x1) / 2, y - 0.002, z0))
     travel = depth * 0.8
-    dr.slide(f"{name}_slide", (0, -1, 0), (0, travel), "drawer", 0.0)
+    dr.slide(f"{name}_slide", (0, -1, 0), (0, travel), DRAWER, 0.0)
     dr.box((w / 2 - 0.002, 0.009, h / 2 - 0.002), (0, -0.009, h / 2), rgba, density)
     dr.box((min(0.06, w * 0.25), 0.01, 0.008), (0, -0.03, h * 0.6), METAL[0], D_METAL)
     bh = h / 2 * 0.75
@@ -105,7 +106,7 @@ def drawer(parent: Part, name: str, x0, x1, z0, z1, y, depth, rgba, density, t=0
     return dr, cav
 
 
-def knob(parent: Part, name: str, pos, r, rgba, axis=(0, -1, 0), label="knob", rng_max=4.7):
+def knob(parent: Part, name: str, pos, r, rgba, axis=(0, -1, 0), label=KNOB, rng_max=4.7):
     """A round knob turning about its own axis (front-facing by default)."""
     k = parent.child(name, pos)
     k.hinge(f"{name}_joint", axis, (0, rng_max), label, 0.0)
@@ -123,7 +124,7 @@ def knob(parent: Part, name: str, pos, r, rgba, axis=(0, -1, 0), label="knob", r
     return k
 
 
-def top_lid(parent: Part, name: str, hx, hy, z, rgba, density, thick=0.01, open_angle=1.9, label="lid"):
+def top_lid(parent: Part, name: str, hx, hy, z, rgba, density, thick=0.01, open_angle=1.9, label=LID):
     """A flat lid hinged along the back (+y) edge at height z, opening upwards."""
     lid = parent.child(name, (0, hy, z))
     lid.hinge(f"{name}_hinge", (1, 0, 0), (-open_angle, 0), label, 0.0)

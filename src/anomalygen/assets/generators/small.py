@@ -26,6 +26,7 @@ from anomalygen.assets.generators.common import (
 from anomalygen.assets.model import Draft, Surface
 from anomalygen.assets.parts import Part, axis_angle
 from anomalygen.assets.registry import register
+from anomalygen.schema import BUTTON, KNOB, LID
 
 
 @register("Camera")
@@ -38,7 +39,7 @@ def camera(rng):
     r.cyl(lr, 0.02, (0, -hy - 0.02, hz), DARK, 1500, axis="y")
     r.cyl(lr * 0.8, 0.001, (0, -hy - 0.041, hz), BLACK_GLASS, 100, axis="y", collide=False)
     lens = r.child("lens_ring", (0, -hy - 0.02, hz))
-    lens.hinge("zoom_ring", (0, -1, 0), (0, 1.5), "knob", 0.0)
+    lens.hinge("zoom_ring", (0, -1, 0), (0, 1.5), KNOB, 0.0)
     lens.cyl(lr * 1.08, 0.006, (0, 0, 0), METAL[2], 1500, axis="y")
     button(r, "shutter", (hx * 0.6, 0, 2 * hz + 0.003), (0.007, 0.007, 0.003), METAL[0], travel=0.003)
     return Draft(r, {}, [], [], [colour_name(c), "lens", "shutter button"])
@@ -149,7 +150,7 @@ def mouse(rng):
     r.ellipsoid((w, L, 0.018), (0, 0.005, 0.012), c, 600)
     for s, name in ((-1, "left_button"), (1, "right_button")):
         b = r.child(name, (s * w * 0.45, -L * 0.1, 0.026))
-        b.hinge(f"{name}_click", (1, 0, 0), (0, 0.05), "button", 0.0, pos=(0, L * 0.5, 0), spring=True)
+        b.hinge(f"{name}_click", (1, 0, 0), (0, 0.05), BUTTON, 0.0, pos=(0, L * 0.5, 0), spring=True)
         b.ellipsoid((w * 0.42, L * 0.45, 0.004), (0, -L * 0.3, 0), c, 600)
     wh = r.child("wheel", (0, -L * 0.3, 0.029))
     wh.hinge("wheel_spin", (1, 0, 0), (-math.pi, math.pi), "wheel", 0.0)
@@ -172,7 +173,7 @@ def pen(rng):
         cp.box((0.02, 0.0015, 0.002), (0.02, 0, rad * 1.4), METAL[0], D_METAL)
     else:
         b = r.child("click", (-L / 2, 0, rad))
-        b.slide("click_press", (1, 0, 0), (0, 0.004), "button", 0.0, spring=True)
+        b.slide("click_press", (1, 0, 0), (0, 0.004), BUTTON, 0.0, spring=True)
         b.cyl(rad * 0.6, 0.006, (-0.006, 0, 0), METAL[0], D_METAL, axis="x")
     return Draft(
         r,
@@ -191,7 +192,7 @@ def phone(rng):
     r.box((hx, hy, 0.004), (0, 0, 0.004), c, 2000)
     r.box((hx * 0.93, hy * 0.95, 0.0005), (0, 0, 0.0085), BLACK_GLASS, 100, collide=False)
     b = r.child("side_button", (hx + 0.001, hy * 0.3, 0.004))
-    b.slide("side_button_press", (-1, 0, 0), (0, 0.001), "button", 0.0, spring=True)
+    b.slide("side_button_press", (-1, 0, 0), (0, 0.001), BUTTON, 0.0, spring=True)
     b.box((0.001, 0.008, 0.0015), (0, 0, 0), c, 2000)
     return Draft(r, {}, [], [], [colour_name(c), "smartphone", "glass touch screen"])
 
@@ -287,7 +288,7 @@ def stapler(rng):
     r.box((L, w, 0.005), (0, 0, 0.005), c, 1500)
     r.box((0.012, w * 0.7, 0.012), (-L + 0.012, 0, 0.02), c, 1500)
     arm = r.child("arm", (-L + 0.012, 0, 0.032))
-    arm.hinge("arm_hinge", (0, 1, 0), (-1.0, 0), "lid", 0.0)
+    arm.hinge("arm_hinge", (0, 1, 0), (-1.0, 0), LID, 0.0)
     arm.box((L * 0.97, w * 0.9, 0.009), (L * 0.97, 0, -0.0), c, 1500)
     return Draft(r, {}, [], [], [colour_name(c), "hinged top arm", "can pinch fingers", "staples are sharp"])
 
@@ -319,6 +320,6 @@ def lighter(rng):
     wheel.hinge("wheel_spin", (0, 1, 0), (-math.pi, math.pi), "wheel", 0.0)
     wheel.cyl(0.0045, 0.003, (0, 0, 0), METAL[2], D_METAL, axis="y")
     lid = r.child("lid", (hx, 0, h + 0.0005))
-    lid.hinge("lid_hinge", (0, 1, 0), (0, 2.0), "lid", 0.0)
+    lid.hinge("lid_hinge", (0, 1, 0), (0, 2.0), LID, 0.0)
     lid.box((hx, hy, 0.008), (-hx, 0, 0.008), c, 1500)
     return Draft(r, {}, [], [], [colour_name(c), "flip lid", "flame: fire risk, keep away from children"])

@@ -21,6 +21,7 @@ from pathlib import Path
 from anomalygen.assets.model import Cavity, Surface
 from anomalygen.assets.real.convert import Raw
 from anomalygen.assets.real.mjcf import Fragments, find, load_spec, package_dir, remove
+from anomalygen.schema.part_labels import DOOR, KNOB
 
 COLLISION_GROUP = 4  # the Franka Kitchen's collision geoms
 PACKAGE = "gymnasium-robotics"
@@ -75,11 +76,11 @@ def microwave() -> Raw:
     # floor z 0.048, ceiling z 0.336; the door closes the front at y -0.176), 2 mm in from each
     return Raw(
         spec=spec,
-        joints={"door_hinge": ("door", 0.0)},
+        joints={"door_hinge": (DOOR, 0.0)},
         collision_group=COLLISION_GROUP,
         cavities=[Cavity("oven_space", (-0.08, -0.0075, 0.192), (0.205, 0.1665, 0.142), "front", "door_hinge")],
         surfaces=[Surface("top", (-0.08, 0.0, 0.374), (0.25, 0.15))],
-        parts={"door": ["door"], "handle": ["handle_bar", "handle_bar_col"]},
+        parts={DOOR: [DOOR], "handle": ["handle_bar", "handle_bar_col"]},
         features=["black with a glass window", "side-hinged door with a bar handle", "control panel"],
     )
 
@@ -89,8 +90,8 @@ def microwave() -> Raw:
 def hinge_cabinet() -> Raw:
     def edit(doc: ET.Element) -> None:
         _rename(doc, "body", "hingecab", "carcass")
-        for side in ("left", "right"):
-            _moving_part(doc, f"hinge{side}door", f"{side}_door", f"{side}_hinge_cabinet", f"{side}_door_hinge",
+        for side, source_body in (("left", "hingeleftdoor"), ("right", "hingerightdoor")):
+            _moving_part(doc, source_body, f"{side}_door", f"{side}_hinge_cabinet", f"{side}_door_hinge",
                          {0: f"{side}_handle_bar"})
 
     spec = load_spec(_fragments("hingecabinet"), edit)
@@ -98,14 +99,14 @@ def hinge_cabinet() -> Raw:
     half = (0.15, 0.27, 0.15)
     return Raw(
         spec=spec,
-        joints={"left_door_hinge": ("door", 0.0), "right_door_hinge": ("door", 0.0)},
+        joints={"left_door_hinge": (DOOR, 0.0), "right_door_hinge": (DOOR, 0.0)},
         collision_group=COLLISION_GROUP,
         cavities=[
             Cavity("left_compartment", (-0.2, -0.02, 0.0), half, "front", "left_door_hinge"),
             Cavity("right_compartment", (0.2, -0.02, 0.0), half, "front", "right_door_hinge"),
         ],
         surfaces=[Surface("top", (0.0, 0.0, 0.2), (0.38, 0.28))],
-        parts={"door": ["left_door", "right_door"], "handle": ["left_handle_bar", "right_handle_bar"]},
+        parts={DOOR: ["left_door", "right_door"], "handle": ["left_handle_bar", "right_handle_bar"]},
         features=["blue-grey", "two doors with bar handles"],
     )
 
@@ -120,11 +121,11 @@ def slide_cabinet() -> Raw:
     # door covers it when shut and slides over the solid right half to open it
     return Raw(
         spec=spec,
-        joints={"door_slide": ("door", 0.0)},
+        joints={"door_slide": (DOOR, 0.0)},
         collision_group=COLLISION_GROUP,
         cavities=[Cavity("compartment", (-0.203, -0.024, 0.0), (0.19, 0.266, 0.15), "front", "door_slide")],
         surfaces=[Surface("top", (0.0, 0.0, 0.2), (0.43, 0.28))],
-        parts={"door": ["door"], "handle": ["handle_bar"]},
+        parts={DOOR: [DOOR], "handle": ["handle_bar"]},
         features=["blue-grey", "one sliding door with a bar handle"],
     )
 
@@ -198,11 +199,11 @@ def stove() -> Raw:
     return Raw(
         spec=spec,
         # FK knobs turn from 0 (off) to -1.57 (full on)
-        joints={f"knob_{i}_joint": ("knob", 0.0) for i in range(1, 5)},
+        joints={f"knob_{i}_joint": (KNOB, 0.0) for i in range(1, 5)},
         collision_group=COLLISION_GROUP,
         surfaces=[Surface("cooktop", (ox - 0.017, oy + 0.1, oz + top), (0.46, 0.42))]
         + [Surface(n, (ox + x, oy + y, oz + top), (0.1, 0.1)) for n, (x, y) in burners.items()],
-        parts={"knob": [f"knob_{i}" for i in range(1, 5)], "burner": list(burners),
+        parts={KNOB: [f"knob_{i}" for i in range(1, 5)], "burner": list(burners),
                "knob_burner": [[k, b] for k, b in sorted(names.items())]},
         features=["white range with an oven window", "four burners on a black cooktop",
                   "four control knobs on the front"],

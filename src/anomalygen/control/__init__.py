@@ -1,1 +1,0 @@
-"""Robot control: the simulation driver, motion primitives, IK and motion planning."""

@@ -1,0 +1,119 @@
+"""What the robot reads of a real built scene carries no answer key and none of the task's words:
+the perceived spec, the scene graph, scene.xml, and the public env's spec, observation layout and info
+until its episode ends (then the referee's verdict)."""
+
+from __future__ import annotations
+
+import json
+from typing import get_args
+
+import numpy as np
+import pytest
+
+import anomalygen
+from anomalygen.config import Settings
+from anomalygen.knowledge import load_kb
+from anomalygen.knowledge.models import PROPERTIES, ROOMS, SUPPORT_HEIGHTS
+from anomalygen.perception import UNKNOWN_ROLE, load_perceived_scene, load_perceived_spec, load_scene_graph
+from anomalygen.runfolder import read_model
+from anomalygen.schema import Relation, SceneSpec
+from support.ids import task_text, words
+
+OBS_KEYS = {"robot_qpos", "robot_qvel", "ee_pos", "ee_quat", "object_pos", "object_quat", "object_joints", "suction"}
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory):
+    """A brainstormed task (its own words, not a test's) and its built scene."""
+    from anomalygen.brainstorm.knowledge_engine import KnowledgeEngine
+    from anomalygen.scene.build import build_scene
+
+    task = KnowledgeEngine(seed=0, agents=2, rounds=1).run(2)[1]
+    folder = tmp_path_factory.mktemp("perceived") / task.id
+    build_scene(task, seed=0, settings=Settings(), out_dir=folder)
+    return task, folder
+
+
+def _keys_and_values(obj, keys: set[str], values: list[str]) -> None:
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            keys.add(str(k))
+            _keys_and_values(v, keys, values)
+    elif isinstance(obj, list):
+        for v in obj:
+            _keys_and_values(v, keys, values)
+    elif isinstance(obj, str):
+        values.append(obj)
+
+
+def _assert_no_task_words(task, dumps: dict[str, object]) -> None:
+    """No distinctive word of the task (one that is not an object, room, property, part, relation,
+    support or field name, all of which the robot may see) appears in any value; nor its id, class
+    or name."""
+    kb = load_kb()
+    keys: set[str] = set()
+    found: dict[str, list[str]] = {}
+    for what, dump in dumps.items():
+        found[what] = []
+        _keys_and_values(dump, keys, found[what])
+    visible = [*kb.objects, *ROOMS, *PROPERTIES, *keys, *get_args(Relation.model_fields["predicate"].annotation),
+               *(p.label for o in kb.objects.values() for p in o.parts), *SUPPORT_HEIGHTS, "support"]
+    seen_anyway = set().union(*(words(n) for n in visible))
+    distinctive = words(task_text(task)) - seen_anyway
+    assert len(distinctive) >= 5, distinctive  # the check has teeth
+    for what, values in found.items():
+        text = " ".join(values).lower()
+        leaked = distinctive & words(text)
+        assert not leaked, (what, leaked)
+        for secret in (task.id, task.hazard_class, task.name.lower()):
+            assert secret.lower() not in text, (what, secret)
+
+
+def test_perceived_spec_and_graph_carry_no_answer_key_or_task_words(scene):
+    task, folder = scene
+    spec = load_perceived_spec(folder)
+    full = read_model(folder / "scene.json", SceneSpec)
+    assert full.bindings and full.validation is not None  # the builder's file has them ...
+    assert spec.bindings == {} and spec.task_id == "" and spec.validation is None  # ... the robot's copy not
+    assert {o.role for o in spec.objects} == {UNKNOWN_ROLE}
+    assert [o.name for o in spec.objects] == sorted(o.name for o in full.objects)
+    model, data, live = load_perceived_scene(folder)
+    assert live == spec and model.nbody > len(spec.objects)
+    model_names = [model.sensor(i).name for i in range(model.nsensor)] + [model.camera(i).name for i in range(model.ncam)]
+    _assert_no_task_words(task, {
+        "perceived spec": spec.model_dump(mode="json"),
+        "scene graph": load_scene_graph(folder).model_dump(mode="json"),
+        "sensor and camera names": model_names,
+    })
+
+
+def test_make_env_shows_no_answer_key_before_the_end_and_the_verdict_at_it(scene):
+    """The public env (``anomalygen.make_env``): its spec, observation layout and every info before the
+    episode ends carry no bindings, roles, validation or task words; the last info holds the referee's
+    verdict on this scene (the robot did nothing, so nothing is resolved)."""
+    from anomalygen.schema import Verdict
+
+    task, folder = scene
+    env = anomalygen.make_env(folder, horizon=5)
+    base = env.unwrapped
+    assert base.scene == load_perceived_spec(folder)
+    obs, info = env.reset(seed=0)
+    infos, ends = [info], [False]
+    while not ends[-1]:
+        obs, _, terminated, truncated, info = env.step(np.zeros(7))
+        infos.append(info)
+        ends.append(terminated or truncated)
+    assert ends == [False] * 5 + [True]
+    assert set(base.obs_layout) == OBS_KEYS and obs.size == env.observation_space.shape[0]
+    assert all(info == {} for info in infos[:-1])  # no success to claim: the env has no answer key
+    _assert_no_task_words(task, {
+        "env scene": base.scene.model_dump(mode="json"),
+        "env layout": {"layout": sorted(base.obs_layout), "objects": base.object_names},
+        "env info before the end": json.loads(json.dumps(infos[:-1])),
+    })
+    end = infos[-1]
+    assert set(end) == {"verdict", "is_success", "own_check"} and end["own_check"] is None
+    verdict = end["verdict"]
+    assert isinstance(verdict, Verdict) and verdict.task_id == task.id and verdict.seed is None
+    assert verdict.status in ("unresolved", "no_action_needed") and end["is_success"] is verdict.resolved is False
+    env.close()
