@@ -163,6 +163,21 @@ def test_doors_close_their_cavities(built):
             assert 0 < c.center[2] - c.half_extents[2] and c.center[2] + c.half_extents[2] < a.aabb[1][2]
 
 
+def test_cavities_stay_with_the_carcass_when_a_door_slides_across_them(built):
+    from anomalygen.scene.cavities import placed_cavities
+
+    for key in ("franka_kitchen/slide_cabinet", "franka_kitchen/hinge_cabinet", "franka_kitchen/microwave"):
+        a = built[key]
+        spec = mujoco.MjSpec()
+        a.attach(spec.worldbody.add_body(name="obj"), "obj/")
+        model = spec.compile()
+        placed = placed_cavities(model, "obj", a)
+        # on the object's own body, where the scene graph looks for "inside": a door moves off the space
+        assert [(c.name, c.body) for c in placed] == [(c.name, "obj") for c in a.cavities], key
+        for c, cav in zip(placed, a.cavities, strict=True):
+            np.testing.assert_allclose(c.center, cav.center, atol=1e-9)
+
+
 @pytest.mark.parametrize("key", ["franka_kitchen/microwave", "franka_kitchen/stove", "myosuite/mug"])
 def test_validation_passes_including_every_joint_sweep(built, key):
     res = validate_asset(built[key], render=False)
