@@ -5,25 +5,13 @@ from __future__ import annotations
 import pytest
 
 from anomalygen.schema import Plan, SkillResult
-from support.kb_scenes import build_with_kb_plans
-
-
-def make_task(task_id, hazard_class, target, hazard, placement, *, articulations=(), room="kitchen", container=None):
-    from anomalygen.schema import TaskProposal
-
-    return TaskProposal(
-        id=task_id, name=f"task {task_id}", explanation="test", description=f"A {hazard} at {placement}.",
-        category="household_hazard", hazard_class=hazard_class, target_asset=target,
-        scenario=dict(hazard_object=hazard, room=room, placement=placement, container=container, co_objects=[]),
-        articulations=[dict(object=o, part=p, initial_state=s) for o, p, s in articulations],
-        provenance=dict(engine="knowledge", mode="brainstorm"))
-
+from support.kb_scenes import build_with_kb_plans, kb_task
 
 TASKS = {
-    "fridge": make_task("t-fridge", "close_open_refrigerator", "Refrigerator", "Refrigerator", "floor",
-                        articulations=[("Refrigerator", "door", "open")]),
-    "litter": make_task("t-litter", "pick_up_floor_litter", "Bucket", "wrapper", "walkway", room="office",
-                        container="Bucket"),
+    "fridge": kb_task("t-fridge", "close_open_refrigerator", "Refrigerator", "Refrigerator", "floor",
+                      articulations=[("Refrigerator", "door", "open")]),
+    "litter": kb_task("t-litter", "pick_up_floor_litter", "Bucket", "wrapper", "walkway", room="office",
+                      container="Bucket"),
 }
 
 
