@@ -222,16 +222,16 @@ def test_run_sac_subtask_trains_and_replays_on_the_driver_deterministically():
 @pytest.mark.slow
 def test_a_closing_reward_about_an_already_closed_part_moves_to_the_open_one(tmp_path):
     """The planner names a fridge's first joint (the freezer); the open one is the door."""
-    from test_execute import TASKS
-
     from anomalygen.config import Settings
     from anomalygen.plan.planner import plan_from_kb
     from anomalygen.scene.build import build_scene
     from anomalygen.scene.graph import load_scene
     from anomalygen.skills.episode import Episode
     from anomalygen.skills.learned.sac_subtask import retarget_joints
+    from support.kb_scenes import kb_task
 
-    task = TASKS["fridge"]
+    task = kb_task("t-fridge", "close_open_refrigerator", "Refrigerator", "Refrigerator", "floor",
+                   articulations=[("Refrigerator", "door", "open")])
     spec = build_scene(task, seed=0, settings=Settings(build={"clutter": 1}), out_dir=tmp_path)
     st = plan_from_kb(task.id, task.hazard_class, dict(spec.bindings), spec=spec).subtasks[0]
     model, data, spec = load_scene(tmp_path)
