@@ -18,6 +18,8 @@ TASKS = {
     "cabinet": kb_task("t-cabinet-0", "close_open_furniture", "StorageFurniture", "StorageFurniture", "floor",
                          articulations=[("StorageFurniture", "door", "open")]),
     "knife": kb_task("t-knife", "store_sharp_objects", "Knife", "Knife", "counter", container="storage_box"),
+    "slide": kb_task("t-slide-0", "reduce_tripping_hazards", "StorageFurniture", "slipper", "walkway",
+                     container="StorageFurniture", room="bedroom"),
 }
 
 
@@ -92,3 +94,14 @@ def test_a_real_knife_is_picked_and_put_in_a_box(built, tmp_path):
     assert any(s.id.endswith("pick") and "holding" in s.detail for s in res.subtasks)  # suction held it
     inside = next(p for p in res.final_predicates if p.call.name == "inside")
     assert inside.holds and inside.call.args["object"] in ("$hazard", knife.name)
+
+
+def test_a_slipper_is_stored_behind_the_real_sliding_door(built, tmp_path):
+    scene_dir, spec, plan = built["slide"]
+    cab = _real(spec, "StorageFurniture")
+    assert cab.asset.params["model"] == "franka_kitchen/slide_cabinet" and spec.bindings["$container"] == cab.name
+    res, joints = _final_joints(tmp_path, scene_dir, plan)
+    assert res.success, [s.detail for s in res.subtasks]
+    inside = next(p for p in res.final_predicates if p.call.name == "inside")
+    assert inside.holds  # in the compartment the door slid off, which stays with the carcass
+    assert joints[f"{cab.name}/door_slide"].open_fraction <= 0.05
