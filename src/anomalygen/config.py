@@ -80,6 +80,10 @@ class BuildConfig(Section):
     render_height: int = Field(240, ge=32)
     repair_attempts: int = Field(3, ge=0)
     relevant_in_unit_cube: bool = Field(True, description="task assets inside (0..1)^3, unrelated ones outside")
+    real_assets: bool = Field(
+        True, description="draw real models from installed packages where a category has them (assets/real); "
+        "false: procedural assets only, for comparisons"
+    )
     start: Literal["dock", "reach"] = Field(
         "dock", description="where the robot starts: 'dock', the same pose in every scene (says nothing about the "
         "hazard); 'reach', the free pose nearest the dock with the hazard within reach, facing it (the answer "

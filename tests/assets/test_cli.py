@@ -16,6 +16,12 @@ def test_list_and_show_json():
     assert res.exit_code == 0
     rows = json.loads(res.stdout)
     assert len(rows) == 126 and sum(r["kind"] == "target" for r in rows) == 44
+    # every name says where its models come from, each with its licence
+    assert all(r["sources"] and r["licences"] == sorted({s["licence"] for s in r["sources"]}) for r in rows)
+    by_name = {r["name"]: r for r in rows}
+    assert [s["source"] for s in by_name["Microwave"]["sources"]] == ["procedural", "gymnasium-robotics"]
+    assert [s["source"] for s in by_name["Stove"]["sources"]] == ["procedural", "gymnasium-robotics"] and by_name["pill"]["real_models"] == 0
+    assert sum(r["real_models"] > 0 for r in rows if r["kind"] == "target") >= 12
     res = runner.invoke(app, ["show", "Dishwasher", "--seed", "1", "--json"])
     info = json.loads(res.stdout)
     assert {j["label"] for j in info["joints"]} >= {"door", "rack"}
@@ -41,6 +47,23 @@ def test_validate_reports_categories_and_exit_code():
     assert res.exit_code == 0, res.output
     summary = json.loads(res.stdout)
     assert summary["passed"] == 2 and summary["assets_ok"] == 2
+
+
+def test_show_real_gives_the_packaged_model_with_its_licence():
+    res = runner.invoke(app, ["show", "Stove", "--real", "--json"])
+    assert res.exit_code == 0, res.output
+    info = json.loads(res.stdout)
+    assert (info["source"], info["package"], info["licence"]) == ("packaged", "gymnasium-robotics", "Apache-2.0")
+    assert [j["label"] for j in info["joints"]] == ["knob"] * 4 and all(j["closed"] == 0.0 for j in info["joints"])
+    res = runner.invoke(app, ["show", "Dishwasher", "--real", "--json"])  # no real model: procedural
+    assert json.loads(res.stdout)["source"] == "procedural"
+
+
+def test_validate_real_checks_each_packaged_model():
+    res = runner.invoke(app, ["validate", "--real", "--name", "StorageFurniture", "--no-render", "--json"])
+    assert res.exit_code == 0, res.output
+    summary = json.loads(res.stdout)
+    assert summary["names"] == 1 and summary["assets"] == 2 and summary["assets_ok"] == 2
 
 
 def test_search_json(tmp_path, monkeypatch):

@@ -19,7 +19,8 @@ from support.moves import cavity_center, hold, put
 
 KNIFE = "kitchen_knife_0"
 PILLS = "pill_bottle_0"
-QUIET_MIX = {"clutter": 0, "near_misses": 0, "multi_hazard": 0.0, "hazard_free": 0.0}
+# procedural assets: the knife's cases need a cabinet with drawers, and the real cabinets have doors
+QUIET_MIX = {"clutter": 0, "near_misses": 0, "multi_hazard": 0.0, "hazard_free": 0.0, "real_assets": False}
 
 
 @pytest.fixture(scope="module")

@@ -40,7 +40,8 @@ TASKS = {
 
 @pytest.fixture(scope="module")
 def scenes(tmp_path_factory):
-    return build_with_kb_plans(TASKS, tmp_path_factory.mktemp("parts_scenes"), clutter=2)
+    # procedural assets: the drawer tests need a chest of drawers (the real cabinets have doors)
+    return build_with_kb_plans(TASKS, tmp_path_factory.mktemp("parts_scenes"), clutter=2, real_assets=False)
 
 
 def _episode(scenes, key, seed=0):

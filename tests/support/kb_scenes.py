@@ -9,15 +9,17 @@ NO_MIX = {"near_misses": 0, "multi_hazard": 0.0, "hazard_free": 0.0}
 SKILL_SCENES = {**NO_MIX, "start": "reach"}
 
 
-def build_with_kb_plans(tasks: dict, root, *, clutter: int) -> dict:
-    """{key: (scene folder, SceneSpec, Plan)} for each TaskProposal in ``tasks``, built with seed 0."""
+def build_with_kb_plans(tasks: dict, root, *, clutter: int, real_assets: bool = True) -> dict:
+    """{key: (scene folder, SceneSpec, Plan)} for each TaskProposal in ``tasks``, built with seed 0
+    (``real_assets`` False: procedural assets only, as before the real models)."""
     from anomalygen.config import Settings
     from anomalygen.plan.planner import plan_from_kb
     from anomalygen.scene.build import build_scene
 
     out = {}
     for key, task in tasks.items():
-        spec = build_scene(task, seed=0, settings=Settings(build={"clutter": clutter, **SKILL_SCENES}), out_dir=root / key)
+        settings = Settings(build={"clutter": clutter, "real_assets": real_assets, **SKILL_SCENES})
+        spec = build_scene(task, seed=0, settings=settings, out_dir=root / key)
         out[key] = (root / key, spec, plan_from_kb(task.id, task.hazard_class, dict(spec.bindings), spec=spec))
     return out
 

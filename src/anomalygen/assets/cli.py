@@ -37,24 +37,27 @@ def _check_name(name: str) -> str:
 def list_cmd(
     json_out: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
 ) -> None:
-    """Every asset name with its kind and plausible size range."""
+    """Every asset name with its kind, plausible size range, and where its models come from (the
+    procedural generator and/or packaged real models, each with its licence)."""
+    from anomalygen.assets.core import sources
     from anomalygen.assets.names import group, household_names, size_range, target_names
 
     rows = [
-        {"name": n, "kind": "target", "group": group(n), "size_range": size_range(n)} for n in target_names()
-    ]
-    rows += [
-        {"name": n, "kind": "household", "group": group(n), "size_range": size_range(n)}
-        for n in household_names()
+        {"name": n, "kind": kind, "group": group(n), "size_range": size_range(n), **sources(n)}
+        for kind, names in (("target", target_names()), ("household", household_names()))
+        for n in names
     ]
     if json_out:
         print(json.dumps(rows))
         return
-    t = Table("name", "kind", "group", "size (m)")
+    t = Table("name", "kind", "group", "size (m)", "sources (licence)")
     for r in rows:
-        t.add_row(r["name"], r["kind"], r["group"], f"{r['size_range'][0]:.3g}-{r['size_range'][1]:.3g}")
+        t.add_row(r["name"], r["kind"], r["group"], f"{r['size_range'][0]:.3g}-{r['size_range'][1]:.3g}",
+                  ", ".join(f"{s['source']} ({s['licence']})" for s in r["sources"]))
     out.print(t)
-    out.print(f"{len(rows)} names ({sum(r['kind'] == 'target' for r in rows)} target categories)")
+    real = [r for r in rows if r["real_models"]]
+    out.print(f"{len(rows)} names ({sum(r['kind'] == 'target' for r in rows)} target categories); "
+              f"{len(real)} with real models ({sum(r['kind'] == 'target' for r in real)} targets)")
 
 
 @app.command()
@@ -62,16 +65,19 @@ def show(
     name: str,
     seed: Annotated[int, typer.Option(help="Variant seed.")] = 0,
     size: Annotated[float | None, typer.Option(help="Largest dimension in metres.")] = None,
+    real: Annotated[bool, typer.Option("--real", help="The real model a scene draws for this seed, if any.")] = False,
     json_out: Annotated[bool, typer.Option("--json")] = False,
 ) -> None:
     """Facts about one asset variant: size, mass, joints, surfaces, cavities, description."""
-    from anomalygen.assets.core import generate
+    from anomalygen.assets.core import draw
 
-    a = generate(_check_name(name), seed, size)
+    a = draw(_check_name(name), seed, size, real=real)
     info = {
         "asset_id": a.asset_id,
         "category": a.category,
         "source": str(a.source),
+        "package": a.package,
+        "licence": a.licence,
         "size": round(a.size, 4),
         "aabb": [a.aabb[0].round(4).tolist(), a.aabb[1].round(4).tolist()],
         "mass": round(a.mass, 4),
@@ -121,24 +127,28 @@ def render(
     open_fraction: Annotated[float, typer.Option("--open", help="Pose joints this far open (0..1).")] = 0.3,
     width: int = 480,
     height: int = 360,
+    real: Annotated[bool, typer.Option("--real", help="The real model a scene draws for this seed, if any.")] = False,
 ) -> None:
     """Render one asset variant to a PNG."""
     os.environ.setdefault("MUJOCO_GL", "egl")
-    from anomalygen.assets.core import generate
+    from anomalygen.assets.core import draw
     from anomalygen.assets.render import render_asset, save_png
 
-    a = generate(_check_name(name), seed)
+    a = draw(_check_name(name), seed, real=real)
     save_png(render_asset(a, width=width, height=height, open_fraction=open_fraction), out_path)
     out.print(f"wrote {out_path}")
 
 
-def _validate_one(args: tuple[str, int, bool]) -> dict:
+def _validate_one(args: tuple[str, int | str, bool]) -> dict:
+    """One asset's checks: ``seed`` an int is a procedural seed, a str a packaged model's key."""
     from anomalygen.assets.core import generate
+    from anomalygen.assets.real.catalogue import build, by_key
     from anomalygen.assets.validate import validate_asset
 
     name, seed, do_render = args
     try:
-        r = validate_asset(generate(name, seed), render=do_render)
+        asset = build(by_key(seed)) if isinstance(seed, str) else generate(name, seed)
+        r = validate_asset(asset, render=do_render)
         return {"name": name, "seed": seed, "ok": r.ok, "reason": r.reason}
     except Exception as exc:  # a generator crash is a failed item, not a failed run
         return {"name": name, "seed": seed, "ok": False, "reason": f"{type(exc).__name__}: {exc}"[:300]}
@@ -156,16 +166,26 @@ def validate(
         bool, typer.Option("--render/--no-render", help="Also render a thumbnail per asset.")
     ] = True,
     workers: Annotated[int, typer.Option("--workers", "-j", help="Parallel processes.")] = 1,
+    real: Annotated[
+        bool, typer.Option("--real", help="Validate every packaged real model (of the --name ones, or all) once.")
+    ] = False,
     json_out: Annotated[bool, typer.Option("--json")] = False,
 ) -> None:
-    """Compile, rest on the floor for 2 s, sweep every joint, render: per name over seeds 0..n-1."""
+    """Compile, rest on the floor for 2 s, sweep every joint, render: per name over seeds 0..n-1
+    (with --real: each packaged model of each name)."""
     os.environ.setdefault("MUJOCO_GL", "egl")
+    from anomalygen.assets.core import real_models
     from anomalygen.assets.names import household_names, target_names
+    from anomalygen.assets.real.catalogue import by_category
 
-    todo_names = (
-        [_check_name(n) for n in names] if names else (household_names() if household else target_names())
-    )
-    jobs = [(n, s, do_render) for n in todo_names for s in range(per_category)]
+    if real:
+        todo_names = [_check_name(n) for n in names] if names else sorted(by_category())
+        jobs = [(n, m.key, do_render) for n in todo_names for m in real_models(n)]
+    else:
+        todo_names = (
+            [_check_name(n) for n in names] if names else (household_names() if household else target_names())
+        )
+        jobs = [(n, s, do_render) for n in todo_names for s in range(per_category)]
     t0 = time.perf_counter()
     if workers > 1:
         import multiprocessing as mp
@@ -194,9 +214,10 @@ def validate(
         print(json.dumps(summary))
     else:
         for f in summary["failures"]:
-            out.print(f"[red]FAIL[/red] {f['name']} seed {f['seed']}: {f['reason']}")
+            out.print(f"[red]FAIL[/red] {f['name']} {'model' if real else 'seed'} {f['seed']}: {f['reason']}")
         out.print(
-            f"{len(passed)}/{len(todo_names)} categories pass ({summary['assets_ok']}/{len(results)} assets, {per_category} seeds each) in {wall:.0f} s"
+            f"{len(passed)}/{len(todo_names)} categories pass ({summary['assets_ok']}/{len(results)} assets, "
+            f"{'every real model' if real else f'{per_category} seeds each'}) in {wall:.0f} s"
         )
     if len(passed) != len(todo_names):
         raise typer.Exit(1)
@@ -242,13 +263,17 @@ def gallery(
     seed: Annotated[int, typer.Option(help="Variant seed.")] = 0,
     cell: Annotated[int, typer.Option(help="Thumbnail size in pixels.")] = 200,
     household: Annotated[bool, typer.Option("--household/--targets")] = False,
+    real: Annotated[bool, typer.Option("--real", help="Every name with a real model, drawn as a scene would.")] = False,
 ) -> None:
     """Contact sheet of all 44 target categories (or the household objects), labelled."""
     os.environ.setdefault("MUJOCO_GL", "egl")
     from anomalygen.assets.names import household_names, target_names
+    from anomalygen.assets.real.catalogue import by_category
     from anomalygen.assets.render import gallery as make_gallery
     from anomalygen.assets.render import save_png
 
     names = household_names() if household else target_names()
-    save_png(make_gallery(names, seed, cell=cell, cols=8 if not household else 10), out_path)
+    if real:
+        names = [n for n in target_names() + household_names() if n in by_category()]
+    save_png(make_gallery(names, seed, cell=cell, cols=8 if not household else 10, real=real), out_path)
     out.print(f"wrote {out_path} ({len(names)} assets)")

@@ -45,15 +45,23 @@ def _world_aabb(model, data) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
-def _scale_spec(spec, s: float) -> None:
-    """Uniformly scale positions, sizes, meshes and slide ranges of a spec in place."""
+def scale_spec(spec, s: float, root_offset=None) -> None:
+    """Uniformly scale positions, sizes, meshes and slide ranges of a spec in place; with
+    ``root_offset`` (already scaled) also move everything the body named ``root`` holds."""
     import mujoco
+
+    off = np.zeros(3) if root_offset is None else np.asarray(root_offset, float)
+
+    def shift(el) -> np.ndarray:
+        return off if el.parent.name == "root" else np.zeros(3)
 
     for b in spec.bodies:
         if b.name != "world":
-            b.pos = np.asarray(b.pos) * s
+            b.pos = np.asarray(b.pos) * s + shift(b)
     for g in spec.geoms:
-        g.pos = np.asarray(g.pos) * s
+        g.pos = np.asarray(g.pos) * s + shift(g)
+        if not np.isnan(g.fromto[0]):
+            g.fromto = np.asarray(g.fromto) * s + np.r_[shift(g), shift(g)]
         if g.type != mujoco.mjtGeom.mjGEOM_MESH:
             g.size = np.asarray(g.size) * s
     for m in spec.meshes:
@@ -63,7 +71,8 @@ def _scale_spec(spec, s: float) -> None:
         if j.type == mujoco.mjtJoint.mjJNT_SLIDE:
             j.range = np.asarray(j.range) * s
     for site in spec.sites:
-        site.pos = np.asarray(site.pos) * s
+        site.pos = np.asarray(site.pos) * s + shift(site)
+        site.size = np.asarray(site.size) * s
 
 
 _TMP_PREFIX = "imp__"
@@ -90,7 +99,7 @@ def _attach_unprefixed(spec, frame, child) -> None:
             m.meshname = m.meshname[len(_TMP_PREFIX) :]
 
 
-def _exclude_all(spec) -> None:
+def exclude_self_contacts(spec) -> None:
     """No contacts among the model's own links (doors must not jam on their frame; see core)."""
     names = [b.name for b in spec.bodies if b.name != "world"]
     for i, a in enumerate(names):
@@ -114,13 +123,13 @@ def _wrap(inner_spec, *, up_quat, size: float | None, default_size: float):
     target = default_size if size is None else size
     s = target / nominal
     scaled = inner_spec.copy()
-    _scale_spec(scaled, s)
+    scale_spec(scaled, s)
     spec = new_spec()
     root = spec.worldbody.add_body(name="root")
     off = -np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2]]) * s
     f = root.add_frame(pos=list(off), quat=list(up_quat))
     _attach_unprefixed(spec, f, scaled)
-    _exclude_all(spec)
+    exclude_self_contacts(spec)
     model = spec.compile()
     mass = float(model.body_subtreemass[1]) if model.nbody > 1 else 0.0
     ext = (hi - lo) * s

@@ -84,6 +84,10 @@ class Asset:
     # its surfaces or controls are reached from its front (-y) only, so the builder turns that side to
     # the robot (a bookcase's shelves, a stove's knobs); doors, drawers and cavities imply it already
     front_access: bool = False
+    package: str | None = None  # the installed package a real model comes from (None: procedural)
+    licence: str | None = None  # SPDX licence of that model's files
+    # the side it is worked from, when no door, drawer or cavity says so (a stove's knobs): (0, -1)
+    front: tuple[float, float] | None = None
     _keep: list = field(default_factory=list, repr=False)
 
     @property
@@ -100,6 +104,8 @@ class Asset:
             seed=self.seed,
             params=dict(self.params),
             path=self.path,
+            package=self.package,
+            licence=self.licence,
         )
 
     def root_body(self):

@@ -119,18 +119,19 @@ def save_png(rgb: np.ndarray, path: str | Path) -> Path:
 GALLERY_POSE = {"Eyeglasses": 1.0, "Chair": 0.0, "USB": 0.0}
 
 
-def gallery(names: list[str], seed: int = 0, *, cell: int = 200, cols: int = 8) -> np.ndarray:
-    """A labelled contact sheet: one thumbnail per name (e.g. the 44 target categories)."""
+def gallery(names: list[str], seed: int = 0, *, cell: int = 200, cols: int = 8, real: bool = False) -> np.ndarray:
+    """A labelled contact sheet: one thumbnail per name (e.g. the 44 target categories); ``real``
+    shows the real model a scene draws where a name has one."""
     from PIL import Image, ImageDraw
 
-    from anomalygen.assets.core import generate
+    from anomalygen.assets.core import draw as draw_asset
 
     rows = math.ceil(len(names) / cols)
     label_h = 18
     sheet = Image.new("RGB", (cols * cell, rows * (cell + label_h)), (255, 255, 255))
     draw = ImageDraw.Draw(sheet)
     for i, name in enumerate(names):
-        asset = generate(name, seed)
+        asset = draw_asset(name, seed, real=real)
         # part-open pose shows what moves; glasses read best with the temples fully unfolded
         rgb = render_asset(asset, width=cell, height=cell, open_fraction=GALLERY_POSE.get(name, 0.35))
         x, y = (i % cols) * cell, (i // cols) * (cell + label_h)

@@ -110,12 +110,8 @@ def kb_size_range(kb, catalogue: str) -> tuple[float, float] | None:
     return tuple(info.size_range) if info is not None else None
 
 
-def choose_size(
-    kb, catalogue: str, rng: np.random.Generator, *, cap: float | None = None, preferred: float | None = None
-) -> float:
-    """Largest dimension: uniform in the knowledge base's range (intersected with the generator's),
-    clamped by ``cap`` (the spatial rule of a container opening or a support surface). A
-    ``preferred`` size (an engine's, e.g. the LLM's) is used instead of the draw, clamped the same way."""
+def size_bounds(kb, catalogue: str) -> tuple[float, float]:
+    """The sizes a name is drawn in: the knowledge base's range intersected with the generator's."""
     from anomalygen.assets.names import size_range
 
     lo, hi = size_range(catalogue)
@@ -124,6 +120,25 @@ def choose_size(
         lo, hi = max(lo, kb_range[0]), min(hi, kb_range[1])
         if lo > hi:  # ranges disagree: trust the generator's own plausible range
             lo, hi = size_range(catalogue)
+    return lo, hi
+
+
+def cavity_cap(asset) -> float:
+    """Largest thing the biggest cavity takes: a fifth less than its smallest extent, or than its
+    floor's long side when it is open above (a power strip lies flat in a sink, turned to fit)."""
+    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+    if cav.open_above:
+        return 0.8 * 2 * float(max(cav.half_extents[0], cav.half_extents[1]))
+    return 0.8 * 2 * float(min(cav.half_extents))
+
+
+def choose_size(
+    kb, catalogue: str, rng: np.random.Generator, *, cap: float | None = None, preferred: float | None = None
+) -> float:
+    """Largest dimension: uniform in the knowledge base's range (intersected with the generator's),
+    clamped by ``cap`` (the spatial rule of a container opening or a support surface). A
+    ``preferred`` size (an engine's, e.g. the LLM's) is used instead of the draw, clamped the same way."""
+    lo, hi = size_bounds(kb, catalogue)
     if cap is not None:
         if cap < lo:
             raise ItemFailed(f"{catalogue} (at least {lo:.2f} m) does not fit a {cap:.2f} m space")
@@ -189,17 +204,32 @@ def pick_asset(
     cap: float | None = None,
     rank: bool = False,
     size: float | None = None,
+    real: bool = True,
+    room_for: float | None = None,
 ):
-    """Generate candidates, verify them, rank the target ones by SBERT; the first plausible one wins."""
-    from anomalygen.assets.core import generate
+    """Generate candidates, verify them, rank the target ones by SBERT; the first plausible one wins.
+
+    A category with real (packaged) models draws those (``real``: ``build.real_assets``); a real
+    candidate that does not fit here (too big for the space, without the part the task needs, an
+    interior too small for the ``room_for`` m thing to go in it) gives way to the procedural one
+    drawn with the same seed and size."""
+    from anomalygen.assets.core import draw, generate
 
     parts = needed_parts(task, catalogue, hc)
     n = TARGET_CANDIDATES if rank else 2
     seeds = [int(s) for s in rng.integers(0, 2**31 - 1, size=n)]
     candidates, problems = [], []
     for s in seeds:
-        asset = generate(catalogue, s, size=choose_size(kb, catalogue, rng, cap=cap, preferred=size))
+        want = choose_size(kb, catalogue, rng, cap=cap, preferred=size)
+        asset = draw(catalogue, s, size=want, real=real)
         problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap)
+        if problem is None and asset.package is not None and room_for and asset.cavities \
+                and cavity_cap(asset) < room_for:
+            problem = f"its interior takes {cavity_cap(asset):.2f} m, less than the {room_for:.2f} m to go in"
+        if problem is not None and asset.package is not None:
+            problems.append(f"real model {asset.asset_id}: {problem}")
+            asset = generate(catalogue, s, size=want)
+            problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap)
         if problem is None:
             candidates.append(asset)
         else:

@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from anomalygen.assets.real.files import relocate_meshes
 from anomalygen.errors import ItemFailed
 from anomalygen.knowledge import load_kb
 from anomalygen.rng import item_rng, stable_hash
@@ -79,7 +80,7 @@ def _plan(task: TaskProposal, settings: Settings, rng, hints=None,
     """Choose and place every object; returns the layout, bindings and instances by name.
 
     A hazard-free scene has no bindings: there is nothing to fix, and the oracle plans nothing."""
-    sel = select_objects(task, rng, hints)
+    sel = select_objects(task, rng, hints, real_assets=settings.build.real_assets)
     sel.hazard_free = hazard_free
     set_initial_joints(sel)
     lay, placed, support = place(sel, settings)
@@ -296,7 +297,8 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_cla
 
 
 def _write_xml(mjspec, out_dir: Path) -> None:
-    """scene.xml with robot meshes under assets/franka, loadable from any working directory."""
+    """scene.xml with robot meshes under assets/franka (real models' under assets/real), loadable
+    from any working directory."""
     src, files = Agent.mesh_files()
     dst = out_dir / "assets" / "franka"
     for rel in files:
@@ -312,4 +314,5 @@ def _write_xml(mjspec, out_dir: Path) -> None:
     xml = xml.replace(f'meshdir="{src}"', 'meshdir="assets/franka"', 1)
     if 'meshdir="assets/franka"' not in xml:  # pragma: no cover - MuJoCo changed its XML writer
         raise RuntimeError("could not relocate the robot mesh folder in scene.xml")
+    xml = relocate_meshes(xml, out_dir, "assets/franka")  # real models' meshes, under assets/real
     atomic_write_text(out_dir / "scene.xml", xml)

@@ -16,7 +16,7 @@ import numpy as np
 from anomalygen.errors import ItemFailed
 from anomalygen.knowledge import load_kb
 from anomalygen.scene import asset_choice
-from anomalygen.scene.instances import cavity_cap, container_room, instance_name
+from anomalygen.scene.instances import container_room, instance_name
 from anomalygen.scene.layout import Placed
 from anomalygen.scene.set_states import set_initial_states
 from anomalygen.schema import ObjectRole, TaskProposal, part_labels
@@ -78,19 +78,23 @@ class Selection:
     hazard_is_target: bool = False
     hints: object | None = None  # scene/hints.py: sizes, positions and auxiliaries from the LLM engine
     hazard_free: bool = False  # build the task's hazard in its safe state (scene/mix.py)
+    real_assets: bool = True  # draw a category's real (packaged) models where it has any (build.real_assets)
 
     @property
     def variables(self) -> set[str]:
         return set(self.hc.variables) if self.hc is not None else set()
 
-    def choose(self, raw: str, role: ObjectRole, *, cap=None, rank=False) -> asset_choice.Chosen:
-        """The asset for a name (one per catalogue category: a second mention reuses it)."""
+    def choose(self, raw: str, role: ObjectRole, *, cap=None, rank=False, room_for=None) -> asset_choice.Chosen:
+        """The asset for a name (one per catalogue category: a second mention reuses it).
+
+        ``room_for``: the least size of what will be put inside it (a real model with too small an
+        interior gives way to the procedural one)."""
         cat = asset_choice.resolve_name(raw)
         if cat in self.by_catalogue:
             return self.by_catalogue[cat]
         want = self.hints.size_for(cat) if self.hints is not None else None
-        asset = asset_choice.pick_asset(cat, role=role, kb=self.kb, task=self.task, hc=self.hc, rng=self.rng, cap=cap,
-                                  rank=rank, size=want)
+        asset = asset_choice.pick_asset(cat, role=role, kb=self.kb, task=self.task, hc=self.hc, rng=self.rng,
+                                        cap=cap, rank=rank, size=want, real=self.real_assets, room_for=room_for)
         if want is not None and abs(asset.size - want) > 1e-3:
             self.hints.note(f"size:{cat}", f"size {want:.3f} m does not fit the generator's range or the space "
                             f"available; built at {asset.size:.3f} m", value=want, limit=round(float(asset.size), 4))
@@ -104,27 +108,33 @@ class Selection:
         self.used.discard(ch.name)
 
 
-def select_objects(task: TaskProposal, rng, hints=None) -> Selection:
+def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = True) -> Selection:
     """Choose an asset for every role the task needs (target, hazard, container, supports, co-objects).
 
     ``hints`` (scene/hints.py, from the LLM engine) supply sizes, floor positions and the auxiliary
-    objects instead of the random draws; every correction is noted in them or in the layout."""
+    objects instead of the random draws; every correction is noted in them or in the layout.
+    ``real_assets`` False builds every object from the procedural generators (a comparison run)."""
     kb = load_kb()
     sc = task.scenario
     kind, parent_raw = _parse_placement(sc.placement)
-    sel = Selection(task, rng, kb, kb.hazard_classes.get(task.hazard_class), kind, parent_raw, hints=hints)
+    sel = Selection(task, rng, kb, kb.hazard_classes.get(task.hazard_class), kind, parent_raw, hints=hints,
+                    real_assets=real_assets)
     hc, variables = sel.hc, sel.variables
     sel.hazard_is_target = asset_choice.resolve_name(sc.hazard_object) == asset_choice.resolve_name(task.target_asset)
+    # what goes inside the parent needs room there (only a real model is turned down for lacking it)
+    holder = asset_choice.resolve_name(parent_raw) if kind == "inside" and parent_raw else None
+    room_for = asset_choice.size_bounds(kb, asset_choice.resolve_name(sc.hazard_object))[0] if holder else None
     # Big things first: they bound what fits in/on them.
     target = sel.target = sel.choose(
-        task.target_asset, ObjectRole.HAZARD if sel.hazard_is_target else ObjectRole.TARGET, rank=True
+        task.target_asset, ObjectRole.HAZARD if sel.hazard_is_target else ObjectRole.TARGET, rank=True,
+        room_for=room_for if asset_choice.resolve_name(task.target_asset) == holder else None,
     )
-    parent = sel.parent = sel.choose(parent_raw, ObjectRole.AUXILIARY) if parent_raw else None
+    parent = sel.parent = sel.choose(parent_raw, ObjectRole.AUXILIARY, room_for=room_for) if parent_raw else None
     cap = None
     if kind == "inside" and parent is not None:
         if not parent.asset.cavities:
             raise ItemFailed(f"placement inside:{parent_raw} but {parent.catalogue} has no interior")
-        cap = cavity_cap(parent.asset)
+        cap = asset_choice.cavity_cap(parent.asset)
     hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=cap)
     if hazard is target:
         target.role = ObjectRole.HAZARD

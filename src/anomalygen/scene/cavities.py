@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from anomalygen.schema import PlacedCavity, PlacedObject
+from anomalygen.schema import DOOR, PlacedCavity, PlacedObject, part_labels
 
 SUPPORT_PREFIX = "support-"  # asset ids of the builder's plain support furniture (tables, counters): no cavity
 
@@ -19,8 +19,8 @@ SUPPORT_PREFIX = "support-"  # asset ids of the builder's plain support furnitur
 def placed_cavities(model, name: str, asset) -> list[PlacedCavity]:
     """The cavities of ``asset`` placed as object ``name`` in the compiled ``model``.
 
-    A cavity closed by a slide moves with the slide's body (a drawer bin); any other stays with the
-    object's body. Poses come from the model at its reference configuration (every joint closed at 0).
+    A cavity closed by a slide moves with the slide's body (a drawer bin), unless the slide is a
+    door (a sliding cabinet door moves across the space it closes); any other stays with the object's body. Poses come from the model at its reference configuration (every joint closed at 0).
     """
     import mujoco
 
@@ -34,7 +34,8 @@ def placed_cavities(model, name: str, asset) -> list[PlacedCavity]:
     out = []
     for cav in asset.cavities:
         joint = joints.get(cav.joint) if cav.joint else None
-        body_name = f"{name}/{joint.body}" if joint is not None and joint.type == "slide" and joint.body else name
+        moves_with = joint is not None and joint.type == "slide" and joint.body and part_labels.canonical(joint.label) != DOOR
+        body_name = f"{name}/{joint.body}" if moves_with else name
         body = model.body(body_name).id
         world = root_pos + root_mat @ np.asarray(cav.center, float)
         pos, mat = data.xpos[body], data.xmat[body].reshape(3, 3)

@@ -64,8 +64,11 @@ def renumber_by_position(lay: layout.Layout, placed: dict[str, Placed],
 
 
 def _front(asset) -> np.ndarray | None:
-    """Local direction the asset's doors/drawers open to (the catalogue convention is -y); an asset
-    reached from its front (a bookcase's shelves, a stove's knobs) faces the robot that way too."""
+    """Local direction the asset's doors/drawers open to (the catalogue convention is -y), the side
+    the asset declares it is worked from (a real stove's control knobs), or -y for an asset reached
+    from its front only (a bookcase's shelves, the procedural stove's knobs)."""
+    if getattr(asset, "front", None) is not None:
+        return np.asarray(asset.front, float)
     if any(part_labels.is_closure(j.label) for j in asset.joints) or asset.cavities or asset.front_access:
         return np.array([0.0, -1.0])
     return None
@@ -182,12 +185,3 @@ def container_room(asset) -> float:
     """Longest thing that lies flat in the container's biggest cavity (along its long side)."""
     cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
     return 0.95 * 2 * float(max(cav.half_extents[0], cav.half_extents[1]))
-
-
-def cavity_cap(asset) -> float:
-    """Largest thing the biggest cavity takes: a fifth less than its smallest extent, or than its
-    floor's long side when it is open above (a power strip lies flat in a sink, turned to fit)."""
-    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
-    if cav.open_above:
-        return 0.8 * 2 * float(max(cav.half_extents[0], cav.half_extents[1]))
-    return 0.8 * 2 * float(min(cav.half_extents))

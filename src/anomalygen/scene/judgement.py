@@ -48,7 +48,8 @@ def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed]
     for cat, role, face in ((items.second_hazard, ObjectRole.HAZARD, False), (items.bin, ObjectRole.CONTAINER, True)):
         if cat is None:
             continue
-        asset = asset_choice.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng)
+        asset = asset_choice.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng,
+                                        real=sel.real_assets)
         p = placed_instance(asset_choice.Chosen(instance_name(cat, sel.used), cat, role, asset))
         lay.place_on_floor(p, relevant=True, face=face)
         if role == ObjectRole.HAZARD:
@@ -69,7 +70,8 @@ def _on_surface_clear_of_edges(lay: Layout, p: Placed, holder: Placed, edge_gap:
 
 
 def _chosen(sel: Selection, category: str, rng) -> Placed:
-    asset = asset_choice.pick_asset(category, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng)
+    asset = asset_choice.pick_asset(category, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng,
+                                    real=sel.real_assets)
     return placed_instance(asset_choice.Chosen(instance_name(category, sel.used), category, ObjectRole.CLUTTER, asset))
 
 

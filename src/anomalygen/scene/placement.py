@@ -129,7 +129,7 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
         for cat in clutter:
             want = sel.hints.size_for(cat) if sel.hints is not None else None
             asset = asset_choice.pick_asset(cat, role=ObjectRole.CLUTTER, kb=sel.kb, task=sel.task, hc=None, rng=rng,
-                                      size=want)
+                                      size=want, real=sel.real_assets)
             ch = asset_choice.Chosen(instance_name(cat, used), cat, ObjectRole.CLUTTER, asset)
             p = placed_instance(ch)
             try:

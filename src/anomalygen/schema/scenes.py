@@ -25,6 +25,8 @@ class AssetRef(Artefact):
     seed: int | None = None
     params: dict[str, Any] = Field(default_factory=dict)
     path: str | None = Field(None, description="file path for imported assets")
+    package: str | None = Field(None, description="installed package a real (packaged) model comes from")
+    licence: str | None = Field(None, description="SPDX licence of a packaged model's files")
 
 
 CHILD_REACH = 1.0  # m: the highest a small child reaches (``child_reachable``, the detectors' checks)

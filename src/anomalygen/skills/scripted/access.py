@@ -42,13 +42,21 @@ def best_drawer(ep: Episode, obj: str, drawers: list):
 
 def compartment_behind(ep: Episode, obj: str, js) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(lo, hi, outward normal) of the space behind a shut door: the door's face extent, as deep as
-    the carcass reaches behind it."""
+    the carcass reaches behind it.
+
+    A hinged door's handle is pulled outwards, so its grasp normal says which way the door faces; a
+    sliding door's handle is pulled sideways, so its face is its panel's thinnest side, on the side
+    of the carcass the panel stands (a sideways normal measured a compartment of no depth)."""
     drv = ep.driver
     dlo, dhi = drv.aabb(drv.joint_body(js.name))
     clo, chi = static_box(ep, obj)
-    g = grasp_candidates(ep, js.name, js.closed_value)[0]
-    n = _world(ep, g)[1]
-    k = int(np.argmax(np.abs(n[:2])))
+    if js.type == "slide":
+        k = int(np.argmin((dhi - dlo)[:2]))
+        n = np.zeros(3)
+        n[k] = 1.0 if (dlo[k] + dhi[k]) > (clo[k] + chi[k]) else -1.0
+    else:
+        n = _world(ep, grasp_candidates(ep, js.name, js.closed_value)[0])[1]
+        k = int(np.argmax(np.abs(n[:2])))
     lo, hi = dlo.copy(), dhi.copy()
     if n[k] < 0:  # the door faces -k: the compartment runs towards +k
         lo[k], hi[k] = dhi[k], chi[k]
