@@ -156,11 +156,25 @@ _KNOBS = (("knob 4", "Burner 4", -0.347), ("knob 2", "Burner 2", -0.137), ("knob
 _BAND_FRONT_Y = -0.342  # the front face of the range's band under the cooktop (ovenroot frame)
 _BAND_Z = 0.455  # its middle height
 _BURNER_RGBA = "0.22 0.07 0.05 1"  # a cold element: dark red-brown
+_GLOW_RADIUS = 0.09  # m, a little inside the burner ring
+_GLOW_HALF_HEIGHT = 0.004  # m
+_GLOW_LIFT = 0.008  # m above the burner geom's centre, so the disc shows over its top face
+_GLOW_RGBA = "1 0.35 0.05 0"  # hidden until the builder lights it
 # A cooker knob turns stiffly. A free one (damped in proportion to its 60 g cm^2 inertia, like a
 # procedural part) was still spinning at 33 rad/s when the suction cup let go of it at off, and
 # coasted 0.3 rad back on; dry friction alone is too soft a constraint on so small an inertia.
 KNOB_DAMPING = 0.2  # N m s/rad: 0.6 N m against a hand turning it at 3 rad/s
 KNOB_FRICTION = 0.1  # N m
+
+
+def _glow(control: str, burner_pos: str) -> ET.Element:
+    """A hidden disc just over a burner, named after the knob that lights it: the builder shows it
+    while that knob is on (``scene/states.py``), as the procedural stove's burners glow."""
+    x, y, z = (float(v) for v in burner_pos.split())
+    return ET.Element("geom", {
+        "name": f"{control}_glow", "type": "cylinder", "size": f"{_GLOW_RADIUS} {_GLOW_HALF_HEIGHT}",
+        "pos": f"{x} {y} {z + _GLOW_LIFT}", "rgba": _GLOW_RGBA, "contype": "0", "conaffinity": "0",
+        "group": "1", "mass": "0"})
 
 
 def stove() -> Raw:
@@ -182,6 +196,7 @@ def stove() -> Raw:
             geom.attrib.pop("material", None)
             geom.set("rgba", _BURNER_RGBA)
             oven.append(geom)
+            oven.append(_glow(f"knob_{i}", b.get("pos")))
             k = _moving_part(doc, knob, f"knob_{i}", f"knob_Joint_{knob.split()[1]}", f"knob_{i}_joint")
             k.set("pos", f"{x} {_BAND_FRONT_Y} {_BAND_Z}")
             names[f"knob_{i}_joint"] = f"burner_{i}"
