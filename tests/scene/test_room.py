@@ -28,7 +28,7 @@ def room_scenes(tmp_path_factory, scene_settings):
 
 
 def _wall_geoms(model) -> np.ndarray:
-    return np.array([g for g in range(model.ngeom) if walls.is_structure(model.geom(g).name)])
+    return walls.wall_geoms(model)
 
 
 def _mounted(folder, category):
@@ -76,8 +76,8 @@ def test_walls_fill_the_background_behind_the_objects(room_scenes, built_scenes,
 
     b = scene_settings.build
     for key, folder in {**room_scenes, **built_scenes}.items():
-        model, data, _ = load_scene(folder)
-        wall = _wall_geoms(model)
+        model, data, spec = load_scene(folder)
+        wall = walls.wall_geoms(model, spec)  # walls, and windows or doors in them
         with SceneRenderer(model, b.render_width, b.render_height) as r:
             seg = r.segment(data, "front")
         assert not np.any(seg < 0), key  # no empty background: floor, walls or things everywhere

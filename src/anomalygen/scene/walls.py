@@ -49,6 +49,18 @@ def is_structure(geom_name: str | None) -> bool:
     return bool(geom_name) and geom_name.startswith(WALL_PREFIX)
 
 
+def wall_geoms(model, spec=None) -> np.ndarray:
+    """Ids of the walls' geoms, and (given the scene spec) of the objects mounted in them: what the
+    background of a render should be made of."""
+    from anomalygen.robot.frames import subtree_geoms
+
+    mask = np.array([is_structure(model.geom(g).name) for g in range(model.ngeom)], dtype=bool)
+    for o in spec.objects if spec is not None else ():
+        if mount_height(o.asset.category) is not None:
+            mask |= subtree_geoms(model, model.body(o.name).id)
+    return np.flatnonzero(mask)
+
+
 def mount_height(category: str) -> float | None:
     """Height of the bottom of a wall-mounted category (None: it is not mounted in a wall)."""
     return WALL_MOUNTED.get(category)
