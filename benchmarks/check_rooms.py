@@ -2,7 +2,8 @@
 
 For each valid scene: every window and door is mounted in a wall (its box against the back or side
 wall, a window's bottom at the sill height, a door's on the floor); the front render's background is
-wall or floor everywhere (no empty pixels) and its top rows are wall (or a window or door in it); and the object at fault (the
+wall or floor everywhere (no empty pixels), its top edge shows no floor (walls, or things standing before
+them), at least 5 % of it is wall; and the object at fault (the
 builder's ``$hazard``, else ``$target``) is not covered by the robot in the front and top renders,
 measured again from scene.xml (its bounding box projected into each camera, the robot's share of
 its visible pixels). Prints the failures and one JSON line.
@@ -18,15 +19,15 @@ from pathlib import Path
 
 import numpy as np
 
-TOP_ROWS = 0.1  # share of the image height at the top that must be wall
-TOP_WALL_MIN = 0.9  # share of those pixels that must be wall
+TOP_ROWS = 2  # rows at the top of the front render that must show no floor (walls, or things before them)
+WALL_MIN = 0.05  # share of the front render that must be wall
 HEIGHT_TOL = 0.03  # m
 
 
 def check_scene(folder: Path, width: int, height: int) -> list[str]:
     from anomalygen.scene import viewpoint, walls
     from anomalygen.scene.build import at_fault
-    from anomalygen.scene.graph import load_scene
+    from anomalygen.scene.graph import FLOOR_GEOM, load_scene
     from anomalygen.scene.render import SceneRenderer
 
     model, data, spec = load_scene(folder)
@@ -43,9 +44,12 @@ def check_scene(folder: Path, width: int, height: int) -> list[str]:
         seg = r.segment(data, "front")
         if np.any(seg < 0):
             problems.append(f"front render: {int((seg < 0).sum())} px of empty background")
-        top = seg[: max(1, int(height * TOP_ROWS))]
-        if np.isin(top, wall).mean() < TOP_WALL_MIN:
-            problems.append(f"front render: only {np.isin(top, wall).mean():.0%} of the top rows is wall (or mounted in it)")
+        top = seg[:TOP_ROWS]
+        floor = model.geom(FLOOR_GEOM).id
+        if np.any(top == floor):
+            problems.append(f"front render: the top edge shows {int((top == floor).sum())} px of floor behind the objects")
+        if np.isin(seg, wall).mean() < WALL_MIN:
+            problems.append(f"front render: only {np.isin(seg, wall).mean():.0%} of it is wall")
         fault = at_fault(spec.bindings)
         if fault is not None:
             for check in viewpoint.fault_coverage(r, model, data, fault):

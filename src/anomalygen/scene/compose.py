@@ -23,6 +23,7 @@ if TYPE_CHECKING:
 
 
 LOOSE_SOLREF = 0.005  # s: contact time constant of loose objects (2.5 physics steps)
+FLOOR_TILE = 1.6  # m: one repeat of the floor's checker texture (two tiles)
 WALL_ABOVE_EYE = 0.3  # m: walls rise this far above the highest front view, so no view sees over them
 
 
@@ -58,10 +59,12 @@ def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rn
         width=256,
         height=256,
     )
-    mat = spec.add_material(name="floor_mat", texrepeat=[6, 6], reflectance=0.05)
+    mat = spec.add_material(name="floor_mat", texrepeat=[walls.WALL_REACH / FLOOR_TILE] * 2, reflectance=0.05)
     mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = tex.name
-    center = layout.ROOM_CENTER
-    half = layout.ROOM_HALF + walls.WALL_REACH / 2  # the floor runs under the walls as far as they go
+    # the floor ends at the walls' faces (through a window one sees the ground outside, not the floor)
+    # and runs the other way as far as they do
+    half = np.full(2, walls.WALL_REACH / 2)
+    center = np.array([walls.WALL_X, walls.WALL_Y]) - half
     spec.worldbody.add_geom(
         name=FLOOR_GEOM,
         type=mujoco.mjtGeom.mjGEOM_PLANE,
@@ -71,7 +74,7 @@ def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rn
     )
     spec.worldbody.add_light(
         name="sun",
-        pos=[center[0], center[1], 3.5],
+        pos=[layout.ROOM_CENTER[0], layout.ROOM_CENTER[1], 3.5],
         dir=[0.2, 0.1, -1],
         type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
         diffuse=[0.6, 0.6, 0.6],

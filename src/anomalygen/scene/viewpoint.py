@@ -72,8 +72,27 @@ def framed_view(lo, hi, aspect: float, away, pitch_deg: float) -> tuple[np.ndarr
 
 
 def front_views(boxes, aspect: float) -> list[tuple[np.ndarray, list[float]]]:
+    """The candidate views of a scene, in order: the first always, the others only when the top of
+    their image meets a wall before the floor (a view from high above a furnished area far from the
+    walls would show bare floor behind the objects)."""
     lo, hi = frame_box(boxes)
-    return [framed_view(lo, hi, aspect, away, pitch) for away, pitch in VIEWS]
+    views = [framed_view(lo, hi, aspect, away, pitch) for away, pitch in VIEWS]
+    return views[:1] + [v for v in views[1:] if top_edge_meets_wall(*v, aspect)]
+
+
+def top_edge_meets_wall(eye, xyaxes, aspect: float) -> bool:
+    """Do the rays through the top corners and top middle of a view hit a wall before the floor?"""
+    from anomalygen.scene.walls import WALL_X, WALL_Y
+
+    x, y = np.asarray(xyaxes[:3]), np.asarray(xyaxes[3:])
+    tan_v = math.tan(math.radians(CAMERA_FOVY) / 2)
+    for side in (-1.0, 0.0, 1.0):
+        d = -np.cross(x, y) + tan_v * y + side * tan_v * aspect * x
+        floor = -eye[2] / d[2] if d[2] < 0 else math.inf
+        wall = min((WALL_X - eye[0]) / d[0] if d[0] > 0 else math.inf, (WALL_Y - eye[1]) / d[1] if d[1] > 0 else math.inf)
+        if wall >= floor:
+            return False
+    return True
 
 
 def _set_camera(model, mjspec, name: str, eye, xyaxes) -> None:

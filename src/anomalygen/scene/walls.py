@@ -27,6 +27,8 @@ WINDOW_SILL = 0.82  # m: height of a window's sill above the floor (real sills: 
 WALL_MOUNTED = {"Window": WINDOW_SILL, "Door": 0.0}  # category -> height of its bottom above the floor
 WALL_GAP = 0.005  # m between a mounted object's back and the wall's face
 BACKDROP_DEPTH = 0.6  # m behind the wall: what is seen through an opening
+BACKDROP_WIDE = 3.0  # m the backdrop runs past each side of its opening (a view through it at a slant)
+GROUND_RGBA = (0.42, 0.5, 0.36, 1.0)  # the ground outside, between the wall and the backdrop
 WALL_RGBA = (0.84, 0.82, 0.74, 1.0)
 WALL_EMISSION = 0.35  # the lights fall on the walls at a grazing angle: without it they render dark grey
 SKIRTING_RGBA = (0.35, 0.27, 0.2, 1.0)
@@ -103,10 +105,12 @@ def emit_walls(spec, openings: list[Opening], height: float) -> None:
             if a1 - a0 > 1e-3 and not any(o.along[0] <= a0 and a1 <= o.along[1] for o in doors):
                 _box(spec, wall, f"{WALL_PREFIX}{wall}_skirting_{k}", (a0, a1), (0.0, SKIRTING_HEIGHT),
                      rgba=SKIRTING_RGBA, inset=-0.01, collide=False)
-        for j, o in enumerate(holes):
-            _box(spec, wall, f"{WALL_PREFIX}{wall}_backdrop_{j}", (o.along[0] - 0.3, o.along[1] + 0.3),
-                 (0.0, height), rgba=BACKDROP_RGBA.get(o.kind, WALL_RGBA), inset=WALL_THICK + BACKDROP_DEPTH,
-                 collide=False)
+        for j, o in enumerate(holes):  # what is seen through an opening: a backdrop, and ground before it
+            wide = (o.along[0] - BACKDROP_WIDE, o.along[1] + BACKDROP_WIDE)
+            _box(spec, wall, f"{WALL_PREFIX}{wall}_backdrop_{j}", wide, (0.0, height),
+                 rgba=BACKDROP_RGBA.get(o.kind, WALL_RGBA), inset=WALL_THICK + BACKDROP_DEPTH, collide=False)
+            _box(spec, wall, f"{WALL_PREFIX}{wall}_ground_{j}", wide, (-0.02, 0.0), rgba=GROUND_RGBA,
+                 inset=0.0, depth=(WALL_THICK + BACKDROP_DEPTH) / 2, collide=False)
 
 
 def _pieces(start: float, end: float, holes: list[Opening], height: float):
@@ -126,13 +130,15 @@ def _pieces(start: float, end: float, holes: list[Opening], height: float):
 
 
 def _box(spec, wall: str, name: str, along, z, *, material=None, rgba=None, inset: float = 0.0,
-         collide: bool = True) -> None:
-    """A box of the wall: ``along`` and ``z`` intervals, its inner face ``inset`` behind the wall's face."""
+         depth: float | None = None, collide: bool = True) -> None:
+    """A box of the wall: ``along`` and ``z`` intervals, its inner face ``inset`` behind the wall's
+    face, ``depth`` its half-thickness (default: the wall's; 1 cm for a skirting board before it)."""
     import mujoco
 
     half_a, half_z = (along[1] - along[0]) / 2, (z[1] - z[0]) / 2
     mid_a, mid_z = (along[0] + along[1]) / 2, (z[0] + z[1]) / 2
-    depth = WALL_THICK / 2 if inset >= 0 else 0.01
+    if depth is None:
+        depth = WALL_THICK / 2 if inset >= 0 else 0.01
     face = inset + depth
     if wall == "back":
         pos, size = [WALL_X + face, mid_a, mid_z], [depth, half_a, half_z]
