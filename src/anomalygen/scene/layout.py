@@ -32,7 +32,7 @@ EDGE_BAND = (0.015, 0.07)  # metres from the edge for *_edge placements (KB thre
 WALKWAY_CLEAR = 0.42  # > the KB's 0.3 m walkway clearance, with margin
 TUCK_GAP = (0.03, 0.12)  # metres from a fixture's side for an item tucked out of the walkway (KB: 0.3)
 TRIES = 60
-WALL_SPAN = {"back": (-1.0, WALL_Y), "side": (0.6, WALL_X)}  # m along each wall where mounted objects go
+WALL_SPAN = {"back": (-1.0, WALL_Y - 0.4), "side": (0.6, WALL_X - 0.4)}  # m along each wall where mounted objects go (not in the corner)
 # Clearance kept round the robot at its start pose (its shape is the agent's: BASE_RADIUS, HOME_ARM_BOXES)
 BASE_CLEAR_TOP = 0.35  # m: a box whose bottom is lower than this (the base's 0.30 m top, plus 5 cm) can hit the base
 BASE_CLEAR_SIDE = 0.08  # m kept between such a box and the base disc
@@ -147,8 +147,8 @@ class Layout:
 
     @staticmethod
     def walls() -> np.ndarray:
-        """The walls' inner faces (x of the back wall, y of the side wall), less the gap kept from them."""
-        return np.array([WALL_X, WALL_Y]) - WALL_GAP / 2
+        """The walls' inner faces (x of the back wall, y of the side wall): a footprint ends at them."""
+        return np.array([WALL_X, WALL_Y])
 
     def _hits_base(self, box) -> bool:
         """Does a world AABB intrude on the robot: its base disc, or the arm's box at the home pose?"""

@@ -28,6 +28,7 @@ VIEWS = (((-1.0, -0.7), 45.0), ((-1.0, -0.7), 62.0), ((-0.45, -1.0), 52.0), ((-1
          ((-1.0, -0.7), 78.0))
 COVER_MAX = 0.15  # an object with more of its visible silhouette than this behind the robot is covered
 MIN_PIXELS = 12  # an object showing fewer pixels than this (shut in a cupboard) is not judged in a view
+TOP_EDGE_RAYS = 65  # rays tested along the top edge of a candidate view (every 5 px at 320 px wide)
 HIDDEN_GROUP = 5  # geom group used to hide the robot in the second segmentation render
 
 
@@ -81,12 +82,13 @@ def front_views(boxes, aspect: float) -> list[tuple[np.ndarray, list[float]]]:
 
 
 def top_edge_meets_wall(eye, xyaxes, aspect: float) -> bool:
-    """Do the rays through the top corners and top middle of a view hit a wall before the floor?"""
+    """Do the rays through the top edge of a view (``TOP_EDGE_RAYS`` of them, corners included) hit a
+    wall before the floor? The walls' corner is the farthest point: a view may see floor just there."""
     from anomalygen.scene.walls import WALL_X, WALL_Y
 
     x, y = np.asarray(xyaxes[:3]), np.asarray(xyaxes[3:])
     tan_v = math.tan(math.radians(CAMERA_FOVY) / 2)
-    for side in (-1.0, 0.0, 1.0):
+    for side in np.linspace(-1.0, 1.0, TOP_EDGE_RAYS):
         d = -np.cross(x, y) + tan_v * y + side * tan_v * aspect * x
         floor = -eye[2] / d[2] if d[2] < 0 else math.inf
         wall = min((WALL_X - eye[0]) / d[0] if d[0] > 0 else math.inf, (WALL_Y - eye[1]) / d[1] if d[1] > 0 else math.inf)

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-WALL_X = 2.9  # m: the back wall's inner face (x): the far edge of the floor area the layout uses (layout.ROOM_CENTER + ROOM_HALF)
-WALL_Y = 2.0  # m: the side wall's inner face (y): likewise
+WALL_X = 3.2  # m: the back wall's inner face (x): where the layout's floor area ended before walls (ROOM_CENTER + ROOM_HALF + 0.3)
+WALL_Y = 2.3  # m: the side wall's inner face (y): likewise, so every layout drawn before walls still fits
 WALL_THICK = 0.12  # m
 WALL_MIN_HEIGHT = 2.6  # m: a room's height; taller when a camera sits higher (the background stays wall)
 WALL_REACH = 12.0  # m: how far the walls run away from the corner (past every camera's view)
