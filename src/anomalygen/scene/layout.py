@@ -227,6 +227,13 @@ class Layout:
             if not self.collides(obj):
                 obj.support = "floor" if bottom <= 0.0 else "wall"
                 self.items.append(obj)
+                want = self.preferred.get(obj.name)
+                if want is not None:  # an engine's floor spot: said, not silently dropped
+                    got = obj.world_center()[:2]
+                    self.corrections.append(ValidationCheck(
+                        name=f"position:{obj.name}", passed=True, value=round(float(np.linalg.norm(got - want)), 4),
+                        detail=f"proposed at ({want[0]:.2f}, {want[1]:.2f}); a {obj.catalogue} is mounted in a wall: "
+                               f"the {wall} wall at ({got[0]:.2f}, {got[1]:.2f})"))
                 return wall
         raise ItemFailed(f"no free spot in a wall for {obj.name}")
 
