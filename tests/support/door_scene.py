@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from anomalygen.scene.compose import look_at_xyaxes
+from anomalygen.scene.viewpoint import look_at_xyaxes
 
 TIMESTEP = 0.005
 

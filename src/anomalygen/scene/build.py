@@ -35,6 +35,7 @@ from anomalygen.knowledge import load_kb
 from anomalygen.rng import item_rng, stable_hash
 from anomalygen.robot.agent import Agent
 from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
+from anomalygen.scene import viewpoint
 from anomalygen.scene.casting import bind_roles, select_objects, set_initial_joints
 from anomalygen.scene.cavities import placed_cavities
 from anomalygen.scene.compose import compose_scene, hold_gravity_hinges, latch_switched_on, set_joints
@@ -73,6 +74,7 @@ class Built:
     report: ValidationReport
     graph: object
     intents: dict = field(default_factory=dict)  # instance -> referee.truth.Intent of the judgement mix
+    views: list = field(default_factory=list)  # the front camera's candidate views (viewpoint.front_views)
 
 
 def _plan(task: TaskProposal, settings: Settings, rng, hints=None,
@@ -103,7 +105,7 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
     hints = hints.model_copy(deep=True) if hints is not None else None  # each attempt records its own
     lay, bindings, placed = _plan(task, settings, rng, hints, hazard_free)
     notes = _hint_notes(hints, lay)
-    mjspec = compose_scene(lay, placed, settings, rng)
+    mjspec, views = compose_scene(lay, placed, settings, rng)
     model = mjspec.compile()
     data = mujoco.MjData(model)
     hold_gravity_hinges(model, placed, mjspec)
@@ -115,7 +117,7 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
     overlap = val.initial_overlap(model, data, spec)
     if overlap is not None:
         report = ValidationReport(ok=False, reason=overlap, checks=notes)
-        return Built(spec, mjspec, model, data, report, None)
+        return Built(spec, mjspec, model, data, report, None, views=views)
     nsteps = max(1, int(round(settings.build.settle_s / model.opt.timestep)))
     mujoco.mj_step(model, data, nstep=nsteps)
     if val.max_loose_speed(model, data, placed) > val.MAX_LIN_VEL:
@@ -132,7 +134,8 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
     if hazard_free and report.ok:
         report = check_hazard_free(report, graph, task.hazard_class)
     report.checks = notes + report.checks
-    return Built(spec, mjspec, model, data, report, graph, {p.name: p.intent for p in placed.values() if p.intent})
+    return Built(spec, mjspec, model, data, report, graph, {p.name: p.intent for p in placed.values() if p.intent},
+                 views)
 
 
 def _hint_notes(hints, lay: Layout) -> list[ValidationCheck]:
@@ -284,8 +287,17 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_cla
         key.mpos = data.mocap_pos.flatten().copy()
         key.mquat = data.mocap_quat.flatten().copy()
     files = {"xml": "scene.xml", "spec": "scene.json", "graph": "scene_graph.json"}
-    _write_xml(mjspec, out_dir)
     with SceneRenderer(model, settings.build.render_width, settings.build.render_height) as r:
+        if built.views:
+            view, worst = viewpoint.choose_front_view(r, model, data, mjspec, [o.name for o in built.spec.objects],
+                                                      built.views)
+            built.report.checks.append(ValidationCheck(
+                name="front_view", passed=True, value=round(worst, 4),
+                detail=f"view {view} of {len(built.views)}: the robot covers at most {worst:.0%} of any object"))
+        fault = at_fault(built.spec.bindings)
+        if fault is not None:  # the answer key stays on the builder's side: scene.json's report
+            built.report.checks.extend(viewpoint.fault_coverage(r, model, data, fault))
+        _write_xml(mjspec, out_dir)  # after the front view is chosen
         for cam in CAMERAS:
             atomic_write_bytes(out_dir / f"render_{cam}.png", png_bytes(r.render(data, cam)))
             files[f"render_{cam}"] = f"render_{cam}.png"
@@ -294,6 +306,11 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_cla
     write_model(out_dir / TRUTH_FILE, hazard_manifest(spec, hazard_class, built.graph, load_kb(), built.intents))
     write_model(out_dir / "scene.json", spec)  # last: its presence marks the scene done
     return spec
+
+
+def at_fault(bindings: dict[str, str]) -> str | None:
+    """The object at fault: the hazard, else the target (a window left open); None when hazard-free."""
+    return bindings.get("$hazard") or bindings.get("$target")
 
 
 def _write_xml(mjspec, out_dir: Path) -> None:

@@ -12,35 +12,33 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from anomalygen.robot.agent import Agent
-from anomalygen.scene import furniture, layout
+from anomalygen.scene import furniture, layout, viewpoint, walls
 from anomalygen.scene.graph import FLOOR_GEOM
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.sensors import add_observation_sensors
 from anomalygen.scene.states import geoms_below, show_states
+from anomalygen.scene.viewpoint import CAMERA_FOVY, FRAME_TOP
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
 
 
 LOOSE_SOLREF = 0.005  # s: contact time constant of loose objects (2.5 physics steps)
-CAMERA_FOVY = 55.0  # degrees, both room cameras
-FRAME_MARGIN = 0.1  # m of floor kept around the objects' footprints in the room cameras
-FRAME_TOP = 1.0  # m: the room cameras see the furnished floor whole up to this height (table and counter tops)
-FOCUS_HEIGHT = 0.4  # m: the cameras aim at this height above the middle of the furnished floor
-FRONT_PITCH = math.radians(45)  # the front camera looks down this much
-VIEW_FROM = np.array([-1.0, -0.7])  # horizontal direction from the room's middle to the front camera
+FLOOR_TILE = 1.6  # m: one repeat of the floor's checker texture (two tiles)
+WALL_ABOVE_EYE = 0.3  # m: walls rise this far above the highest front view, so no view sees over them
 
 
-def look_at_xyaxes(eye, target) -> list[float]:
-    """Camera xyaxes (MuJoCo cameras look along -z) for a camera at ``eye`` looking at ``target``."""
-    fwd = np.asarray(target, float) - np.asarray(eye, float)
-    fwd /= np.linalg.norm(fwd)
-    right = np.cross(fwd, [0.0, 0.0, 1.0])
-    if np.linalg.norm(right) < 1e-6:
-        right = np.array([0.0, -1.0, 0.0])
-    right /= np.linalg.norm(right)
-    up = np.cross(right, fwd)
-    return [*right.tolist(), *up.tolist()]
+def wall_openings(placed) -> list[walls.Opening]:
+    """The holes the walls need behind the windows and doors mounted in them."""
+    out = []
+    for p in placed:
+        if walls.mount_height(p.catalogue) is None:
+            continue
+        lo, hi = p.footprint()
+        side = walls.wall_of(lo, hi)
+        if side is not None:
+            out.append(walls.opening_for(side, lo, hi, p.catalogue))
+    return out
 
 
 def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rng):
@@ -62,10 +60,12 @@ def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rn
         width=256,
         height=256,
     )
-    mat = spec.add_material(name="floor_mat", texrepeat=[6, 6], reflectance=0.05)
+    mat = spec.add_material(name="floor_mat", texrepeat=[walls.WALL_REACH / FLOOR_TILE] * 2, reflectance=0.05)
     mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = tex.name
-    center = layout.ROOM_CENTER
-    half = layout.ROOM_HALF + 0.6
+    # the floor ends at the walls' faces (through a window one sees the ground outside, not the floor)
+    # and runs the other way as far as they do
+    half = np.full(2, walls.WALL_REACH / 2)
+    center = np.array([walls.WALL_X, walls.WALL_Y]) - half
     spec.worldbody.add_geom(
         name=FLOOR_GEOM,
         type=mujoco.mjtGeom.mjGEOM_PLANE,
@@ -73,24 +73,9 @@ def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rn
         pos=[center[0], center[1], 0],
         material="floor_mat",
     )
-    wall_rgba = [0.86, 0.85, 0.8, 1]
-    spec.worldbody.add_geom(
-        name="wall_back",
-        type=mujoco.mjtGeom.mjGEOM_BOX,
-        size=[0.05, half[1], 1.3],
-        pos=[center[0] + half[0] + 0.05, center[1], 1.3],
-        rgba=wall_rgba,
-    )
-    spec.worldbody.add_geom(
-        name="wall_left",
-        type=mujoco.mjtGeom.mjGEOM_BOX,
-        size=[half[0], 0.05, 1.3],
-        pos=[center[0], center[1] + half[1] + 0.05, 1.3],
-        rgba=wall_rgba,
-    )
     spec.worldbody.add_light(
         name="sun",
-        pos=[center[0], center[1], 3.5],
+        pos=[layout.ROOM_CENTER[0], layout.ROOM_CENTER[1], 3.5],
         dir=[0.2, 0.1, -1],
         type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
         diffuse=[0.6, 0.6, 0.6],
@@ -101,7 +86,8 @@ def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rn
         name="fill", pos=[-1.0, -1.0, 2.5], dir=[0.5, 0.4, -0.6], diffuse=[0.35, 0.35, 0.35], castshadow=False
     )
 
-    add_room_cameras(spec, list(placed.values()), settings.build.render_width / settings.build.render_height)
+    views = add_room_cameras(spec, list(placed.values()), settings.build.render_width / settings.build.render_height)
+    walls.emit_walls(spec, wall_openings(placed.values()), max(eye[2] for eye, _ in views) + WALL_ABOVE_EYE)
 
     objects = sorted(placed.values(), key=lambda p: p.name)  # name order: no role shows in the model
     loose, parts = [], []
@@ -137,40 +123,30 @@ def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rn
         [f"{p.name}/{j.name}" for p in objects if p.asset is not None for j in p.asset.joints],
     )
     spec.add_key(name="init")
-    return spec
+    return spec, views
 
 
-def add_room_cameras(spec, objects: list[Placed], aspect: float) -> None:
+def add_room_cameras(spec, objects: list[Placed], aspect: float) -> list:
     """The ``front`` and ``top`` cameras, framed on the furnished part of the room: the box around
-    every object's footprint, each object alike, up to ``FRAME_TOP`` high.
+    every object's footprint, each object alike, up to ``FRAME_TOP`` high; returns the front camera's
+    candidate views (``viewpoint.front_views``; it starts at the first).
 
     Why not the task's objects: cameras aimed at their mean pointed the robot at the hazard. The
-    front camera looks in from the room's open corner (the walls stand at +x and +y), pitched down
-    ``FRONT_PITCH``, just far enough back for the box to fit its view (``aspect``: width / height);
-    the top camera looks straight down from just high enough."""
+    front camera looks in from the room's open corner at the walls (at +x and +y), just far enough
+    back for the box to fit its view (``aspect``: width / height); the top camera looks straight down
+    from just high enough."""
     boxes = [p.footprint() for p in objects] or [(np.r_[layout.ROOM_CENTER - 1.0, 0.0], np.r_[layout.ROOM_CENTER + 1.0, 1.0])]
-    lo = np.min([b[0][:2] for b in boxes], axis=0) - FRAME_MARGIN
-    hi = np.max([b[1][:2] for b in boxes], axis=0) + FRAME_MARGIN
-    focus = np.r_[(lo + hi) / 2, FOCUS_HEIGHT]
-    tan_v = math.tan(math.radians(CAMERA_FOVY) / 2)
-    tan_h = tan_v * aspect
-    away = VIEW_FROM / np.linalg.norm(VIEW_FROM)
-    fwd = -np.r_[away * math.cos(FRONT_PITCH), math.sin(FRONT_PITCH)]
-    right = np.cross(fwd, [0.0, 0.0, 1.0])
-    right /= np.linalg.norm(right)
-    up = np.cross(right, fwd)
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (0.0, FRAME_TOP)]) - focus
-    # a point stays in view when its sideways and upward offsets fit the view's half-angles at its
-    # depth; the depth grows one for one as the eye moves back along the viewing direction
-    depth = corners @ fwd
-    back = max(float(np.max(np.abs(corners @ right) / tan_h - depth)), float(np.max(np.abs(corners @ up) / tan_v - depth)))
-    eye = focus - fwd * back
-    spec.worldbody.add_camera(name="front", pos=eye.tolist(), xyaxes=look_at_xyaxes(eye, focus), fovy=CAMERA_FOVY)
+    views = viewpoint.front_views(boxes, aspect)
+    eye, xyaxes = views[0]
+    spec.worldbody.add_camera(name="front", pos=eye.tolist(), xyaxes=xyaxes, fovy=CAMERA_FOVY)
     # top view: image up is world +x, image right is world -y
+    lo, hi = viewpoint.frame_box(boxes)
+    tan_v = math.tan(math.radians(CAMERA_FOVY) / 2)
     half = (hi - lo) / 2
-    top = max(half[0] / tan_v, half[1] / tan_h) + FRAME_TOP
-    top_eye = np.array([focus[0], focus[1] - 0.01, top])
+    top = max(half[0] / tan_v, half[1] / (tan_v * aspect)) + FRAME_TOP
+    top_eye = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2 - 0.01, top])
     spec.worldbody.add_camera(name="top", pos=top_eye.tolist(), xyaxes=[0, -1, 0, 1, 0, 0], fovy=CAMERA_FOVY)
+    return views
 
 
 def _articulated_bodies(body) -> list[str]:

@@ -20,6 +20,7 @@ import numpy as np
 from anomalygen.errors import ItemFailed
 from anomalygen.robot.agent import Agent
 from anomalygen.scene.furniture import Support
+from anomalygen.scene.walls import WALL_GAP, WALL_X, WALL_Y, mount_height
 from anomalygen.schema import ObjectRole, ValidationCheck
 
 REGION_ORIGIN = np.array([0.8, -0.6, 0.0])  # world position of the cube corner (0, 0, 0)
@@ -31,6 +32,7 @@ EDGE_BAND = (0.015, 0.07)  # metres from the edge for *_edge placements (KB thre
 WALKWAY_CLEAR = 0.42  # > the KB's 0.3 m walkway clearance, with margin
 TUCK_GAP = (0.03, 0.12)  # metres from a fixture's side for an item tucked out of the walkway (KB: 0.3)
 TRIES = 60
+WALL_SPAN = {"back": (-1.0, WALL_Y - 0.4), "side": (0.6, WALL_X - 0.4)}  # m along each wall where mounted objects go (not in the corner)
 # Clearance kept round the robot at its start pose (its shape is the agent's: BASE_RADIUS, HOME_ARM_BOXES)
 BASE_CLEAR_TOP = 0.35  # m: a box whose bottom is lower than this (the base's 0.30 m top, plus 5 cm) can hit the base
 BASE_CLEAR_SIDE = 0.08  # m kept between such a box and the base disc
@@ -140,10 +142,8 @@ class Layout:
     # ---------------------------------------------------------------- checks
     def collides(self, obj: Placed, *, ignore: tuple[str, ...] = ()) -> bool:
         box = obj.footprint()
-        if np.any(box[0][:2] < ROOM_CENTER - ROOM_HALF - 0.3) or np.any(
-            box[1][:2] > ROOM_CENTER + ROOM_HALF + 0.3
-        ):
-            return True
+        if np.any(box[0][:2] < ROOM_CENTER - ROOM_HALF - 0.3) or np.any(box[1][:2] > self.walls()):
+            return True  # off the floor, or into a wall
         zone = obj.footprint(swing=True)
         for other in self.items:
             if other.name in ignore or other.name == obj.name:
@@ -151,6 +151,11 @@ class Layout:
             if overlaps(zone, other.footprint()) or overlaps(box, other.footprint(swing=True)):
                 return True
         return self._hits_base(box)
+
+    @staticmethod
+    def walls() -> np.ndarray:
+        """The walls' inner faces (x of the back wall, y of the side wall): a footprint ends at them."""
+        return np.array([WALL_X, WALL_Y])
 
     def _hits_base(self, box) -> bool:
         """Does a world AABB intrude on the robot: its base disc, or the arm's box at the home pose?"""
@@ -176,7 +181,11 @@ class Layout:
         """Stand ``obj`` on the floor at a proposal that overlaps nothing (furniture faces the robot).
 
         A preferred position is tried first; if it overlaps, the solver falls back on its own draws
-        and records the move."""
+        and records the move. A window or door is mounted in a wall instead (``place_on_wall``)."""
+        bottom = mount_height(obj.catalogue)
+        if bottom is not None and obj.fixed and obj.support_geom is None:
+            self.place_on_wall(obj, bottom)
+            return
         want = self.preferred.get(obj.name)
         for attempt in range(2 * TRIES):
             # a crowded cube: fall back to anywhere in the room rather than fail the scene
@@ -205,6 +214,35 @@ class Layout:
                     self._record_preferred(obj, want, moved=attempt > 0)
                 return
         raise ItemFailed(f"no free floor spot for {obj.name}")
+
+    def place_on_wall(self, obj: Placed, bottom: float) -> str:
+        """Mount ``obj`` (a window, a door) in the back or side wall, its front into the room and its
+        bottom ``bottom`` above the floor; returns the wall ("back" or "side")."""
+        for _ in range(TRIES):
+            wall = "back" if self.rng.random() < 0.5 else "side"
+            obj.yaw = face_robot_yaw(obj.front, np.array([-1.0, 0.0]) if wall == "back" else np.array([0.0, -1.0]))
+            half = obj.world_half()
+            lo_a, hi_a = WALL_SPAN[wall][0] + half[1 - (wall == "side")], WALL_SPAN[wall][1] - half[1 - (wall == "side")]
+            if hi_a < lo_a:
+                continue
+            center = np.zeros(2)
+            axis = 0 if wall == "back" else 1  # the wall's normal
+            center[axis] = (WALL_X if wall == "back" else WALL_Y) - WALL_GAP - half[axis]
+            center[1 - axis] = self.rng.uniform(lo_a, hi_a)
+            obj.pos = np.array([0.0, 0.0, bottom - obj.lo[2]])
+            obj.pos[:2] = center - (obj.world_center()[:2] - obj.pos[:2])
+            if not self.collides(obj):
+                obj.support = "floor" if bottom <= 0.0 else "wall"
+                self.items.append(obj)
+                want = self.preferred.get(obj.name)
+                if want is not None:  # an engine's floor spot: said, not silently dropped
+                    got = obj.world_center()[:2]
+                    self.corrections.append(ValidationCheck(
+                        name=f"position:{obj.name}", passed=True, value=round(float(np.linalg.norm(got - want)), 4),
+                        detail=f"proposed at ({want[0]:.2f}, {want[1]:.2f}); a {obj.catalogue} is mounted in a wall: "
+                               f"the {wall} wall at ({got[0]:.2f}, {got[1]:.2f})"))
+                return wall
+        raise ItemFailed(f"no free spot in a wall for {obj.name}")
 
     def place_beside(self, obj: Placed, fixtures: list[Placed]) -> None:
         """Stand a loose object on the floor against the side of a piece of furniture, out of the walkway.

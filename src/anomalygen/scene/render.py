@@ -92,6 +92,31 @@ class SceneRenderer:
             mujoco.mjr_readPixels(rgb, None, self.viewport, self.con)
         return np.flipud(rgb).copy()
 
+    def segment(self, data: mujoco.MjData, camera: str | int, *, hide_group: int | None = None) -> np.ndarray:
+        """Geom id per pixel (height, width; -1 where no geom is seen) from a named fixed camera;
+        ``hide_group``: geoms of that group are left out."""
+        import mujoco
+
+        flags = (mujoco.mjtRndFlag.mjRND_SEGMENT, mujoco.mjtRndFlag.mjRND_IDCOLOR)
+        groups = self.option.geomgroup.copy()
+        for f in flags:
+            self.scene.flags[f] = 1
+        if hide_group is not None:
+            self.option.geomgroup[hide_group] = 0
+        try:
+            rgb = self.render(data, camera).astype(np.int64)
+        finally:
+            for f in flags:
+                self.scene.flags[f] = 0
+            self.option.geomgroup[:] = groups
+        seg = rgb[..., 0] + (rgb[..., 1] << 8) + (rgb[..., 2] << 16) - 1  # index into the scene's geoms
+        lookup = np.full(self.scene.ngeom + 1, -1, dtype=np.int64)
+        for i in range(self.scene.ngeom):
+            g = self.scene.geoms[i]
+            if g.objtype == mujoco.mjtObj.mjOBJ_GEOM:
+                lookup[i] = g.objid
+        return lookup[np.clip(seg, -1, self.scene.ngeom - 1)]
+
     def close(self) -> None:
         if self.con is not None:
             with _LOCK:

@@ -104,7 +104,7 @@ class PlacedObject(Artefact):
     size: float = Field(gt=0, description="largest dimension in metres")
     pos: Vec3
     quat: Quat = Field(default_factory=lambda: [1.0, 0.0, 0.0, 0.0])
-    support: str = Field("floor", description="floor, or '<instance>' / '<instance>:<surface>' it rests on")
+    support: str = Field("floor", description="floor, wall (a window mounted in a wall), or '<instance>' / '<instance>:<surface>' it rests on")
     inside: str | None = Field(None, description="instance it is contained in, if any")
     joint_states: list[JointState] = Field(default_factory=list)
     fixed: bool = Field(False, description="welded to the world (furniture) rather than free")
