@@ -79,7 +79,7 @@ def tasks():
     from anomalygen.knowledge import load_kb
 
     out = {}
-    for line, _, _ in COMBOS:  # one file per line: a task's id (and so its scene) does not move with the list
+    for line, _, _ in (getattr(c, "values", c) for c in COMBOS):  # one file per line: a task's id (and so its scene) does not move with the list
         (out[line],), errors = tasks_from_lines([line], load_kb())
         assert errors == {}
     for cls, obj, placement, container in STORED:
