@@ -24,12 +24,13 @@ def _task(tid, target, hazard, placement, states=None, *, arts=(), room="kitchen
 
 
 TASKS = {
-    "stove": _task("w-stove", "Stove", "towel", "on:Stove", {"Stove": ["lit"]}),
+    # a kitchen has a counter beside the stove: the towel needs somewhere safe to go
+    "stove": _task("w-stove", "Stove", "towel", "on:Stove", {"Stove": ["lit"]}, co=["counter"]),
     "devices": _task("w-devices", "SpaceHeater", "SpaceHeater", "floor",
                      {"SpaceHeater": ["on"], "PowerStrip": ["on"], "hair_dryer": ["on"]}, room="bedroom",
                      co=["Curtains", "PowerStrip", "hair_dryer"]),
     "candle": _task("w-candle", "candle", "candle", "table", {"candle": ["lit"], "iron": ["on"]}, room="living_room",
-                    co=["Curtains", "iron"]),
+                    co=["Curtains", "iron", "StorageFurniture"]),
     "pan": _task("w-pan", "Stove", "frying_pan", "on:Stove", {"frying_pan": ["handle_out"]}),
     "gate": _task("w-gate", "Stairs", "toy_car", "floor", arts=[("BabyGate", "gate", "open")], room="hallway",
                   co=["BabyGate"]),
@@ -147,7 +148,7 @@ def test_candle_put_out_moved_away_from_the_curtains_and_iron_off(built, tmp_pat
     assert _off(final, candle) and _off(final, iron)
     assert gap(final) >= distance - 0.01
     (holder,) = _on(final, candle)
-    assert final.get(holder).category == "Table" and not final.get(candle).on_floor
+    assert final.get(holder).category in ("Table", "StorageFurniture") and not final.get(candle).on_floor
     assert final.get(candle).size[2] > final.get(candle).size[0]  # standing, not knocked over
 
 

@@ -10,8 +10,9 @@ cost minutes per control), and ``anomalygen.referee.judge`` judges the settled e
 
 Each test builds its own scene (about a second; a scene that cannot be built fails its test alone).
 
-Left out, each for a real reason (see the issue): a power strip *in* a full sink (the detector ranks
-``move_electrical_away_from_water`` first and no safe support stands 0.6 m from the sink), a pan
+Left out, each for a real reason (see the issue): a power strip *in* a full sink (the detector ranked
+``move_electrical_away_from_water`` first, and no safe support stands 0.6 m from the sink; the near-water
+rule no longer fires on a thing inside the water, and the combo has not been tried again since), a pan
 handle turned inward (a heavy pan on a hob stays within 0.12 m of its edge, so
 ``move_heavy_from_edge`` fires), a ball in the crib (it settles inside, not on, so ``$crib`` is
 unbound), a dumbbell taken down off a shelf (it rolls to the table's edge), a toy car near the crib

@@ -27,6 +27,7 @@ from anomalygen.schema import (
 #: Top-surface heights (m) per placement, inside the knowledge base's SUPPORT_HEIGHTS ranges.
 SURFACE_TOP = {"table": 0.75, "table_edge": 0.75, "counter": 0.9, "counter_edge": 0.9, "shelf": 1.4, "low_table": 0.42}
 EDGE_GAP = 0.04  # distance to the edge for *_edge placements (m)
+CLUTTER_X = (0.08, 0.64, -0.2, 1.2, 0.36, 0.92)  # m: clutter spots along the counter (x -0.4..1.4), 0.28 m apart
 
 
 def _obj(name: str, category: str, props: list[str], *, pos, size, height: float, on_floor: bool,
@@ -59,11 +60,12 @@ def furniture(kb) -> list[GraphObject]:
 
 
 def clutter(kb, n: int) -> tuple[list[GraphObject], list[Relation]]:
-    """``n`` benign objects (no hazard property) resting on the table and counter, away from edges."""
+    """``n`` benign objects (no hazard property) resting along the counter, away from its edges and more
+    than any class's ``near`` limit from the hazards (which stand by the table and the room's door side):
+    a blanket is benign alone but not beside a hot iron, and a loaf not beside a cleaner."""
     names = sorted(kb.benign_objects())
     objs, rels = [], []
-    spots = [(1.4, 0.35, 0.75, "table_0"), (1.8, 0.65, 0.75, "table_0"), (0.1, 1.6, 0.9, "counter_0"),
-             (0.9, 1.65, 0.9, "counter_0"), (1.5, 0.7, 0.75, "table_0"), (0.5, 1.55, 0.9, "counter_0")]
+    spots = [(x, 1.6, 0.9, "counter_0") for x in CLUTTER_X]
     for i in range(n):
         cat = names[(7 * i) % len(names)]
         x, y, top, support = spots[i % len(spots)]
@@ -74,6 +76,18 @@ def clutter(kb, n: int) -> tuple[list[GraphObject], list[Relation]]:
     return objs, rels
 
 
+#: Scenes of one class that are, by design, first a scene of another class on the same set-up, the
+#: severities settling it: (class, the placement's other object or None) -> (class ranked first, whose
+#: object it names: "hazard" or "other").
+RANKED_FIRST_BY_DESIGN: dict[tuple[str, str | None], tuple[str, str]] = {
+    # a hot iron face down is a heat tool left on: switching it off, a fix the robot has, ends both
+    ("stand_iron_upright", None): ("switch_off_heat_tool", "hazard"),
+    # paper by a heater or an iron that is on is the heater left on beside something that burns (0.96 over 0.95)
+    ("clear_burning_risk_near_heat_source", "iron"): ("switch_off_heater_near_fabric", "other"),
+    ("clear_burning_risk_near_heat_source", "SpaceHeater"): ("switch_off_heater_near_fabric", "other"),
+}
+
+
 @dataclass(frozen=True)
 class Case:
     hazard_class: str
@@ -81,6 +95,14 @@ class Case:
     placement: str
     graph: SceneGraph
     instance: str
+    ranked_first: str = ""  # the class the detector must name first: hazard_class unless set by design
+
+
+def _expected(hc_id: str, placement: str, inst: str) -> tuple[str, str]:
+    """(instance, class) the detector must rank first on a case's scene (RANKED_FIRST_BY_DESIGN)."""
+    parent = placement.partition(":")[2] or None
+    first, whose = RANKED_FIRST_BY_DESIGN.get((hc_id, parent), (hc_id, "hazard"))
+    return (f"{parent.lower()}_0" if whose == "other" and parent else inst), first
 
 
 def _hazard_objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObject], list[Relation], str]:
@@ -121,16 +143,94 @@ def _hazard_objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObject]
     return [o], [Relation(subject=name, predicate="on", object=support)], name
 
 
+PARENT_GAP = 0.1  # m between a 'near:<name>' hazard and that object, inside every class's near: limit
+SMALL_PARENT = 0.4  # m: a parent whose largest size is below this is a thing, not furniture (a magazine)
+
+
+def _parent(kb, parent: str) -> GraphObject:
+    """The object a composed placement names: furniture (the crib in ``near:Crib``) stands on the floor, a
+    small thing (the apple in ``near:apple``) on a shelf out of a child's reach, so only the class's own
+    mechanism is set up."""
+    info = kb.objects.get(parent)
+    if info is None or info.size_range[1] >= SMALL_PARENT:
+        return _obj(f"{parent.lower()}_0", parent, _props(kb, parent), pos=(1.0, -0.8, 0.45), size=(0.6, 0.6, 0.9),
+                    height=0.0, on_floor=True)
+    top = SURFACE_TOP["shelf"]
+    return _obj(f"{parent.lower()}_0", parent, _props(kb, parent), pos=(1.0, -0.8, top + 0.05), size=(0.2, 0.2, 0.1),
+                height=top, on_floor=False, edge=0.2)
+
+
+def _composed_objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObject], list[Relation], str] | None:
+    """A composed class's hazard with the other object its placement names (the crib beside a cable, the
+    sink a power strip lies in); None for a placement without one (the plain builder's spots)."""
+    kind, _, parent = placement.partition(":")
+    if not parent or (kind == "inside" and parent in ("Refrigerator", "StorageFurniture")):
+        return None
+    other = _parent(kb, parent)
+    name, props = f"{obj.lower()}_0", _props(kb, obj)
+    top = other.position[2] + other.size[2] / 2
+    x, y = other.position[0], other.position[1]
+    if kind == "on":
+        o = _obj(name, obj, props, pos=(x, y, top + 0.03), size=(0.1, 0.1, 0.06), height=top, on_floor=False, edge=0.2)
+        return [other, o], [Relation(subject=name, predicate="on", object=other.name)], name
+    if kind == "inside":
+        o = _obj(name, obj, props, pos=(x, y, top / 2), size=(0.1, 0.1, 0.06), height=top / 2, on_floor=False)
+        return [other, o], [Relation(subject=name, predicate="inside", object=other.name)], name
+    ox, base = x + other.size[0] / 2 + PARENT_GAP + 0.05, other.height_above_floor
+    o = _obj(name, obj, props, pos=(ox, y, base + 0.03), size=(0.1, 0.1, 0.06), height=base, on_floor=other.on_floor,
+             edge=None if other.on_floor else 0.2)
+    return [other, o], [], name
+
+
+def _set_up(kb, hc, objs: list[GraphObject], inst: str, placement: str) -> list[GraphObject]:
+    """What a composed class's scene must show beyond its objects: each object's own states (a candle is
+    lit), the mechanism's set-up states (a sink holds water), and the control its fix works left on."""
+    from anomalygen.knowledge.mechanisms import load_mechanisms, setup_states
+
+    ms = load_mechanisms()
+    place = ms.places.get(hc.composition.place)
+    relvar = place.relation.variable if place is not None and place.relation is not None else None
+    parent = placement.partition(":")[2]
+    names = {hc.hazard_variable: inst}
+    if relvar and parent:
+        names[relvar] = f"{parent.lower()}_0"
+    states = {names[v]: list(s) for v, s in setup_states(ms, hc).items() if v in names}
+    for call in hc.preconditions:  # switched on: by its control when the fix works one, else its states
+        var = call.args.get("object")
+        if call.name == "is_on" and not call.negate and var in names and (hc.articulation is None or hc.articulation.variable != var):
+            states.setdefault(names[var], []).append("on")
+    art = hc.articulation
+    out = []
+    for o in objs:
+        info = kb.objects.get(o.category)
+        extra = [*(info.states if info else []), *states.get(o.name, [])]
+        update: dict = {"states": sorted({*o.states, *extra})}
+        if art is not None and names.get(art.variable) == o.name and not o.joints:
+            label = part_labels.alternatives(art.part)[0]
+            frac = 0.8 if art.initial_state in ("open", "on") else 0.0
+            update["joints"] = [_joint(f"{o.name}_{label}", label, frac)]
+        out.append(o.model_copy(update=update))
+    return out
+
+
+def _objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObject], list[Relation], str]:
+    if hc.composition is None or hc.composition.legacy:
+        return _hazard_objects(kb, hc, obj, placement)
+    objs, rels, inst = _composed_objects(kb, hc, obj, placement) or _hazard_objects(kb, hc, obj, placement)
+    return _set_up(kb, hc, objs, inst, placement), rels, inst
+
+
 def cases(kb, *, n_clutter: int = 0) -> list[Case]:
     out = []
     extra, extra_rels = clutter(kb, n_clutter)
     for hc in sorted(kb.hazard_classes.values(), key=lambda h: h.id):
         for obj in kb.hazard_candidates(hc):
             for placement in kb.placements_for(hc, obj):
-                objs, rels, inst = _hazard_objects(kb, hc, obj, placement)
+                objs, rels, inst = _objects(kb, hc, obj, placement)
                 graph = SceneGraph(scene_id=f"{hc.id}-{obj}-{placement}", room="kitchen",
                                    objects=furniture(kb) + objs + extra, relations=rels + extra_rels)
-                out.append(Case(hc.id, obj, placement, graph, inst))
+                inst, first = _expected(hc.id, placement, inst)
+                out.append(Case(hc.id, obj, placement, graph, inst, first))
     return out
 
 
@@ -148,7 +248,7 @@ def sweep(kb=None, *, n_clutter: int = 0, k: int = 3) -> dict:
     failures = []
     for c in all_cases:
         got = [(h.target_object, h.hazard_class) for h in det.detect(c.graph, k)]
-        want = (c.instance, c.hazard_class)
+        want = (c.instance, c.ranked_first or c.hazard_class)
         top1 += bool(got) and got[0] == want
         topk += want in got
         if not got or got[0] != want:
