@@ -38,6 +38,9 @@ def group_table(title: str, columns: Sequence[str], rows: Mapping[str, Sequence[
         table.add_row(group, *((totals or {}).get(group) or blank), style="bold cyan")
         for member, cells in members:
             table.add_row(INDENT + member, *cells)
+    every = [*(cells for members in rows.values() for _, cells in members), *(totals or {}).values(), overall or []]
+    for i, col in enumerate(table.columns[1:]):  # a figure stays on one line ("2/3 (67%)"); headers fold
+        col.min_width = max((len(str(cells[i])) for cells in every if cells and i < len(cells)), default=0)
     return table
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 
 from anomalygen.knowledge import HazardClass, KnowledgeBase
+from anomalygen.schema import part_labels
 
 
 @functools.cache
@@ -63,8 +64,9 @@ def asset_parts(obj: str) -> frozenset[str]:
 def has_part(obj: str, part: str) -> bool:
     """Does the asset have a joint for ``part`` ('knob|switch': either; a button is a switch)?"""
     wanted = part.split("|")
-    if any(w in ("knob", "switch") for w in wanted):
-        wanted = [*wanted, "knob", "switch"]
+    either = (part_labels.KNOB, part_labels.SWITCH)
+    if any(w in either for w in wanted):
+        wanted = [*wanted, *either]
     return bool(set(wanted) & asset_parts(obj))
 
 

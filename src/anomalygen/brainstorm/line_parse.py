@@ -13,6 +13,7 @@ import re
 from dataclasses import dataclass, field
 
 from anomalygen.knowledge.grounding import NameGrounder, singular
+from anomalygen.schema import part_labels
 
 _WORD = re.compile(r"[a-z0-9]+(?:'[a-z]+)?|[,.;:!?]")
 
@@ -55,8 +56,8 @@ NOT_OBJECTS = frozenset({
     "morning", "evening", "time", "while", "way", "path", "walkway", "doorway", "corridor", "thing", "things", "stuff",
     "lot", "pair", "bunch", "pile", "set", "piece", "couple", "bit", "handful", "few", "hand", "hands", "fingers",
     "lunch", "dinner", "breakfast", "use", "water", "heat", "fire", "flame", "flames", "fumes", "smoke", "air", "risk",
-    "hazard", "danger", "level", "area", "spot", "place", "position", "wall", "window sill", "sill", "handle", "lid",
-    "door", "drawer", "knob", "switch", "tap", "plug", "outlet", "socket", "cord", "cable", "shelf", "one", "ones",
+    "hazard", "danger", "level", "area", "spot", "place", "position", "wall", "window sill", "sill", "handle",
+    part_labels.LID, part_labels.DOOR, part_labels.DRAWER, part_labels.KNOB, part_labels.SWITCH, part_labels.TAP, "plug", "outlet", "socket", "cord", "cable", "shelf", "one", "ones",
     "inch", "inches", "foot", "feet", "metre", "metres", "meter", "meters", "cm", "little",
 })
 #: Catalogue names that, right after another name, are a part of it ("fridge door", "toilet lid").

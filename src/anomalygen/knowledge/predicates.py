@@ -18,15 +18,12 @@ from collections.abc import Callable
 from pydantic import BaseModel, ConfigDict
 
 from anomalygen.knowledge.models import PredicateSpec
-from anomalygen.schema import CLOSED_TOL, GraphObject, PredicateCall, PredicateResult, SceneGraph
+from anomalygen.schema import CLOSED_TOL, GraphObject, PredicateCall, PredicateResult, SceneGraph, part_labels
 
 #: Horizontal clearance (m) from furniture/appliances beyond which a floor object is "in the walkway".
 WALKWAY_CLEARANCE = 0.3
 #: Properties of the objects that line a room (a floor object close to one of them is out of the way).
 ROOM_FIXTURES = ("furniture", "appliance")
-#: Joint labels of the controls that switch something on (a tap runs water). Until one part-label
-#: table owns these words, the list lives here and in detect/observation.py.
-SWITCH_LABELS = ("knob", "switch", "button", "dial", "tap", "faucet")
 #: Open fraction of a control from which it counts as on (``switch_off_appliance`` uses the same 0.5).
 ON_FRACTION = 0.5
 #: Instance states that say a control-less thing is on (a lit candle).
@@ -326,7 +323,7 @@ def _has_state(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
 )
 def _is_on(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
     obj = ctx.obj(call)
-    controls = [j for j in obj.joints if j.label in SWITCH_LABELS]
+    controls = [j for j in obj.joints if part_labels.is_switch(j.label)]  # a tap runs water
     if controls:
         best = max(controls, key=lambda j: j.open_fraction)
         return best.open_fraction >= ON_FRACTION, f"{obj.name} {best.label} is {best.open_fraction:.0%} on"
