@@ -193,6 +193,22 @@ def joints_with_label(asset, label: str) -> list:
     return [j for j in asset.joints if part_labels.canonical(j.label) in wanted]
 
 
+def wants_handle_out(task: TaskProposal, catalogue: str, hc) -> bool:
+    """Does the task ask the object at fault to have its handle out (a pan on the hob)?"""
+    from anomalygen.scene.states import HANDLE_OUT
+
+    asked = HANDLE_OUT in task.scenario.states.get(catalogue, [])
+    return asked or (hc is not None and any(
+        c.name == "has_state" and not c.negate and c.args.get("state") == HANDLE_OUT for c in hc.preconditions))
+
+
+def has_long_handle(asset) -> bool:
+    """Only a variant with a long handle can have it stick out (some pots have two side grips)."""
+    from anomalygen.scene.states import HANDLE_GEOM, geoms_below
+
+    return any(g.name == HANDLE_GEOM for g in geoms_below(asset.spec.worldbody))
+
+
 def pick_asset(
     catalogue: str,
     *,
@@ -216,6 +232,7 @@ def pick_asset(
     from anomalygen.assets.core import draw, generate
 
     parts = needed_parts(task, catalogue, hc)
+    handle = role is ObjectRole.HAZARD and wants_handle_out(task, catalogue, hc)
     n = TARGET_CANDIDATES if rank else 2
     seeds = [int(s) for s in rng.integers(0, 2**31 - 1, size=n)]
     candidates, problems = [], []
@@ -223,6 +240,8 @@ def pick_asset(
         want = choose_size(kb, catalogue, rng, cap=cap, preferred=size)
         asset = draw(catalogue, s, size=want, real=real)
         problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap)
+        if problem is None and handle and not has_long_handle(asset):
+            problem = f"{catalogue} candidate has no long handle to stick out"
         if problem is None and asset.package is not None and room_for and asset.cavities \
                 and cavity_cap(asset) < room_for:
             problem = f"its interior takes {cavity_cap(asset):.2f} m, less than the {room_for:.2f} m to go in"
@@ -230,6 +249,8 @@ def pick_asset(
             problems.append(f"real model {asset.asset_id}: {problem}")
             asset = generate(catalogue, s, size=want)
             problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap)
+            if problem is None and handle and not has_long_handle(asset):
+                problem = f"{catalogue} candidate has no long handle to stick out"
         if problem is None:
             candidates.append(asset)
         else:
