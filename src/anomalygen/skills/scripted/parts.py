@@ -218,6 +218,51 @@ def _joint_of(m, joint: str) -> tuple[int, int, bool]:
     return j, int(m.jnt_qposadr[j]), bool(m.jnt_type[j] == HINGE)
 
 
+BASE_IN_FRONT = 0.10  # m the base's centre stands in front of a steep face's plane for the arm to come at it
+
+
+def _faces_base(ep: Episode, g: PartGrasp) -> bool:
+    """Does the arm come at the face from the side it looks to? A steep face whose plane the base
+    stands behind (a lid leaning back past upright, its outer face towards a wall) is reached only
+    by wrapping the arm round the panel, and the arm sweeping past shoves it open on its stop,
+    which tips a light box over backwards."""
+    p, n = _world(ep, g)
+    if abs(n[2]) >= 0.5 or np.linalg.norm(n[:2]) < 1e-6:
+        return True
+    base = ep.driver.agent.base_pose(ep.driver.data)[:2]
+    return float(np.dot(base - p[:2], n[:2] / np.linalg.norm(n[:2]))) > BASE_IN_FRONT
+
+
+def _place_base_for(ep: Episode, joint: str, g: PartGrasp, goal: float, closed: float) -> tuple[float, bool]:
+    """(where the drive stops for this face, whether a base pose was found): the base faces the middle
+    of the arc still to go, on the side the face looks to."""
+    from anomalygen.robot.ik import quat_z_to
+
+    drv = ep.driver
+    m, d = drv.model, drv.data
+    _, adr, hinge = _joint_of(m, joint)
+    q = float(d.qpos[adr])
+    stop = goal
+    if not g.outer and hinge and abs(goal - closed) < INNER_FACE_STOP:
+        stop = closed + np.sign(q - closed) * INNER_FACE_STOP
+    p, n = _world(ep, g)
+    r, t = part_transform(ep, joint, (stop - q) / 2)
+    mid = r @ p + t
+    side = n if np.linalg.norm(n[:2]) > 0.3 else None
+    reach = [(p + n * PRE_CONTACT, quat_z_to(-n))]
+    arc = []
+    if g.lid:  # the cup turns with a lid: a base from which the arm follows the arc to its end, cup
+        # on the face all the way (from the free edge's side the wrist cannot tip back far enough and
+        # presses on the lid; from the hinge axis's end it is a roll of the wrist)
+        for f in (0.5, 1.0):
+            r_f, t_f = part_transform(ep, joint, (stop - q) * f)
+            arc.append((r_f @ p + t_f + r_f @ n * PRE_CONTACT, quat_z_to(-(r_f @ n))))
+    placed = drv.place_base_near(mid, side=side, reach_poses=reach + arc)
+    if placed and arc and not drv.reaches:  # no base follows the whole arc: one that reaches the lid
+        placed = drv.place_base_near(mid, side=side, reach_poses=reach)
+    return stop, bool(placed or drv.place_base_near(p, side=side) or drv.place_base_near(p))
+
+
 def actuate_part(ep: Episode, joint: str, goal: float, *, closed: float, tol: float = 0.02, attempts: int = 4,
                  max_steps: int = 900, max_drag: float = MAX_DRAG):
     """Hold the part by suction and lead it to ``goal``; re-grasp when it stops following."""
@@ -240,29 +285,14 @@ def actuate_part(ep: Episode, joint: str, goal: float, *, closed: float, tol: fl
         if not grasps:
             notes.append("no reachable face")
             break
-        g = _on_surface(ep, grasps[0])
-        stop = goal
-        if not g.outer and hinge and abs(goal - closed) < INNER_FACE_STOP:
-            stop = closed + np.sign(q() - closed) * INNER_FACE_STOP
-        p, n = _world(ep, g)
-        # base: facing the middle of the arc still to go, on the side the face looks to
-        r, t = part_transform(ep, joint, (stop - q()) / 2)
-        mid = r @ p + t
-        side = n if np.linalg.norm(n[:2]) > 0.3 else None
-        reach = [(p + n * PRE_CONTACT, quat_z_to(-n))]
-        arc = []
-        if g.lid:  # the cup turns with a lid: a base from which the arm follows the arc to its end, cup
-            # on the face all the way (from the free edge's side the wrist cannot tip back far enough and
-            # presses on the lid; from the hinge axis's end it is a roll of the wrist)
-            for f in (0.5, 1.0):
-                r_f, t_f = part_transform(ep, joint, (stop - q()) * f)
-                arc.append((r_f @ p + t_f + r_f @ n * PRE_CONTACT, quat_z_to(-(r_f @ n))))
-        placed = drv.place_base_near(mid, side=side, reach_poses=reach + arc)
-        if placed and arc and not drv.reaches:  # no base follows the whole arc: one that reaches the lid
-            placed = drv.place_base_near(mid, side=side, reach_poses=reach)
-        if not (placed or drv.place_base_near(p, side=side) or drv.place_base_near(p)):
+        for g in [_on_surface(ep, c) for c in grasps] + [_on_surface(ep, grasps[0])]:
+            stop, placed = _place_base_for(ep, joint, g, goal, closed)
+            if placed and _faces_base(ep, g):
+                break
+        if not placed:
             notes.append("no base pose")
             break
+        p, n = _world(ep, g)
         quat = quat_z_to(-n)
         hover = p + n * (PRE_CONTACT + 0.10)
         reached = drv.reach_planned((p + n * PRE_CONTACT, hover), quat)  # as for grasps
