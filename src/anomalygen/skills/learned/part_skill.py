@@ -129,33 +129,73 @@ def grasp_part(ep: Episode, joint: str) -> tuple[bool, str]:
     return False, why
 
 
-def lead_held_part(ep: Episode, readout: PartReadout, act, *, horizon: int, tol: float = CLOSED_TOL) -> tuple[bool, int]:
+MAX_HOLDER_SHIFT = 0.03  # m the appliance carrying a led control may move before the lead stops
+MAX_HOLDER_TILT = 0.08  # rad it may tip or turn
+
+
+def _holder_moved(model, data, body: int, pos0: np.ndarray, rot0: np.ndarray) -> bool:
+    """Has the body carrying the part been dragged or tipped since (pos0, rot0)?"""
+    rel = rot0.T @ data.xmat[body].reshape(3, 3)
+    angle = float(np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0)))
+    return bool(np.linalg.norm(data.xpos[body] - pos0) > MAX_HOLDER_SHIFT or angle > MAX_HOLDER_TILT)
+
+
+def lead_held_part(ep: Episode, readout: PartReadout, act, *, horizon: int,
+                   tol: float = CLOSED_TOL) -> tuple[bool, int, str]:
     """Drive the held part with ``act(observation) -> 7-D action`` on the Driver, at the env's frameskip,
     until it is within ``tol`` of its travel from off or ``horizon`` control steps pass: the learned
-    skill's replay (a policy) and the scripted primitive (:func:`reference_action`) alike.
-    Returns (off, control steps taken)."""
+    skill's replay (a policy) and the scripted primitive (:func:`reference_action`) alike. The lead stops
+    when the appliance carrying the part is being dragged or tipped (a cup running off a small dial's
+    circle hauls a fan heater over by it): a stopped lead lets go and may try again, a tipped heater
+    stays tipped. Returns (off, control steps taken, why it stopped early or "")."""
     from anomalygen.skills.learned.subtask_env import FRAMESKIP
 
     drv = ep.driver
+    m, d = drv.model, drv.data
+    holder = int(m.body_parentid[readout.body])
+    pos0, rot0 = d.xpos[holder].copy(), d.xmat[holder].reshape(3, 3).copy()
     fs, drv.frameskip = drv.frameskip, FRAMESKIP
-    t, ok = 0, abs(readout.fraction(drv.data)) <= tol
+    t, ok, why = 0, abs(readout.fraction(d)) <= tol, ""
     try:
         while t < horizon and not ok:
-            readout.agent.apply_action(drv.data, act(readout.observation(drv.model, drv.data, t, horizon)))
+            readout.agent.apply_action(d, act(readout.observation(m, d, t, horizon)))
             t += 1
             drv.step()
-            ok = abs(readout.fraction(drv.data)) <= tol
+            ok = abs(readout.fraction(d)) <= tol
+            if not ok and holder and _holder_moved(m, d, holder, pos0, rot0):
+                why = f"stopped: {m.body(holder).name} was being dragged or tipped"
+                break
     finally:
         drv.frameskip = fs
-    return ok, t
+    return ok, t, why
+
+
+RELEASE_HOLD = 2  # control steps the arm holds still, target on the held point, before suction goes off
+BACK_OFF_STEP = 0.004  # m a control step while the cup backs away from the part (as parts.py backs off a lid)
 
 
 def let_go(ep: Episode, joint: str) -> None:
-    """Switch suction off and back the cup away from the part's face, wrist straightened."""
+    """Bring the arm's target onto the held point and hold still, switch suction off and back the cup
+    slowly away along the part's face normal, wrist straightened. A lead leaves the target ahead of the
+    cup (up to the leash): released there, the arm lunges after it (its wrist knocked a fan heater
+    over); a target on the cup instead pulls the part back by the stretched weld (a dial sprang back)."""
     drv = ep.driver
-    drv.agent.release(drv.data)
-    normal = part_geometry(drv.model, drv.data, joint)["normal"]
-    drv.goto(drv.site + BACK_OFF * normal, max_steps=40)
+    m, d = drv.model, drv.data
+    a = drv.agent
+    body = int(m.jnt_bodyid[m.joint(joint).id])
+    eq = a.suction_eq(m.body(body).name)
+    if eq >= 0 and d.eq_active[eq]:
+        held = d.xpos[body] + d.xmat[body].reshape(3, 3) @ m.eq_data[eq, 0:3]
+        d.mocap_pos[a.mocap], d.mocap_quat[a.mocap] = held, d.xquat[a.cup]
+        for _ in range(RELEASE_HOLD):
+            drv.step()
+    a.release(d)
+    normal = part_geometry(m, d, joint)["normal"]
+    dp, drv.dp = drv.dp, BACK_OFF_STEP
+    try:
+        drv.goto(drv.site + BACK_OFF * normal, max_steps=40)
+    finally:
+        drv.dp = dp
     drv.straighten_wrist(lift=0.1, lift_steps=30)
 
 

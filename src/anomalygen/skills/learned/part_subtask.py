@@ -116,13 +116,13 @@ def run_part_subtask(ep: Episode, st: SubTask, plan: Plan, *, steps: int, seed: 
     mujoco.mj_setState(drv.model, drv.data, snap, kind)
     mujoco.mj_forward(drv.model, drv.data)
     readout = PartReadout(drv.model, joint, closed, far)
-    ok, t = lead_held_part(ep, readout, lambda obs: policy.predict(obs, deterministic=True)[0], horizon=HORIZON)
+    ok, t, stopped = lead_held_part(ep, readout, lambda obs: policy.predict(obs, deterministic=True)[0], horizon=HORIZON)
     q = float(drv.data.joint(joint).qpos[0])
     let_go(ep, joint)
     after = float(drv.data.joint(joint).qpos[0])
     ok = ok and js.open_fraction_at(after) <= 0.05
     detail = (f"{why}; {tuned}; rollout {'turned' if ok else 'did not turn'} {joint} to off in {t} steps "
-              f"({q:.3f}, off {closed:.3f}, on {far:.3f})" + (f"; {after:.3f} after letting go" if abs(after - q) > 1e-3 else ""))
+              f"({q:.3f}, off {closed:.3f}, on {far:.3f})" + (f" ({stopped})" if stopped else "") + (f"; {after:.3f} after letting go" if abs(after - q) > 1e-3 else ""))
     return SkillOutcome(ok, drv.steps - s0, detail)
 
 

@@ -26,19 +26,24 @@ CONTROL_LABELS = (part_labels.KNOB, part_labels.SWITCH, part_labels.BUTTON, part
 OFF_TOL = 0.01  # fraction of the travel from off at which the script lets go (the graph's "off" is 5 %)
 HORIZON = 90  # control steps per hold (the reference turns a knob from 90 % on to off in 15-26)
 ATTEMPTS = 2  # holds tried before giving up (a hold can slip off a small knob)
+TURN_PER_STEP = 0.2  # rad a held knob is led round per control step at most
 
 
 def paced(readout):
     """The family's scripted reference, its move along the part's path cut to what is left of the
     travel: a 6 mm push switch led at the reference's 18 mm a step is driven through its end stop and
-    springs back when let go; a knob's last few degrees are approached as gently."""
+    springs back when let go; a knob's last few degrees are approached as gently. A knob is turned at
+    most ``TURN_PER_STEP`` a step: the reference's 18 mm along the tangent of a dial held 1 cm off its
+    axis is more than a radian, the cup runs off the dial's circle and the weld hauls the appliance
+    after it (a 3 kg fan heater tipped over)."""
     from anomalygen.robot.agent import Agent
     from anomalygen.skills.learned.part_skill import POS_SCALE, REFERENCE_MOVE, reference_action
 
     def act(obs: np.ndarray) -> np.ndarray:
         lever = float(np.linalg.norm(obs[6:9])) / POS_SCALE if readout.hinge else 1.0
         left = abs(float(obs[9])) * readout.span * lever  # m the held point still has to go
-        return reference_action(obs, min(REFERENCE_MOVE, left / Agent.STEP_POS))
+        turn = TURN_PER_STEP * lever if readout.hinge else REFERENCE_MOVE * Agent.STEP_POS  # m a step
+        return reference_action(obs, min(REFERENCE_MOVE, left / Agent.STEP_POS, turn / Agent.STEP_POS))
 
     return act
 
@@ -58,9 +63,9 @@ def switch_off_control(ep: Episode, joint: str, closed: float, far: float) -> Sk
         if not held:
             notes.append(f"hold {attempt}: {why}")
             continue
-        ok, t = lead_held_part(ep, readout, paced(readout), horizon=HORIZON, tol=OFF_TOL)
+        ok, t, stopped = lead_held_part(ep, readout, paced(readout), horizon=HORIZON, tol=OFF_TOL)
         let_go(ep, joint)
-        notes.append(f"hold {attempt}: led {'to off' if ok else 'towards off'} in {t} steps")
+        notes.append(f"hold {attempt}: led {'to off' if ok else 'towards off'} in {t} steps" + (f" ({stopped})" if stopped else ""))
         if abs(readout.fraction(drv.data)) <= CLOSED_TOL:
             break
     q = float(drv.data.joint(joint).qpos[0])
