@@ -225,9 +225,10 @@ def _faces_base(ep: Episode, g: PartGrasp) -> bool:
     """Does the arm come at the face from the side it looks to? A steep face whose plane the base
     stands behind (a lid leaning back past upright, its outer face towards a wall) is reached only
     by wrapping the arm round the panel, and the arm sweeping past shoves it open on its stop,
-    which tips a light box over backwards."""
+    which tips a light box over backwards. Lids only: a door's inner face is held only to 0.4 rad
+    from shut, and choosing it for an open fridge door left the door open."""
     p, n = _world(ep, g)
-    if abs(n[2]) >= 0.5 or np.linalg.norm(n[:2]) < 1e-6:
+    if not g.lid or abs(n[2]) >= 0.5 or np.linalg.norm(n[:2]) < 1e-6:
         return True
     base = ep.driver.agent.base_pose(ep.driver.data)[:2]
     return float(np.dot(base - p[:2], n[:2] / np.linalg.norm(n[:2]))) > BASE_IN_FRONT
