@@ -31,10 +31,12 @@ import tempfile
 import time
 from pathlib import Path
 
+from anomalygen import procs
+
 
 def _cli(*args: str, env=None) -> None:
     exe = Path(sys.executable).with_name("anomalygen")
-    subprocess.run([str(exe), *args, "--quiet"], check=True, env=env)
+    subprocess.run([str(exe), *args, "--quiet"], check=True, env=env, preexec_fn=procs.end_with_parent)
 
 
 def _copy_run(src: Path, dst: Path) -> None:

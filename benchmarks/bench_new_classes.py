@@ -21,6 +21,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from anomalygen import procs
+
 #: (hazard class, target asset, hazard object, placement, room) per task
 TASKS = [
     ("push_heavy_item_out_of_walkway", "Table", "dumbbell", "walkway", "living_room"),
@@ -57,7 +59,7 @@ def task_lines() -> list[str]:
 
 def _cli(*args: str, env=None) -> None:
     exe = Path(sys.executable).with_name("anomalygen")
-    subprocess.run([str(exe), *args, "--quiet"], check=True, env=env)
+    subprocess.run([str(exe), *args, "--quiet"], check=True, env=env, preexec_fn=procs.end_with_parent)
 
 
 def main() -> int:

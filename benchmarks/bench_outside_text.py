@@ -32,6 +32,8 @@ from collections import Counter, defaultdict
 from pathlib import Path
 from urllib.parse import urlparse
 
+from anomalygen import procs
+
 DATA = Path(__file__).parent / "data" / "outside_hazards.jsonl"
 
 
@@ -128,7 +130,7 @@ def run_pipeline(lines: list[str], out: Path, workers: int = 1) -> dict:
              ["build", "--run", str(run), *par], ["detect", "--run", str(run), "--detector", "rules"],
              ["plan", "--run", str(run)], ["learn", "--run", str(run), *par], ["judge", "--run", str(run), *par]]
     for args in steps:
-        subprocess.run([exe, *args, "--quiet"], check=False)
+        subprocess.run([exe, *args, "--quiet"], check=False, preexec_fn=procs.end_with_parent)
     folder = RunFolder(run)
     tasks = folder.load_tasks()
     manifests = load_manifests(folder, tasks)

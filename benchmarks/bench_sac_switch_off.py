@@ -25,6 +25,8 @@ import sys
 import time
 from pathlib import Path
 
+from anomalygen import procs
+
 CLASS = "switch_off_appliance"
 
 
@@ -49,7 +51,7 @@ def main() -> int:
     tasks = [json.loads(x) for x in (run / "tasks.jsonl").read_text().splitlines() if x.strip()]
     ids = [t["id"] for t in tasks if t["hazard_class"] == CLASS and (run / "scenes" / t["id"] / "scene.json").is_file()]
     only = [x for tid in ids for x in ("--only", tid)]
-    subprocess.run([str(exe), "plan", "--run", str(run), "--force", *only, "--quiet"], check=True, env=env)
+    subprocess.run([str(exe), "plan", "--run", str(run), "--force", *only, "--quiet"], check=True, env=env, preexec_fn=procs.end_with_parent)
     if a.method == "primitive":
         for tid in ids:
             p = run / "plans" / f"{tid}.json"
@@ -59,7 +61,7 @@ def main() -> int:
             p.write_text(json.dumps(plan))
     t0 = time.perf_counter()
     subprocess.run([str(exe), "learn", "--run", str(run), "--seeds", str(a.seeds), "--sac-steps", str(a.sac_steps),
-                    "--workers", "1", "--force", *only, "--quiet"], check=True, env=env)
+                    "--workers", "1", "--force", *only, "--quiet"], check=True, env=env, preexec_fn=procs.end_with_parent)
     wall = time.perf_counter() - t0
     from anomalygen.evaluate.verdicts import verdict_of
     from anomalygen.runfolder import RunFolder

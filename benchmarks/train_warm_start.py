@@ -27,6 +27,8 @@ import sys
 import time
 from pathlib import Path
 
+from anomalygen import procs
+
 CLASS = "switch_off_appliance"
 DEFAULT_OUT = Path(__file__).resolve().parents[1] / "src" / "anomalygen" / "data" / "policies" / "switch_off.zip"
 
@@ -37,11 +39,11 @@ def make_run(run: Path, seed: int, n: int = 300) -> None:
     env = {**os.environ, "ANOMALYGEN_BUILD__HAZARD_FREE": "0", "ANOMALYGEN_BUILD__MULTI_HAZARD": "0",
            "ANOMALYGEN_BUILD__NEAR_MISSES": "0"}
     subprocess.run([str(exe), "brainstorm", "--run", str(run), "--engine", "knowledge", "--n", str(n),
-                    "--seed", str(seed), "--quiet"], check=True, env=env)
+                    "--seed", str(seed), "--quiet"], check=True, env=env, preexec_fn=procs.end_with_parent)
     tasks = [json.loads(line) for line in (run / "tasks.jsonl").read_text().splitlines() if line.strip()]
     only = [x for t in tasks if t["hazard_class"] == CLASS for x in ("--only", t["id"])]
     subprocess.run([str(exe), "build", "--run", str(run), "--workers", "1", "--seed", str(seed), *only, "--quiet"],
-                   check=True, env=env)
+                   check=True, env=env, preexec_fn=procs.end_with_parent)
 
 
 def starts_of(run: Path, log=lambda m: print(m, file=sys.stderr)) -> list:

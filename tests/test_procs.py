@@ -53,3 +53,29 @@ def test_killing_the_parent_takes_its_workers_and_their_children_along(tmp_path)
         proc.kill()
     out, err = proc.communicate(timeout=10)
     assert out == b"" and b"a library talking on stdout" in err
+
+
+# A script that starts a stage the way the benchmarks do (subprocess.run with end_with_parent).
+SCRIPT = textwrap.dedent("""
+    import subprocess, sys
+    from anomalygen.procs import end_with_parent
+
+    subprocess.run([sys.executable, "-c", "import time; print('started', flush=True); time.sleep(600)"],
+                   preexec_fn=end_with_parent)
+""")
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_a_stage_a_killed_script_started_ends_with_it(tmp_path):
+    script = tmp_path / "script.py"
+    script.write_text(SCRIPT)
+    proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        assert proc.stdout.readline() == b"started\n"
+        below = descendants(proc.pid)
+        assert len(below) == 1
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(timeout=10)
+        assert wait_gone(below, 10.0) == set()
+    finally:
+        proc.kill()
