@@ -125,9 +125,13 @@ def _predicate(name: str, args: dict[str, str], meaning: str):
 )
 def _has_property(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
     obj = ctx.obj(call)
-    wanted = _alternatives(call.args.get("property", ""))
-    found = [p for p in wanted if p in obj.properties]
-    return bool(found), f"{obj.name} is {'/'.join(found) or 'not ' + '/'.join(wanted)}"
+    return _any_of(obj.name, _alternatives(call.args.get("property", "")), obj.properties)
+
+
+def _any_of(name: str, wanted: list[str], present) -> tuple[bool, str]:
+    """Holds when any alternative is among the object's words (its properties, its states)."""
+    found = [w for w in wanted if w in present]
+    return bool(found), f"{name} is {'/'.join(found) or 'not ' + '/'.join(wanted)}"
 
 
 @_predicate(
@@ -310,9 +314,7 @@ def _in_walkway(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
 )
 def _has_state(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
     obj = ctx.obj(call)
-    wanted = _alternatives(call.args.get("state", ""))
-    found = [w for w in wanted if w in obj.states]
-    return bool(found), f"{obj.name} is {'/'.join(found) or 'not ' + '/'.join(wanted)}"
+    return _any_of(obj.name, _alternatives(call.args.get("state", "")), obj.states)
 
 
 @_predicate(
