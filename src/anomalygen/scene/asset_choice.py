@@ -168,7 +168,7 @@ def needed_parts(task: TaskProposal, catalogue: str, hc) -> list[ArticulationUse
 
 
 def plausibility_problem(
-    asset, catalogue: str, kb, parts: list[ArticulationUse], *, cap: float | None
+    asset, catalogue: str, kb, parts: list[ArticulationUse], *, cap: float | None, handle: bool = False
 ) -> str | None:
     """The knowledge-based verification of a candidate: None when plausible, else why not."""
     rng = kb_size_range(kb, catalogue)
@@ -181,6 +181,11 @@ def plausibility_problem(
     for part in parts:
         if part.initial_state in ("open", "closed", "on", "off") and not joints_with_label(asset, part.part):
             return f"{catalogue} candidate has no '{part.part}' joint"
+    if handle:
+        from anomalygen.scene.states import handle_tip_x
+
+        if handle_tip_x(asset) is None:
+            return f"{catalogue} candidate has no long handle to stick out"
     return None
 
 
@@ -200,13 +205,6 @@ def wants_handle_out(task: TaskProposal, catalogue: str, hc) -> bool:
     asked = HANDLE_OUT in task.scenario.states.get(catalogue, [])
     return asked or (hc is not None and any(
         c.name == "has_state" and not c.negate and c.args.get("state") == HANDLE_OUT for c in hc.preconditions))
-
-
-def has_long_handle(asset) -> bool:
-    """Only a variant with a long handle can have it stick out (some pots have two side grips)."""
-    from anomalygen.scene.states import HANDLE_GEOM, geoms_below
-
-    return any(g.name == HANDLE_GEOM for g in geoms_below(asset.spec.worldbody))
 
 
 def pick_asset(
@@ -239,18 +237,14 @@ def pick_asset(
     for s in seeds:
         want = choose_size(kb, catalogue, rng, cap=cap, preferred=size)
         asset = draw(catalogue, s, size=want, real=real)
-        problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap)
-        if problem is None and handle and not has_long_handle(asset):
-            problem = f"{catalogue} candidate has no long handle to stick out"
+        problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap, handle=handle)
         if problem is None and asset.package is not None and room_for and asset.cavities \
                 and cavity_cap(asset) < room_for:
             problem = f"its interior takes {cavity_cap(asset):.2f} m, less than the {room_for:.2f} m to go in"
         if problem is not None and asset.package is not None:
             problems.append(f"real model {asset.asset_id}: {problem}")
             asset = generate(catalogue, s, size=want)
-            problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap)
-            if problem is None and handle and not has_long_handle(asset):
-                problem = f"{catalogue} candidate has no long handle to stick out"
+            problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap, handle=handle)
         if problem is None:
             candidates.append(asset)
         else:

@@ -17,7 +17,6 @@ from anomalygen.scene.states import (
     CONTAINS_WATER,
     FACE_DOWN,
     FACE_DOWN_CATEGORIES,
-    HANDLE_GEOM,
     HANDLE_OUT,
     HOLDS_WATER,
     KNOWN_STATES,
@@ -26,7 +25,7 @@ from anomalygen.scene.states import (
     WET,
     _add,
     _is_on,
-    geoms_below,
+    handle_tip_x,
 )
 from anomalygen.schema import part_labels
 
@@ -133,7 +132,7 @@ def _turn_handle_out(lay, p, placed: dict) -> None:
     from anomalygen.errors import ItemFailed
     from anomalygen.scene.instances import surface_of
 
-    tip = _handle_tip_x(p.asset)
+    tip = handle_tip_x(p.asset)
     holder = placed.get(p.support.split(":")[0])
     if tip is None:
         raise ItemFailed(f"{p.catalogue} has no long handle to stick out")
@@ -157,14 +156,6 @@ def _turn_handle_out(lay, p, placed: dict) -> None:
             return
     p.yaw, p.pos = yaw0, pos0
     raise ItemFailed(f"no room to turn {p.name}'s handle out over {holder.name}'s edge")
-
-
-def _handle_tip_x(asset) -> float | None:
-    """Local x of the free end of the asset's handle geom (None when it has none)."""
-    for geom in geoms_below(asset.spec.worldbody):
-        if geom.name == HANDLE_GEOM:
-            return float(geom.pos[0] + geom.size[0])
-    return None
 
 
 def switch_joints(asset) -> list:

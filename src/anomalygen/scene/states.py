@@ -53,6 +53,15 @@ def _add(states: list[str], state: str) -> None:
 # ---------------------------------------------------------------------------- how the builder shows them
 
 
+def handle_tip_x(asset) -> float | None:
+    """Local x of the free end of the asset's long handle (None when it has none: a pot with two side
+    grips), the geom a pan's "handle_out" is built and read from."""
+    for geom in geoms_below(asset.spec.worldbody):
+        if geom.name == HANDLE_GEOM:
+            return float(geom.pos[0] + geom.size[0])
+    return None
+
+
 def show_states(root, placed) -> None:
     """Draw a placed object's states on its attached body (``compose.py``): water in a filled basin,
     the glow of each control that starts on. The asset hides both (alpha 0)."""
