@@ -18,6 +18,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from anomalygen.assets.generators.parts_lib import GLOW
 from anomalygen.assets.model import Cavity, Surface
 from anomalygen.assets.real.convert import Raw
 from anomalygen.assets.real.mjcf import Fragments, find, load_spec, package_dir, remove
@@ -159,7 +160,7 @@ _BURNER_RGBA = "0.22 0.07 0.05 1"  # a cold element: dark red-brown
 _GLOW_RADIUS = 0.09  # m, a little inside the burner ring
 _GLOW_HALF_HEIGHT = 0.004  # m
 _GLOW_LIFT = 0.008  # m above the burner geom's centre, so the disc shows over its top face
-_GLOW_RGBA = "1 0.35 0.05 0"  # hidden until the builder lights it
+_GLOW_RGBA = " ".join(f"{v:g}" for v in GLOW)  # the procedural burners' glow, hidden until lit
 # A cooker knob turns stiffly. A free one (damped in proportion to its 60 g cm^2 inertia, like a
 # procedural part) was still spinning at 33 rad/s when the suction cup let go of it at off, and
 # coasted 0.3 rad back on; dry friction alone is too soft a constraint on so small an inertia.
