@@ -10,18 +10,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from anomalygen.schema import Plan, SceneGraph, SceneSpec, SkillMethod, SubTask, SuccessSpec, TaskProposal
+from anomalygen.schema import Plan, SceneGraph, SceneSpec, SkillMethod, SubTask, SuccessSpec
 from support.kb_scenes import NO_MIX
-
-
-def _task(tid, target, hazard, placement, states=None, *, arts=(), room="kitchen", co=()):
-    return TaskProposal(
-        id=tid, name=f"task {tid}", explanation="test", description=f"A {hazard} at {placement}.",
-        category="household_hazard", hazard_class="other", target_asset=target,
-        scenario=dict(hazard_object=hazard, room=room, placement=placement, states=states or {}, co_objects=list(co)),
-        articulations=[dict(object=o, part=p, initial_state=s) for o, p, s in arts],
-        provenance=dict(engine="knowledge", mode="brainstorm"))
-
+from support.kb_scenes import state_task as _task
 
 TASKS = {
     # a kitchen has a counter beside the stove: the towel needs somewhere safe to go

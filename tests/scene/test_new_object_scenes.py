@@ -15,18 +15,8 @@ from anomalygen.errors import ItemFailed
 from anomalygen.runfolder import read_model
 from anomalygen.scene.graph import load_scene, scene_graph
 from anomalygen.scene.states import GLOW_ALPHA, WATER_ALPHA, refresh_glows
-from anomalygen.schema import SceneSpec, TaskProposal
-
-
-def _task(tid, target, hazard, placement, states=None, *, arts=(), room="kitchen", co=()):
-    return TaskProposal(
-        id=tid, name=f"task {tid}", explanation="test", description=f"A {hazard} at {placement}.",
-        category="household_hazard", hazard_class="other", target_asset=target,
-        scenario=dict(hazard_object=hazard, room=room, placement=placement, states=states or {}, co_objects=list(co)),
-        articulations=[dict(object=o, part=p, initial_state=s) for o, p, s in arts],
-        provenance=dict(engine="knowledge", mode="brainstorm"),
-    )
-
+from anomalygen.schema import SceneSpec
+from support.kb_scenes import state_task as _task
 
 TASKS = {
     "stove": _task("n-stove", "Stove", "towel", "on:Stove", {"Stove": ["lit"]}, co=["PaperTowels"]),

@@ -24,13 +24,22 @@ def build_with_kb_plans(tasks: dict, root, *, clutter: int, real_assets: bool = 
     return out
 
 
-def kb_task(task_id, hazard_class, target, hazard, placement, *, container=None, articulations=(), room="kitchen"):
-    """A knowledge-engine TaskProposal for a scene test: ``articulations`` are (object, part, state)."""
+def kb_task(task_id, hazard_class, target, hazard, placement, *, container=None, articulations=(), room="kitchen",
+            states=None, co_objects=()):
+    """A knowledge-engine TaskProposal for a scene test: ``articulations`` are (object, part, state),
+    ``states`` the instance states by catalogue name ({'Stove': ['lit']})."""
     from anomalygen.schema import TaskProposal
 
     return TaskProposal(
         id=task_id, name=f"task {task_id}", explanation="test", description=f"A {hazard} at {placement}.",
         category="household_hazard", hazard_class=hazard_class, target_asset=target,
-        scenario=dict(hazard_object=hazard, room=room, placement=placement, container=container, co_objects=[]),
+        scenario=dict(hazard_object=hazard, room=room, placement=placement, container=container,
+                      states=states or {}, co_objects=list(co_objects)),
         articulations=[dict(object=o, part=p, initial_state=s) for o, p, s in articulations],
         provenance=dict(engine="knowledge", mode="brainstorm"))
+
+
+def state_task(task_id, target, hazard, placement, states=None, *, arts=(), room="kitchen", co=()):
+    """A task with no class of its own ('other') that asks for instance states: the open-world objects' tests."""
+    return kb_task(task_id, "other", target, hazard, placement, articulations=arts, room=room, states=states,
+                   co_objects=co)
