@@ -22,6 +22,7 @@ from anomalygen.errors import ItemFailed
 from anomalygen.schema import SWITCH_LABELS, ArticulationUse, ObjectRole, TaskProposal, part_labels
 
 TARGET_CANDIDATES = 3  # generated variants ranked per target
+EXTRA_DRAWS_FOR_PARTS = 8  # further variants drawn when none so far has the part the task needs
 FIXED_SIZE = 0.55  # m: assets at least this big are furniture (welded), smaller ones are loose
 MIN_OPEN_HINGE = math.radians(50)  # "fridge door open >= 45 deg", with a margin
 
@@ -161,10 +162,29 @@ def rank_by_similarity(text: str, descriptions: list[str]) -> np.ndarray:
     return np.argsort(-sims, kind="stable")
 
 
-def needed_parts(task: TaskProposal, catalogue: str, hc) -> list[ArticulationUse]:
-    """Articulations the task (or its hazard class template) requires of this catalogue object."""
+def needed_parts(task: TaskProposal, catalogue: str, hc, role: ObjectRole | None = None) -> list[ArticulationUse]:
+    """Articulations the task (or its hazard class template) requires of this catalogue object.
+
+    A task that names none still needs the part its class is about on the object playing that role
+    (a drawer on the table of a close-the-drawer scene): without it every candidate drawn for the
+    role counts as plausible, and a table with no drawer fails the build afterwards."""
     out = [a for a in task.articulations if a.object == catalogue]
+    art = getattr(hc, "articulation", None)
+    if not out and art is not None and role is not None:
+        plays = (art.variable == "$target" and role in (ObjectRole.TARGET, ObjectRole.HAZARD)
+                 and _same_category(catalogue, task.target_asset)) or (
+                 art.variable != "$target" and art.variable == hc.hazard_variable and role is ObjectRole.HAZARD)
+        if plays:
+            out.append(ArticulationUse(object=catalogue, part=art.part, function=art.function,
+                                       initial_state=art.initial_state, target_state=art.target_state))
     return out
+
+
+def _same_category(catalogue: str, name: str) -> bool:
+    try:
+        return resolve_name(name) == catalogue
+    except ItemFailed:
+        return False
 
 
 def plausibility_problem(
@@ -229,12 +249,17 @@ def pick_asset(
     drawn with the same seed and size."""
     from anomalygen.assets.core import draw, generate
 
-    parts = needed_parts(task, catalogue, hc)
+    parts = needed_parts(task, catalogue, hc, role)
     handle = role is ObjectRole.HAZARD and wants_handle_out(task, catalogue, hc)
     n = TARGET_CANDIDATES if rank else 2
     seeds = [int(s) for s in rng.integers(0, 2**31 - 1, size=n)]
     candidates, problems = [], []
-    for s in seeds:
+    drawn = 0
+    # a needed part may be on only some variants (one table in three has a drawer): draw on, up to
+    # EXTRA_DRAWS_FOR_PARTS more, until one has it; a scene whose first draws pass is unchanged
+    while drawn < n or (parts and not candidates and drawn < n + EXTRA_DRAWS_FOR_PARTS):
+        s = seeds[drawn] if drawn < n else int(rng.integers(0, 2**31 - 1))
+        drawn += 1
         want = choose_size(kb, catalogue, rng, cap=cap, preferred=size)
         asset = draw(catalogue, s, size=want, real=real)
         problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap, handle=handle)
