@@ -69,3 +69,14 @@ def test_one_bad_line_fails_alone_and_the_power_strip_in_a_full_sink_is_built_as
     strip = tasks[1]
     assert (strip.scenario.placement, strip.scenario.room) == ("inside:Sink", "bathroom")
     assert strip.scenario.states == {"Sink": ["contains_water"]}
+
+
+@pytest.mark.parametrize(("line", "fault"), [
+    ("A space heater is left on next to the sofa.", "SpaceHeater"),
+    ("The medicine cabinet door is left open.", "medicine_cabinet"),
+])
+def test_a_class_about_its_target_gets_the_lines_object_as_target(reader, line, fault):
+    """switch_off_appliance puts its 'on' on the target: with an oven as the target, a heater left on
+    would be built as an oven left on."""
+    task = reader.proposal(line, 1)
+    assert (task.scenario.hazard_object, task.target_asset) == (fault, fault)

@@ -126,3 +126,27 @@ def test_a_named_container_is_never_swapped_for_a_roomier_kind():
     assert all(o[0] == "failed" for o in outcomes), outcomes
     for _, message in outcomes:
         assert "does not fit" in message and "names the Bucket" in message and "TrashCan" in message
+
+
+def _open_drawer(target: str, hazard: str) -> TaskProposal:
+    return TaskProposal(
+        id=f"t-part-{target}-{hazard}", name="open drawer", explanation="test",
+        description=f"The {hazard} was left open.", category="child_safety",
+        hazard_class="close_open_furniture", target_asset=target,
+        scenario=dict(hazard_object=hazard, room="bedroom", placement="floor", co_objects=[]),
+        provenance=dict(engine="knowledge", mode="brainstorm"))
+
+
+def test_a_table_whose_drawer_is_the_hazard_is_drawn_with_a_drawer():
+    """One procedural table in three has a drawer: the draws go on until one has it."""
+    task = _open_drawer("Table", "Table")
+    for attempt in range(6):
+        _, bindings, placed = build._plan(task, SETTINGS, item_rng(0, task.id, attempt))
+        table = placed[bindings["$target"]]
+        assert asset_choice.joints_with_label(table.asset, "drawer"), f"attempt {attempt}: a table without a drawer"
+
+
+def test_a_task_naming_another_object_at_fault_than_its_target_is_refused():
+    """Built, the open drawer would be the table's while the task speaks of the safe."""
+    with pytest.raises(ItemFailed, match="about the target itself"):
+        build._plan(_open_drawer("Table", "Safe"), SETTINGS, item_rng(0, "x", 0))

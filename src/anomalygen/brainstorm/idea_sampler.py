@@ -49,7 +49,13 @@ def _class_targets(kb: KnowledgeBase, hc: HazardClass) -> list[str]:
     # around that category only: a table as the target of such a scene cannot be built
     pinned = {c for call in hc.preconditions if call.name == "category_is" and not call.negate
               and call.args.get("object") == "$target" for c in str(call.args.get("category", "")).split("|")}
-    return [t for t in out if t in pinned] or out if pinned else out
+    out = [t for t in out if t in pinned] or out if pinned else out
+    if hc.hazard_variable == "$target":  # the target is the object at fault: only those that can be
+        from anomalygen.brainstorm.drawable import hazards_for
+
+        can = set(hazards_for(kb, hc))
+        out = [t for t in out if t in can]
+    return out
 
 
 def classes_for_target(kb: KnowledgeBase, target: str) -> list[HazardClass]:
@@ -150,7 +156,12 @@ class IdeaSampler:
 
         kb = self.kb
         candidates = hazards_for(kb, hc)
-        if target in candidates and (avoid_hazard != target) and (len(candidates) == 1 or rng.random() < 0.7):
+        if hc.hazard_variable == "$target":
+            # the class is about the target itself (its door is open, it is on): a safe named beside a
+            # table would be built as the table's open drawer, so the object at fault is the target
+            # (class_targets offers only targets that can be)
+            hazard = target
+        elif target in candidates and (avoid_hazard != target) and (len(candidates) == 1 or rng.random() < 0.7):
             hazard = target
         else:
             pool = [c for c in candidates if c != avoid_hazard] or candidates

@@ -26,7 +26,11 @@ def proposal_problems(p: TaskProposal, kb: KnowledgeBase) -> list[str]:
     """Human-readable problems; empty when the proposal can be built."""
     names = set(kb.objects)
     out: list[str] = []
-    if p.target_asset not in kb.targets:
+    about_target = p.hazard_class in kb.hazard_classes and kb.hazard_classes[p.hazard_class].hazard_variable == "$target"
+    # a class about the target itself (a heater left on) takes the object at fault as its target,
+    # one of the 44 categories or not
+    if p.target_asset not in kb.targets and not (about_target and p.target_asset == p.scenario.hazard_object
+                                                  and p.target_asset in kb.objects):
         out.append(f"target_asset '{p.target_asset}' is not one of the 44 target categories")
     if p.hazard_class == "other":
         if not p.hazard_other:
@@ -35,6 +39,9 @@ def proposal_problems(p: TaskProposal, kb: KnowledgeBase) -> list[str]:
         out.append(f"hazard_class '{p.hazard_class}' is unknown (use a knowledge-base class id or 'other')")
     elif kb.hazard_classes[p.hazard_class].category != p.category:
         out.append(f"category '{p.category.value}' does not match class {p.hazard_class} ({kb.hazard_classes[p.hazard_class].category.value})")
+    elif about_target and p.scenario.hazard_object != p.target_asset:
+        out.append(f"class {p.hazard_class} is about the target itself: scenario.hazard_object "
+                   f"'{p.scenario.hazard_object}' must be the target_asset '{p.target_asset}'")
     s = p.scenario
     for label, name in [("scenario.hazard_object", s.hazard_object), ("scenario.container", s.container)]:
         if name is not None and name not in names:
