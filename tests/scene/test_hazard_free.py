@@ -48,3 +48,22 @@ def test_the_share_of_hazard_free_scenes_follows_the_setting():
     assert 0.10 <= share <= 0.20  # default 0.15
     assert not any(is_hazard_free(t, Settings(build={"hazard_free": 0.0})) for t in ids)
     assert [is_hazard_free(t, Settings()) for t in ids] == [is_hazard_free(t, Settings()) for t in ids]
+
+
+def test_a_hazard_free_high_shelf_scene_has_the_hammer_down_on_the_table(tmp_path):
+    """The safe version of 'a hammer on a high shelf' is where the fix leaves it: on the table (the
+    seed-19 demo's t0006 failed its build with the hammer put back on the shelf)."""
+    from pathlib import Path
+
+    from anomalygen.schema import TaskProposal
+    from anomalygen.scene.build import build_scene
+
+    task = TaskProposal.model_validate_json((Path(__file__).parent / "fixtures" / "hammer_on_high_shelf.json").read_text())
+    out = tmp_path / "hammer"
+    build_scene(task, seed=19, settings=SAFE, out_dir=out, hazard_free=True)
+    graph = read_model(out / "scene_graph.json", SceneGraph)
+    hammer = next(o for o in graph.objects if o.category == "hammer")
+    on = {r.object for r in graph.relations if r.subject == hammer.name and r.predicate == "on"}
+    assert any(n.startswith("table") for n in on), on
+    assert hammer.position[2] < 1.1
+    assert read_model(out / "truth.json", HazardManifest).hazards == []

@@ -104,7 +104,10 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
 
     if hazard.name not in placed:
         if sel.hazard_free:
-            place_hazard_safely(sel, lay, placed, support)
+            # where the fix would leave it: on the fix's own support (the table a hammer is taken down
+            # onto), not the high shelf the hazardous version stands it on
+            fix_support = placed.get(sel.support_var.name) if sel.support_var is not None else None
+            place_hazard_safely(sel, lay, placed, fix_support or support)
         else:
             _place_hazard(sel, lay, placed, support, support_kind)
 
