@@ -234,3 +234,12 @@ def test_new_objects_have_knowledge_with_the_agreed_names():
     assert "combustible" in kb.objects["Curtains"].properties and "combustible" not in kb.objects["Lighter"].properties
     ms = load_mechanisms()
     assert set(ms.places["in_water"].states) == {"$water"}
+
+
+def test_a_chemical_shut_in_a_latched_safe_beside_the_crib_is_no_hazard():
+    """Near the crib means within the baby's reach: a pod locked in a safe that stands 0.2 m from the
+    crib is out of it (the seed-19 demo's referee called such a fix unresolved)."""
+    hc = load_kb().hazard_classes["chemical_near_crib"]
+    assert match_class(hc, POSITIVE["chemical_near_crib"]())
+    locked = graph(obj("pod_0", "detergent_pod", at="floor", xy=NEAR, reachable=False), crib())
+    assert not match_class(hc, locked)
