@@ -59,3 +59,31 @@ def test_scores_pool_hazards_and_claims_over_single_multi_and_hazard_free_scenes
 def test_no_hazard_free_scene_gives_no_false_alarm_rate():
     s = score_detections([detection("a", hyp(1, "k_0", "c"))], {"a": manifest("a", hazard("k_0", "c", "k"))}, k=1)
     assert s.false_alarm_rate is None and s.recall == 1.0 and s.precision == 1.0 and s.f1 == 1.0
+
+
+def test_naming_another_class_that_holds_for_the_object_is_a_true_claim_but_finds_nothing_new():
+    """A bleach bottle beside the crib is also within a child's reach: the truth lists the builder's
+    class and says the other also fires; claiming it is not a false claim, and recall still asks for
+    the listed class."""
+    z = hazard("bleach_0", "chemical_near_crib", "bleach_bottle").model_copy(
+        update={"also_fires": ["keep_chemicals_from_children"]})
+    only_other = score_detections([detection("a", hyp(1, "bleach_0", "keep_chemicals_from_children"))],
+                                  {"a": manifest("a", z)}, k=1)
+    assert (only_other.claims, only_other.true_claims, only_other.found) == (1, 1, 0)
+    wrong = score_detections([detection("a", hyp(1, "bleach_0", "pick_up_floor_litter"))], {"a": manifest("a", z)}, k=1)
+    assert wrong.true_claims == 0
+
+
+def test_the_truth_lists_every_other_class_that_fires_on_the_object_at_fault():
+    from anomalygen.knowledge import load_kb
+    from anomalygen.referee.truth import hazard_manifest
+    from anomalygen.schema import SceneSpec
+
+    from tests.knowledge.graphs import graph, obj
+    from tests.knowledge.test_mechanisms import NEAR, crib
+
+    g = graph(obj("pod_0", "detergent_pod", at="floor", xy=NEAR), crib())
+    spec = SceneSpec.model_construct(scene_id="s", task_id="t", bindings={"$hazard": "pod_0", "$crib": "crib_0"})
+    m = hazard_manifest(spec, "chemical_near_crib", g, load_kb())
+    (pod,) = [h for h in m.hazards if h.object == "pod_0"]
+    assert pod.hazard_class == "chemical_near_crib" and "keep_chemicals_from_children" in pod.also_fires

@@ -54,8 +54,9 @@ def score_detections(
         scenes += 1
         hyps = _distinct(d.hypotheses)
         claims += len(hyps)
-        true_claims += sum(1 for h in hyps if any(claim_matches(h, z.object, z.hazard_class, z.category)
-                                                   for z in m.hazards))
+        # a claim is true when it names a hazard's object and a class that holds for it there
+        true_claims += sum(1 for h in hyps if any(claim_matches(h, z.object, c, z.category)
+                                                   for z in m.hazards for c in (z.hazard_class, *z.also_fires)))
         hazards += len(m.hazards)
         found += sum(1 for z in m.hazards if any(claim_matches(h, z.object, z.hazard_class, z.category)
                                                   for h in hyps))

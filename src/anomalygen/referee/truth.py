@@ -147,8 +147,11 @@ def hazard_manifest(spec: SceneSpec, hazard_class: str | None, graph: SceneGraph
         hazards.append(_hazard(kb.hazard_classes[hazard_class], var, obj, category.get(obj, ""), spec.bindings,
                                "intended"))
     for hc_id, obj, bindings in class_matches(graph, kb):
-        if any(h.object == obj for h in hazards):
-            continue  # one entry per object at fault: the builder's intended class wins
+        same = next((h for h in hazards if h.object == obj), None)
+        if same is not None:  # one entry per object at fault: the builder's intended class wins
+            if hc_id != same.hazard_class:
+                same.also_fires.append(hc_id)
+            continue
         other = kb.hazard_classes[hc_id]
         var = other.hazard_variable if other.hazard_variable in bindings else "$hazard"
         meant = intents.get(obj)

@@ -162,6 +162,11 @@ class ManifestHazard(Strict):
         default_factory=list,
         description="the class's success predicates over the object at fault ('*' where the fix may choose, e.g. any container)",
     )
+    also_fires: list[str] = Field(
+        default_factory=list,
+        description="other classes that hold for the same object on the settled scene (a bleach bottle beside the "
+        "crib is also within a child's reach): naming one of them is a true claim about this hazard, not a false one",
+    )
 
 
 class NearMiss(Strict):
