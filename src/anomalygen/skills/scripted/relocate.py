@@ -28,6 +28,8 @@ REACH_TOP = (0.3, 1.3)  # m: tops the arm sets things on (a low table to a shelf
 LIFT = 0.05  # m a pan is lifted off its hob to be turned
 HANDLE_GEOM = "handle"  # the geom of a pan's long handle (the catalogue's name, scene/states.py reads it too)
 EDGE_CLEAR = 0.03  # m the turned handle's tip keeps inside the edge of the surface
+BACK_FROM_EDGE = 0.17  # m the turned pan's body is set down inside the top's edges, where there is room
+SHIFT_GRID = 15  # positions per axis tried for setting it down back from the edges
 TURNS = (0.0, np.pi / 4, -np.pi / 4, np.pi / 2, -np.pi / 2)  # tried around the inward direction, nearest first
 
 
@@ -146,8 +148,10 @@ def _rot(theta: float) -> np.ndarray:
 def inward_turn(ep: Episode, obj: str, support: str) -> tuple[float, np.ndarray] | None:
     """(turn about the vertical, box centre after it) that brings the handle's tip back over the
     support, pointing into it; the body stays where it is. Turns near the straight-inward one are
-    tried in order and the first whose tip keeps ``EDGE_CLEAR`` inside the top and whose box misses
-    what else stands there is taken; None when none does."""
+    tried in order, each set down back from the top's edges where it has room (``_back_from_edge``) or
+    where it stood. Of those whose tip keeps ``EDGE_CLEAR`` inside the top and whose box misses what
+    else stands there, the first that also leaves the body clear of every edge is taken, else the
+    first; None when none qualifies."""
     drv = ep.driver
     found = _handle(ep, obj)
     if found is None:
@@ -164,6 +168,7 @@ def inward_turn(ep: Episode, obj: str, support: str) -> tuple[float, np.ndarray]
     box_c, half = (olo[:2] + ohi[:2]) / 2, (ohi[:2] - olo[:2]) / 2
     others = [drv.aabb(o.name) for o in ep.spec.objects if o.name not in (obj, support)]
     others = [(a[:2], b[:2]) for a, b in others if b[2] > hi[2] - 0.01 and a[2] < hi[2] + 0.3]
+    options: list[tuple[float, np.ndarray, float]] = []
     for extra in TURNS:
         theta = (base + extra + np.pi) % (2 * np.pi) - np.pi
         r = _rot(theta)
@@ -173,10 +178,32 @@ def inward_turn(ep: Episode, obj: str, support: str) -> tuple[float, np.ndarray]
         corners = np.array([[sx, sy] for sx in (-1, 1) for sy in (-1, 1)]) * half + box_c
         pts = (corners - body) @ r.T + body
         nlo, nhi = pts.min(axis=0), pts.max(axis=0)
-        inside = np.all(new_tip > lo[:2] + EDGE_CLEAR) and np.all(new_tip < hi[:2] - EDGE_CLEAR)
-        if inside and all(box_gap((nlo, nhi), o) > 0.0 for o in others):
-            return theta, new_c
-    return None
+        # set down back from the edge where the top has room (a heavy pan left at the hob's edge is
+        # still a heavy thing at an edge), else where it stood
+        for shift in (*_shifts_back_from_edge(nlo, nhi, lo, hi), np.zeros(2)):
+            tip = new_tip + shift
+            inside = np.all(tip > lo[:2] + EDGE_CLEAR) and np.all(tip < hi[:2] - EDGE_CLEAR)
+            if inside and all(box_gap((nlo + shift, nhi + shift), o) > 0.0 for o in others):
+                clear = float(np.min(np.minimum(nlo + shift - lo[:2], hi[:2] - nhi - shift)))
+                options.append((theta, new_c + shift, clear))
+    # the first turn (nearest straight inward) that leaves the pan clear of every edge; else the first
+    # that only brings the handle in (a pan too long for the top across: its handle is turned along it)
+    if not options:
+        return None
+    theta, centre, _ = next((o for o in options if o[2] >= BACK_FROM_EDGE - 0.02), options[0])
+    return theta, centre
+
+
+def _shifts_back_from_edge(blo: np.ndarray, bhi: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
+    """x, y shifts that put the box [blo, bhi] at least BACK_FROM_EDGE inside the top [lo, hi], the
+    shortest first (a 15 x 15 grid over the positions that keep it so); on an axis where the top is
+    too small for that, the shift that centres it there (as far from both edges as it can be)."""
+    room_lo, room_hi = lo[:2] + BACK_FROM_EDGE - blo, hi[:2] - BACK_FROM_EDGE - bhi
+    centred = (lo[:2] + hi[:2]) / 2 - (blo + bhi) / 2
+    xs, ys = (np.linspace(room_lo[i], room_hi[i], SHIFT_GRID) if room_hi[i] >= room_lo[i] else centred[i:i + 1]
+              for i in (0, 1))
+    grid = np.array([[x, y] for x in xs for y in ys])
+    return list(grid[np.argsort(np.linalg.norm(grid, axis=1), kind="stable")])
 
 
 def rotate_inward(ep: Episode, obj: str) -> SkillOutcome:
