@@ -9,7 +9,8 @@ relates to (the window of a stuffy room). The robot chooses them itself, here, f
 - ``$container``: the nearest object of a kind the class puts such things in (the knowledge base's
   containers for the class and object) that the object fits and the arm can reach, preferring one
   that ends the hazard once shut (``ends_hazard``);
-- ``$support``: the nearest surface of a kind the class lays things on.
+- ``$support``: the nearest surface of a kind the class lays things on, preferring one with nothing
+  over it and room to leave the object clear of its edges.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ REACH_BOTTOM_M = 1.2  # a container standing higher than this is out of the arm'
 AFTER_PLACE_LIFT_M = 0.02  # predicted height of a placed object above its container's base
 REACH_TOP_M = 1.6  # a surface whose top is higher than this is out of the arm's comfortable reach
 STABLE_TOPS = ("Table", "counter", "shelf", "StorageFurniture")  # categories with a flat, level top board
+EDGE_ROOM_M = 0.15  # a support should leave the object this far from its edges on both sides
 
 
 def bind_fix(hc, fault: str, graph: SceneGraph, kb) -> dict[str, str]:
@@ -107,6 +109,13 @@ def choose_support(hc, obj: GraphObject, graph: SceneGraph) -> str:
                  and o.position[2] + o.size[2] / 2 <= REACH_TOP_M and min(o.size[:2]) > max(obj.size[:2])]
     if not cands:
         raise ItemFailed(f"no surface for {obj.name} in the scene (wanted: {', '.join(sorted(kinds)) or 'none'})")
+    # better a top with nothing over it (the arm cannot lower a pan under a wall shelf) and room to
+    # leave the object clear of its edges (else it is a heavy thing at an edge once put there)
+    covered = {r.subject for r in graph.relations if r.predicate == "under"}
+    roomy = [o for o in cands if min(o.size[:2]) >= max(obj.size[:2]) + 2 * EDGE_ROOM_M]
+    for pool in ([o for o in roomy if o.name not in covered], [o for o in cands if o.name not in covered], roomy):
+        if pool:
+            return _nearest(obj, pool)
     return _nearest(obj, cands)
 
 
