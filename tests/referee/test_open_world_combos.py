@@ -12,9 +12,7 @@ Each test builds its own scene (about a second; a scene that cannot be built fai
 
 Left out, each for a real reason (see the issue): a power strip *in* a full sink (the detector ranked
 ``move_electrical_away_from_water`` first, and no safe support stands 0.6 m from the sink; the near-water
-rule no longer fires on a thing inside the water, and the combo has not been tried again since), a pan
-handle turned inward (a heavy pan on a hob stays within 0.12 m of its edge, so
-``move_heavy_from_edge`` fires), a ball in the crib (it settles inside, not on, so ``$crib`` is
+rule no longer fires on a thing inside the water, and the combo has not been tried again since), a ball in the crib (it settles inside, not on, so ``$crib`` is
 unbound), a dumbbell taken down off a shelf (it rolls to the table's edge), a toy car near the crib
 (no safe is placed in the nursery), a fork in the toaster (it does not fit the slot), a blanket on a
 heater (its top is too small); paper towels on a hob and a hair dryer beside a bathtub pass or fail
@@ -51,6 +49,7 @@ COMBOS = [
      "cleaning_spray"),
     ("The tap of the kitchen sink was left running.", "turn_off_running_tap", "Sink"),
     ("The bathtub tap was left running.", "turn_off_running_tap", "Bathtub"),
+    ("A pot on the stove in the kitchen has its handle turned outward.", "turn_pan_handle_inward", "KitchenPot"),
     pytest.param("A bottle of cleaning spray was put in the fridge.", "remove_chemical_from_fridge", "cleaning_spray",
                  marks=pytest.mark.xfail(strict=True, reason=(
                      "with real models in the scene the safe stands where the spray is not put fully through "
