@@ -127,7 +127,7 @@ POSITIVE = {
     "turn_pan_handle_inward": lambda: graph(stated(obj("pot_0", "KitchenPot", at="counter"), "handle_out")),
     "stand_iron_upright": lambda: graph(stated(obj("iron_0", "iron", at="table", joints=[joint("switch", 0.9)]), "face_down")),
     "clear_soft_things_from_crib": lambda: graph(
-        obj("blanket_0", "Blanket", at="low_table"), crib(), relations=[on("blanket_0", "crib_0")], room="nursery"),
+        obj("blanket_0", "Blanket", at="low_table"), crib(), relations=[inside("blanket_0", "crib_0")], room="nursery"),
 }
 
 NEGATIVE = {

@@ -12,8 +12,9 @@ Each test builds its own scene (about a second; a scene that cannot be built fai
 
 Left out, each for a real reason (see the issue): a power strip *in* a full sink (the detector ranked
 ``move_electrical_away_from_water`` first, and no safe support stands 0.6 m from the sink; the near-water
-rule no longer fires on a thing inside the water, and the combo has not been tried again since), a ball in the crib (it settles inside, not on, so ``$crib`` is
-unbound), a dumbbell taken down off a shelf (it rolls to the table's edge), a toy car near the crib
+rule no longer fires on a thing inside the water, and the combo has not been tried again since), a ball or a
+blanket in the crib (built since the crib is read as a container; the suction cup does not reliably
+catch a thing lying down in it), a dumbbell taken down off a shelf (it rolls to the table's edge), a toy car near the crib
 (no safe is placed in the nursery), a fork in the toaster (it does not fit the slot), a blanket on a
 heater (its top is too small); paper towels on a hob and a hair dryer beside a bathtub pass or fail
 with the scene their task id draws (no base pose by the counter; no safe support 0.6 m from the tub).
