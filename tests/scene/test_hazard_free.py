@@ -55,8 +55,8 @@ def test_a_hazard_free_high_shelf_scene_has_the_hammer_down_on_the_table(tmp_pat
     seed-19 demo's t0006 failed its build with the hammer put back on the shelf)."""
     from pathlib import Path
 
-    from anomalygen.schema import TaskProposal
     from anomalygen.scene.build import build_scene
+    from anomalygen.schema import TaskProposal
 
     task = TaskProposal.model_validate_json((Path(__file__).parent / "fixtures" / "hammer_on_high_shelf.json").read_text())
     out = tmp_path / "hammer"
