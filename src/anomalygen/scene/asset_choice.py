@@ -171,9 +171,10 @@ def needed_parts(task: TaskProposal, catalogue: str, hc, role: ObjectRole | None
     out = [a for a in task.articulations if a.object == catalogue]
     art = getattr(hc, "articulation", None)
     if not out and art is not None and role is not None:
-        plays = (art.variable == "$target" and role in (ObjectRole.TARGET, ObjectRole.HAZARD)
-                 and _same_category(catalogue, task.target_asset)) or (
-                 art.variable != "$target" and art.variable == hc.hazard_variable and role is ObjectRole.HAZARD)
+        if art.variable == "$target":  # the target, built in the target's or (being at fault) the hazard's role
+            plays = role in (ObjectRole.TARGET, ObjectRole.HAZARD) and _same_category(catalogue, task.target_asset)
+        else:
+            plays = art.variable == hc.hazard_variable and role is ObjectRole.HAZARD
         if plays:
             out.append(ArticulationUse(object=catalogue, part=art.part, function=art.function,
                                        initial_state=art.initial_state, target_state=art.target_state))

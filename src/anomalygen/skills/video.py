@@ -32,18 +32,16 @@ class VideoRecorder:
             self._renderer = mujoco.Renderer(model, height=height, width=width)
         finally:
             model.vis.quality.offsamples = samples
+        flags = self._renderer.scene.flags  # kept by every update_scene
+        flags[mujoco.mjtRndFlag.mjRND_SHADOW] = flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
         self.frames: list[np.ndarray] = []
         self._n = 0
 
     def capture(self, data, *, force: bool = False) -> None:
-        import mujoco
-
         self._n += 1
         if not force and (self._n % self.every or len(self.frames) >= self.max_frames):
             return
         self._renderer.update_scene(data, camera=self.camera)
-        flags = self._renderer.scene.flags
-        flags[mujoco.mjtRndFlag.mjRND_SHADOW] = flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
         self.frames.append(self._renderer.render().copy())
 
     def save(self, path: Path, fps: int = 15) -> Path | None:

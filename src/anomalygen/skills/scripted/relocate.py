@@ -30,6 +30,7 @@ HANDLE_GEOM = "handle"  # the geom of a pan's long handle (the catalogue's name,
 EDGE_CLEAR = 0.03  # m the turned handle's tip keeps inside the edge of the surface
 BACK_FROM_EDGE = 0.17  # m the turned pan's body is set down inside the top's edges, where there is room
 SHIFT_GRID = 15  # positions per axis tried for setting it down back from the edges
+CLEAR_SLACK = 0.02  # m short of BACK_FROM_EDGE a spot still counts as clear (above the 0.15 m edge rule)
 TURNS = (0.0, np.pi / 4, -np.pi / 4, np.pi / 2, -np.pi / 2)  # tried around the inward direction, nearest first
 
 
@@ -147,9 +148,8 @@ def _rot(theta: float) -> np.ndarray:
 
 def inward_turn(ep: Episode, obj: str, support: str) -> tuple[float, np.ndarray] | None:
     """(turn about the vertical, box centre after it) that brings the handle's tip back over the
-    support, pointing into it; the body stays where it is. Turns near the straight-inward one are
-    tried in order, each set down back from the top's edges where it has room (``_back_from_edge``) or
-    where it stood. Of those whose tip keeps ``EDGE_CLEAR`` inside the top and whose box misses what
+    support, pointing into it. Turns near the straight-inward one are tried in order, each set down
+    back from the top's edges where it has room (``_shifts_back_from_edge``) or where it stood. Of those whose tip keeps ``EDGE_CLEAR`` inside the top and whose box misses what
     else stands there, the first that also leaves the body clear of every edge is taken, else the
     first; None when none qualifies."""
     drv = ep.driver
@@ -168,7 +168,7 @@ def inward_turn(ep: Episode, obj: str, support: str) -> tuple[float, np.ndarray]
     box_c, half = (olo[:2] + ohi[:2]) / 2, (ohi[:2] - olo[:2]) / 2
     others = [drv.aabb(o.name) for o in ep.spec.objects if o.name not in (obj, support)]
     others = [(a[:2], b[:2]) for a, b in others if b[2] > hi[2] - 0.01 and a[2] < hi[2] + 0.3]
-    options: list[tuple[float, np.ndarray, float]] = []
+    first = None  # the first turn and spot that only brings the handle in
     for extra in TURNS:
         theta = (base + extra + np.pi) % (2 * np.pi) - np.pi
         r = _rot(theta)
@@ -185,13 +185,13 @@ def inward_turn(ep: Episode, obj: str, support: str) -> tuple[float, np.ndarray]
             inside = np.all(tip > lo[:2] + EDGE_CLEAR) and np.all(tip < hi[:2] - EDGE_CLEAR)
             if inside and all(box_gap((nlo + shift, nhi + shift), o) > 0.0 for o in others):
                 clear = float(np.min(np.minimum(nlo + shift - lo[:2], hi[:2] - nhi - shift)))
-                options.append((theta, new_c + shift, clear))
-    # the first turn (nearest straight inward) that leaves the pan clear of every edge; else the first
-    # that only brings the handle in (a pan too long for the top across: its handle is turned along it)
-    if not options:
-        return None
-    theta, centre, _ = next((o for o in options if o[2] >= BACK_FROM_EDGE - 0.02), options[0])
-    return theta, centre
+                if clear >= BACK_FROM_EDGE - CLEAR_SLACK:  # nearest straight inward, clear of every edge
+                    return theta, new_c + shift
+                if first is None:
+                    first = (theta, new_c + shift)
+    # none leaves the pan clear of the edges (a pan too long for the top across): the first that
+    # brings the handle in
+    return first
 
 
 def _shifts_back_from_edge(blo: np.ndarray, bhi: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
