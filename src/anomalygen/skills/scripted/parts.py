@@ -321,6 +321,7 @@ def actuate_part(ep: Episode, joint: str, goal: float, *, closed: float, tol: fl
         why = _drive(ep, joint, stop, tol=tol, max_drag=max_drag)
         if why:
             notes.append(f"attempt {attempt + 1}: {why}")
+        _slacken(ep)
         drv.agent.release(d, name)
         p, n = _world(ep, g)
         dp, drv.dp = drv.dp, 0.004  # back off gently: a fast pull drags a light part along
@@ -342,6 +343,23 @@ def actuate_part(ep: Episode, joint: str, goal: float, *, closed: float, tol: fl
     ok = abs(q() - goal) <= tol
     detail = f"{joint} = {q():.3f} (goal {goal:.3f})" + (f"; {'; '.join(notes)}" if notes else "")
     return SkillOutcome(ok, drv.steps - s0, detail)
+
+
+SLACKEN_STEPS = 15  # control steps the arm holds still, its target on the cup, before letting go of a part
+
+
+def _slacken(ep: Episode) -> None:
+    """Stop leading the held part before letting go: the drive keeps the arm's target ahead of the
+    cup, and the wrist pressed on the panel pushes back against the suction weld; let go under that
+    strain, a light safe door sprang back shut at 1.2 rad/s. The target moved onto the cup, the
+    strain goes while the cup still holds the part."""
+    drv = ep.driver
+    d = drv.data
+    cup = drv.agent.cup
+    for _ in range(SLACKEN_STEPS):
+        d.mocap_pos[drv._mocap] = d.xpos[cup]
+        d.mocap_quat[drv._mocap] = d.xquat[cup]
+        drv.step()
 
 
 def _cup_touches(ep: Episode, body: int) -> bool:

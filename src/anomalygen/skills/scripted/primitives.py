@@ -28,7 +28,8 @@ from anomalygen.skills.geometry import (
     top_rect,
 )
 from anomalygen.skills.registry import SkillOutcome
-from anomalygen.skills.scripted.setdown import centre_over, let_swing_die, lower_until_contact
+from anomalygen.skills.scripted.laydown import LAY_DOWN_OUT, depth_inside, lay_on_side, too_tall_to_go_in
+from anomalygen.skills.scripted.setdown import centre_over, let_swing_die, lower_until_contact, turn_until_there
 
 
 def approach(ep: Episode, obj: str, point=None) -> SkillOutcome:
@@ -343,6 +344,14 @@ def _place_sideways(ep: Episode, obj: str, region: str, floor: float, *, release
     s0 = drv.steps
     lo, hi, out = _compartment(ep, region)
     centre = (lo + hi) / 2
+    laid = ""
+    if too_tall_to_go_in(ep, obj, depth_inside(ep, lo, hi, out, obj)):  # lay it on its side first
+        k = int(np.argmax(np.abs(out[:2])))
+        spot = centre + out * (abs(hi[k] - lo[k]) / 2 + LAY_DOWN_OUT)
+        if not lay_on_side(ep, obj, spot, out):
+            return SkillOutcome(False, drv.steps - s0, f"{obj} is too tall for {region}'s depth and was not "
+                                                       "laid on its side and taken again")
+        laid = "laid on its side, "
     down = quat_z_to(np.array([0.0, 0.0, -1.0]))
     across = 0.0 if abs(out[0]) > abs(out[1]) else np.pi / 2
     turn = (across + np.pi / 2 - long_axis_yaw(ep, obj) + np.pi / 2) % np.pi - np.pi / 2
@@ -361,6 +370,7 @@ def _place_sideways(ep: Episode, obj: str, region: str, floor: float, *, release
         q = np.zeros(4)
         mujoco.mju_mulQuat(q, np.array([np.cos(f * np.pi / 4), *(np.sin(f * np.pi / 4) * axis)]), level)
         drv.goto(front_hi, q, max_steps=40)
+    turn_until_there(ep, side)
     let_swing_die(ep, obj)
     olo, ohi = drv.aabb(obj)
     below = drv.site[2] - olo[2]
@@ -371,7 +381,7 @@ def _place_sideways(ep: Episode, obj: str, region: str, floor: float, *, release
     ok = _enter_and_set_down(ep, obj, front, inside, side, out, out * 0.01, release_after)
     if ok is None:
         return SkillOutcome(False, drv.steps - s0, f"no base pose that reaches into {region} sideways")
-    return SkillOutcome(ok, drv.steps - s0, f"{obj} {'slid into' if ok else 'not fully into'} {region} "
+    return SkillOutcome(ok, drv.steps - s0, f"{obj} {laid}{'slid into' if ok else 'not fully into'} {region} "
                                                "through its door, cup pointing in")
 
 

@@ -20,6 +20,27 @@ def let_swing_die(ep: Episode, obj: str, max_steps: int = 40) -> None:
         drv.step()
 
 
+TURNED_TOL = np.radians(10)  # rad the cup's axis may stay off the direction it was sent to
+TURN_MAX_STEPS = 200  # control steps to wait for the cup to turn there
+
+
+def turn_until_there(ep: Episode, quat, *, tol: float = TURNED_TOL, max_steps: int = TURN_MAX_STEPS) -> bool:
+    """Hold the target until the cup's axis points the way ``quat`` has it. ``goto`` stops once the
+    cup is in place, and a big turn on the spot (a held bottle tipped to lie ahead of the cup) lags
+    behind: carried on still half upright, a bleach bottle went in askew and stuck in the door."""
+    import mujoco
+
+    drv = ep.driver
+    r = np.zeros(9)
+    mujoco.mju_quat2Mat(r, np.asarray(quat, dtype=float) / np.linalg.norm(quat))
+    want = r.reshape(3, 3)[:, 2]
+    for _ in range(max_steps):
+        if float(drv.data.xmat[drv._cup].reshape(3, 3)[:, 2] @ want) > np.cos(tol):
+            return True
+        drv.step()
+    return False
+
+
 def lower_until_contact(ep: Episode, obj: str, target, quat, *, max_steps: int = 300, tol: float = 0.02) -> bool:
     """Lower the held object towards ``target`` (cup face) and stop the moment it touches anything.
 
