@@ -15,8 +15,8 @@ TASKS = {"spray": kb_task("t-spray-safe", "manage_chemical_risks", "Bottle", "cl
 
 @pytest.fixture(scope="module")
 def opened(tmp_path_factory):
-    from anomalygen.schema import DOOR
     from anomalygen.scene.graph import load_scene
+    from anomalygen.schema import DOOR
     from anomalygen.skills.episode import Episode
     from anomalygen.skills.scripted.access import open_for_access
 

@@ -10,6 +10,8 @@ again by its new top: its long side then runs across the opening and only its th
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from anomalygen.robot.frames import subtree_geoms
@@ -55,14 +57,13 @@ def too_tall_to_go_in(ep: Episode, obj: str, depth: float) -> bool:
     return drv.site[2] - drv.aabb(obj)[0][2] + DEPTH_MARGIN > depth
 
 
-def lay_on_side(ep: Episode, obj: str, spot: np.ndarray, out: np.ndarray) -> bool:
+def lay_on_side(ep: Episode, obj: str, spot: np.ndarray, out: np.ndarray, take_again: Callable[[], bool]) -> bool:
     """Tip the held object over (its top towards ``-out``) at ``spot`` on the floor, set it down
-    there lying on its side, let go and take it again from above. True when it is held again and
+    there lying on its side, let go and take it again from above (``take_again``, the grasp primitive). True when it is held again and
     did lie down (lowered a long way, the arm can turn the cup back down and the object lands upright)."""
     import mujoco
 
     from anomalygen.robot.ik import quat_z_to
-    from anomalygen.skills.scripted.primitives import grasp, release
     from anomalygen.skills.scripted.setdown import let_swing_die, lower_until_contact, turn_until_there
 
     drv = ep.driver
@@ -86,10 +87,11 @@ def lay_on_side(ep: Episode, obj: str, spot: np.ndarray, out: np.ndarray) -> boo
     let_swing_die(ep, obj)
     below = drv.site[2] - drv.aabb(obj)[0][2]
     lower_until_contact(ep, obj, np.array([*drv.site[:2], floor + below - 0.03]), side)
-    release(ep)
+    drv.agent.release(drv.data)
+    drv.settle(15)
     drv.goto(drv.site + out * 0.08, side, max_steps=40)
     drv.goto(drv.site + np.array([0.0, 0.0, 0.2]), side, max_steps=100)
     drv.straighten_wrist()
     olo, ohi = drv.aabb(obj)
     lying = ohi[2] - olo[2] < LYING_HEIGHT * tall
-    return grasp(ep, obj).success and lying
+    return take_again() and lying

@@ -29,7 +29,12 @@ from anomalygen.skills.geometry import (
 )
 from anomalygen.skills.registry import SkillOutcome
 from anomalygen.skills.scripted.laydown import LAY_DOWN_OUT, depth_inside, lay_on_side, too_tall_to_go_in
-from anomalygen.skills.scripted.setdown import centre_over, let_swing_die, lower_until_contact, turn_until_there
+from anomalygen.skills.scripted.setdown import (
+    centre_over,
+    let_swing_die,
+    lower_until_contact,
+    turn_until_there,
+)
 
 
 def approach(ep: Episode, obj: str, point=None) -> SkillOutcome:
@@ -348,7 +353,7 @@ def _place_sideways(ep: Episode, obj: str, region: str, floor: float, *, release
     if too_tall_to_go_in(ep, obj, depth_inside(ep, lo, hi, out, obj)):  # lay it on its side first
         k = int(np.argmax(np.abs(out[:2])))
         spot = centre + out * (abs(hi[k] - lo[k]) / 2 + LAY_DOWN_OUT)
-        if not lay_on_side(ep, obj, spot, out):
+        if not lay_on_side(ep, obj, spot, out, lambda: grasp(ep, obj).success):
             return SkillOutcome(False, drv.steps - s0, f"{obj} is too tall for {region}'s depth and was not "
                                                        "laid on its side and taken again")
         laid = "laid on its side, "
