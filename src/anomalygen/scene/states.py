@@ -62,6 +62,18 @@ def handle_tip_x(asset) -> float | None:
     return None
 
 
+def why_cannot_show(asset, state: str) -> str | None:
+    """Why this asset cannot show ``state`` as the builder draws it, None when it can (or when the
+    state is read from controls the part check already asks for: on, lit, running)."""
+    if state == HANDLE_OUT and handle_tip_x(asset) is None:
+        return "has no long handle to stick out"
+    if state == FACE_DOWN and asset.category not in FACE_DOWN_CATEGORIES:
+        return f"cannot lie face down (only {', '.join(sorted(FACE_DOWN_CATEGORIES))} can)"
+    if state == CONTAINS_WATER and not any(g.name == WATER_GEOM for g in geoms_below(asset.spec.worldbody)):
+        return "has no basin to fill with water"
+    return None
+
+
 def show_states(root, placed) -> None:
     """Draw a placed object's states on its attached body (``compose.py``): water in a filled basin,
     the glow of each control that starts on. The asset hides both (alpha 0)."""
