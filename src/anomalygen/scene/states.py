@@ -63,13 +63,14 @@ def handle_tip_x(asset) -> float | None:
 
 
 def why_cannot_show(asset, state: str) -> str | None:
-    """Why this asset cannot show ``state`` as the builder draws it, None when it can (or when the
-    state is read from controls the part check already asks for: on, lit, running)."""
+    """Why this variant of a category that can show ``state`` cannot (a pot with two side grips has no
+    handle to stick out; a sink model without the hidden water geom), None when it can. A category
+    that never can is refused by ``set_states`` with what can; states read from controls (on, lit,
+    running) are the part check's."""
     if state == HANDLE_OUT and handle_tip_x(asset) is None:
         return "has no long handle to stick out"
-    if state == FACE_DOWN and asset.category not in FACE_DOWN_CATEGORIES:
-        return f"cannot lie face down (only {', '.join(sorted(FACE_DOWN_CATEGORIES))} can)"
-    if state == CONTAINS_WATER and not any(g.name == WATER_GEOM for g in geoms_below(asset.spec.worldbody)):
+    if state == CONTAINS_WATER and asset.category in HOLDS_WATER \
+            and not any(g.name == WATER_GEOM for g in geoms_below(asset.spec.worldbody)):
         return "has no basin to fill with water"
     return None
 
