@@ -5,7 +5,7 @@ from __future__ import annotations
 import detect_graphs as g
 import pytest
 
-from anomalygen.detect.rules import REPEAT_PENALTY, Candidate, RuleDetector, candidates, rank
+from anomalygen.detect.rules import Candidate, RuleDetector, candidates, rank
 from anomalygen.schema import Relation
 
 
@@ -72,9 +72,11 @@ def test_ranking_prefers_severity_then_covers_other_objects():
 
     a1, a2, b1 = cand("a", "c1", 0.9), cand("a", "c2", 0.85), cand("b", "c3", 0.8)
     assert [c.hazard_class for c in rank([b1, a2, a1], 3)] == ["c1", "c3", "c2"]
-    # a second class on the same object still wins when it is far more severe than the other object
-    b_low = cand("b", "c3", 0.85 - REPEAT_PENALTY - 0.05)
-    assert [c.hazard_class for c in rank([a1, a2, b_low], 3)] == ["c1", "c2", "c3"]
+    # a second class on an object never pushes a different object out of the top k, however much
+    # weaker that object's hazard is (the planner fixes one class per object: the cut-off hid litter)
+    b_low, a3 = cand("b", "c3", 0.3), cand("a", "c4", 0.84)
+    assert [c.hazard_class for c in rank([a1, a2, a3, b_low], 2)] == ["c1", "c3"]
+    assert [c.hazard_class for c in rank([a1, a2, a3, b_low], 4)] == ["c1", "c3", "c2", "c4"]
     assert rank([a1, a2, b1], 1) == [a1]
 
 

@@ -72,3 +72,22 @@ def test_stored_shears_go_where_no_other_class_fires_on_them():
     assert not ends_hazard(list(kb.hazard_classes.values()), shears, by["box_0"], g)
     assert not ends_hazard(list(kb.hazard_classes.values()), shears, by["storagefurniture_0"], g)
     assert ends_hazard(list(kb.hazard_classes.values()), shears, by["safe_0"], g)
+
+
+def test_a_flat_bag_wider_than_a_bin_has_no_container_however_tall_the_bin():
+    """The suction cup lowers litter lying as it lay: a 0.31 m bag does not pass a 0.24 m bin's mouth
+    even though the bin is taller than the bag is wide; a bin wide enough takes it."""
+    from anomalygen.errors import ItemFailed
+
+    kb = load_kb()
+    hc = kb.hazard_classes["pick_up_floor_litter"]
+    bag = obj("plastic_bag_0", "plastic_bag", at="floor", xy=(0.0, 0.0), size=(0.31, 0.30, 0.012))
+    narrow = furniture("trashcan_0", "TrashCan", xy=(0.4, 0.0), size=(0.24, 0.23, 0.34), joints=[joint("lid", 0.0)])
+    g = graph(bag, narrow)
+    try:
+        choose_container(hc, bag, g, kb)
+        raise AssertionError("a bag wider than the bin was given the bin")
+    except ItemFailed as exc:
+        assert "plastic_bag_0" in str(exc) and "TrashCan" in str(exc)
+    wide = furniture("trashcan_1", "TrashCan", xy=(1.0, 0.0), size=(0.55, 0.54, 0.65), joints=[joint("lid", 0.0)])
+    assert choose_container(hc, bag, graph(bag, narrow, wide), kb) == "trashcan_1"

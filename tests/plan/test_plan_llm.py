@@ -358,3 +358,25 @@ def test_plan_stage_on_the_bundled_gguf_ends_each_item_cleanly(tmp_path):
         assert "\n" not in err and ("TaskPlan" in err or "llamacpp" in err), err
     usage = run.load_manifest().llm_usage
     assert usage.requests >= 1 and usage.completion_tokens > 0
+
+
+def test_a_detected_fix_that_cannot_be_bound_is_recorded_in_the_plan_not_dropped_silently(tmp_path):
+    """Two detected hazards, one with nothing in the scene to fix it with (litter, no bin): the plan
+    makes the other fix and names the dropped one with the planner's reason, for reports to show."""
+    from anomalygen.schema import Detection, DroppedFix, Hypothesis
+
+    run = _run(tmp_path)
+    hyps = [Hypothesis(rank=1, problem="p", solution="s", target_object="refrigerator_0",
+                       hazard_class="close_open_refrigerator", score=0.9),
+            Hypothesis(rank=2, problem="p", solution="s", target_object="apple_0",
+                       hazard_class="pick_up_floor_litter", score=0.9)]
+    write_jsonl(run.detections_path, [Detection(task_id="t-fridge", scene_id="t-fridge", detector="rules",
+                                                hypotheses=hyps)])
+    settings = load_settings(None, {"quiet": True, "workers": 1, "plan.source": "detected"})
+    assert run_stage(run, settings, only=["t-fridge"]).done == 1
+    plan = read_model(run.plan_path("t-fridge"), Plan)
+    assert plan.subtasks and all(s.params.get("object") == "refrigerator_0" for s in plan.subtasks)
+    (dropped,) = plan.dropped
+    assert isinstance(dropped, DroppedFix)
+    assert (dropped.hazard_class, dropped.object) == ("pick_up_floor_litter", "apple_0")
+    assert "no reachable container for apple_0" in dropped.reason and "TrashCan" in dropped.reason

@@ -190,3 +190,28 @@ def test_the_judge_stage_writes_a_verdict_per_run_from_its_saved_final_state(sce
     main(["judge", "--run", str(run.root), "--json"])
     assert json.loads(capsys.readouterr().out)["done"] == 1
     assert load_verdict(run, task.id, 2) is None
+
+
+@pytest.mark.slow
+def test_the_settle_lets_go_of_the_cups_tracking_weld_so_a_tugged_arm_does_not_reset_the_scene(scenes):
+    """An episode can end with the cup's tracking weld on and its target away from the cup (the arm
+    limp, pulled by the weld); kept on while the referee settles with the robot's contacts off, it blew
+    MuJoCo up, which reset the scene: a bag put in a bin was judged back where it started."""
+    import mujoco
+
+    from anomalygen.referee.settle import released_and_settled
+    from anomalygen.robot.agent import Agent
+
+    model, data, spec = load_scene(scenes["knife"])
+    cabinet = next(o for o in spec.objects if o.asset.category == "StorageFurniture")
+    top = max((c.name for c in cabinet.cavities if c.name.startswith("drawer")),
+              key=lambda c: cavity_center(model, data, spec, cabinet.name, c)[2])
+    put(model, data, KNIFE, cavity_center(model, data, spec, cabinet.name, top), size_z=0.02)
+    track = model.equality(Agent.EE_TRACK).id
+    data.eq_active[track] = 1
+    data.mocap_pos[model.body(Agent.EE_TARGET).mocapid[0]] += [0.0, 0.0, 1.0]  # a target a metre off
+    m, d, _, _ = released_and_settled(model, data, spec)
+    assert d.eq_active[track] == 0 and data.eq_active[track] == 1  # let go on the copy only
+    assert d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number == 0
+    v = judge(scenes["knife"], model, data)
+    assert v.resolved and _knife_verdict(v).detail == "fixed", v

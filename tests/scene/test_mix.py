@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 from anomalygen.config import Settings
 from anomalygen.knowledge import load_kb
 from anomalygen.scene.mix import (
@@ -125,3 +127,53 @@ def test_near_placements_build_the_composed_hazard_and_bind_its_other_object(tmp
     snuffed = read_model(tmp_path / "c" / "scene_graph.json", SceneGraph)
     # a candle's flame is its snuffer control: off unless the class asks for it lit (is_on / has_state lit)
     assert next(o for o in snuffed.objects if o.category == "candle").states == ["off"]
+
+
+def test_the_bin_added_for_the_second_hazard_is_the_kind_the_planner_looks_for():
+    """One rule: the builder adds a bin unless the scene holds a kind ``containers_for`` (the planner's
+    choice for that very object) names; a bucket is no bin for a plastic bag, a trash can is."""
+    kb = load_kb()
+    hc = kb.hazard_classes[SECOND_HAZARD_CLASS]
+    on = Settings(build={"near_misses": 0, "multi_hazard": 1.0})
+    assert "Bucket" in hc.default_containers and "Bucket" not in kb.containers_for(hc, "plastic_bag")
+    seen = set()
+    for t in range(60):
+        items = choose_judgement_items(f"t{t}", "store_sharp_objects", {"Bucket"}, kb, on)
+        if items.second_hazard is None:
+            continue
+        wanted = kb.containers_for(hc, items.second_hazard)
+        assert items.bin_kinds == wanted
+        assert items.bin == (None if "Bucket" in wanted else wanted[0])
+        seen.add(items.bin)
+    assert seen == {None, "TrashCan"}  # both cases were drawn
+
+
+@pytest.mark.slow
+def test_a_plastic_bag_second_hazard_comes_with_a_bin_it_goes_into_in_the_simulator(tmp_path):
+    """A flat plastic bag (0.3 m at its smallest) was paired with a bin whose mouth was 0.15 m: the
+    robot lifted it and lowered it onto the rim, twice. The builder now draws the bin (or the bag) so
+    the bag fits, and the robot's own plan puts it in: inside the bin in the settled simulator."""
+    from anomalygen.learn.execute import execute_plan
+    from anomalygen.plan.bind import bind_fix
+    from anomalygen.plan.planner import plan_from_kb
+    from anomalygen.runfolder import read_model
+    from anomalygen.scene.build import build_scene
+    from anomalygen.scene.instances import container_room
+    from anomalygen.schema import SceneGraph
+
+    kb = load_kb()
+    settings = Settings(build={"clutter": 0, "near_misses": 0, "multi_hazard": 1.0, "hazard_free": 0.0})
+    task = make_task("t-bag2", "store_sharp_objects", "Table", "kitchen_knife", "counter_edge")
+    assert choose_judgement_items(task.id, task.hazard_class, set(), kb, settings).second_hazard == "plastic_bag"
+    spec = build_scene(task, seed=0, settings=settings, out_dir=tmp_path / "s")
+    bag = next(o for o in spec.objects if o.asset.category == "plastic_bag")
+    bins = [o for o in spec.objects if o.asset.category == "TrashCan"]
+    assert bins and bag.size <= max(container_room(o) for o in bins)  # its declared cavities
+    graph = read_model(tmp_path / "s" / "scene_graph.json", SceneGraph)
+    hc = kb.hazard_classes[SECOND_HAZARD_CLASS]
+    bindings = bind_fix(hc, bag.name, graph, kb)
+    assert bindings["$container"] in {o.name for o in bins}
+    plan = plan_from_kb(task.id, hc.id, bindings, spec=spec)
+    result = execute_plan(tmp_path / "s", plan, seed=0)
+    inside = [p for p in result.final_predicates if p.call.name == "inside"]
+    assert inside and all(p.holds for p in inside), [p.explanation for p in inside]

@@ -13,7 +13,8 @@ scores ATYPICAL_PENALTY lower and does not outrank, say, the litter next to it. 
 broken by typicality, by specificity (a class with more preconditions that all hold explains the
 object more sharply), then by names, so the order is deterministic. When several objects are
 hazardous, the top of the list should cover them all rather than repeat one object under three
-classes, so each further hypothesis about an object already listed pays a diversity penalty.
+classes: every object's best hypothesis comes before any object's second one (the planner makes one
+fix per object, so a second class for the iron must not push the soda can beside it out of the top k).
 """
 
 from __future__ import annotations
@@ -24,8 +25,6 @@ from anomalygen.schema import Hypothesis, SceneGraph
 
 #: Score taken off when a class with a curated hazard-object list fires on an object not on it.
 ATYPICAL_PENALTY = 0.2
-#: Penalty for each hypothesis already listed about the same object (coverage of several hazards).
-REPEAT_PENALTY = 0.12
 
 
 @dataclass(frozen=True)
@@ -120,19 +119,15 @@ def _because(hc, graph: SceneGraph, bindings: dict[str, str], evaluate) -> str:
 
 
 def rank(cands: list[Candidate], k: int) -> list[Candidate]:
-    """Greedy ranking by score with a penalty for objects already listed; deterministic ties."""
+    """The top ``k`` by score, each object's n-th hypothesis after every object's (n-1)-th (distinct
+    objects first, then second classes, ...); deterministic ties."""
     pool = sorted(cands, key=lambda c: (-c.score, not c.typical, -c.specificity, c.object, c.hazard_class))
-    chosen: list[Candidate] = []
-    seen: dict[str, int] = {}
-    while pool and len(chosen) < k:
-        best_i = min(
-            range(len(pool)),
-            key=lambda i: (-(pool[i].score - REPEAT_PENALTY * seen.get(pool[i].object, 0)), i),
-        )
-        c = pool.pop(best_i)
-        chosen.append(c)
-        seen[c.object] = seen.get(c.object, 0) + 1
-    return chosen
+    listed: dict[str, int] = {}
+    tier = []
+    for i, c in enumerate(pool):
+        tier.append((listed.get(c.object, 0), i))
+        listed[c.object] = listed.get(c.object, 0) + 1
+    return [pool[i] for _, i in sorted(tier)[:k]]
 
 
 def to_hypotheses(ranked: list[Candidate]) -> list[Hypothesis]:

@@ -22,6 +22,7 @@ class ClassRow(Strict):
     hazards: int = 0
     detected: int = 0
     planned: int = 0
+    dropped: int = Field(0, description="detected, but the planner found nothing to fix it with (Plan.dropped)")
     runs: int = Field(0, description="(hazard, seed) executions judged")
     resolved: int = Field(0, description="of those, the hazard was fixed at the end (no hazard class fires on its "
                           "object) and the run created no new hazard")
@@ -53,6 +54,7 @@ def hazard_table(run: RunFolder, task_ids: list[str], seeds: int) -> HazardTable
         det = try_read_model(run.detections_dir / f"{tid}.json", Detection)
         plan = try_read_model(run.plan_path(tid), Plan)
         acted = {str(st.params.get("object")) for st in plan.subtasks} if plan is not None else set()
+        dropped = {d.object for d in plan.dropped} if plan is not None else set()
         results = [v for s in range(seeds) if (v := verdict_of(run, tid, s)) is not None]
         for r in results:
             table.runs += 1
@@ -64,6 +66,7 @@ def hazard_table(run: RunFolder, task_ids: list[str], seeds: int) -> HazardTable
             hyps = det.hypotheses if det is not None else []
             row.detected += int(finds(hyps, h))
             row.planned += int(h.object in acted)
+            row.dropped += int(h.object in dropped and h.object not in acted)
             for r in results:
                 outcome = next((o for o in r.hazards if o.object == h.object), None)
                 if outcome is not None:
@@ -71,7 +74,7 @@ def hazard_table(run: RunFolder, task_ids: list[str], seeds: int) -> HazardTable
                     row.resolved += int(outcome.resolved and not r.new_hazards)  # new hazards count against the run
     table.by_class = dict(sorted(rows.items()))
     for row in table.by_class.values():
-        for key in ("hazards", "detected", "planned", "runs", "resolved"):
+        for key in ("hazards", "detected", "planned", "dropped", "runs", "resolved"):
             setattr(table.total, key, getattr(table.total, key) + getattr(row, key))
     return table
 
@@ -87,6 +90,9 @@ def markdown(table: HazardTable, title: str = "") -> str:
         lines.append(f"| {name} | {r.hazards} | {pct(r.detected, r.hazards)} | {pct(r.planned, r.hazards)} | "
                      f"{pct(r.resolved, r.runs)} of {r.runs} |")
     lines.append("")
+    dropped = [f"{name} {r.dropped}" for name, r in table.by_class.items() if r.dropped]
+    if dropped:
+        lines.append(f"Detected but left out of the plan, nothing in the scene to fix them with: {', '.join(dropped)}.")
     lines.append(f"{table.scenes} scenes ({table.hazard_free_scenes} hazard-free), {table.runs} runs: "
                  f"{pct(table.runs_with_new_hazards, table.runs)} created a new hazard, "
                  f"{pct(table.runs_acting_on_safe, table.runs)} acted on an already-safe object.")

@@ -120,8 +120,10 @@ def choose_support(hc, obj: GraphObject, graph: SceneGraph) -> str:
 
 
 def _fits(obj: GraphObject, container: GraphObject) -> bool:
-    """Loose test on bounding boxes: the object's longest side within the container's longest side."""
-    return max(obj.size) < max(container.size)
+    """Loose test on bounding boxes: the object's longest side within the container's longest side, and
+    its footprint within the container's (the suction cup lowers it lying as it lay: a flat bag wider
+    than a bin does not pass the bin's mouth however tall the bin is)."""
+    return max(obj.size) < max(container.size) and max(obj.size[:2]) < max(container.size[:2])
 
 
 def _nearest(obj: GraphObject, cands: list[GraphObject]) -> str:

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 from anomalygen.errors import ItemFailed, UserError
 from anomalygen.runfolder import RunFolder, read_jsonl, try_read_model, write_model
 from anomalygen.runner import StageContext, StageSummary, check_only, config_section, run_items
-from anomalygen.schema import Detection, Plan, SceneSpec, SuccessSpec, TaskProposal
+from anomalygen.schema import Detection, DroppedFix, Plan, SceneSpec, SuccessSpec, TaskProposal
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
@@ -82,19 +82,19 @@ def _plan_from_perception(task_id: str, payload: dict, ctx: StageContext) -> Pla
         top = chosen[0]
         bindings = bind_fix(kb.hazard_classes[top["hazard_class"]], top["target_object"], graph, kb)
         return _plan_with_llm(task_id, payload, ctx, top["hazard_class"], bindings, spec, top)
-    plans, problems = [], []
+    plans, dropped = [], []
     for hyp in chosen:
         hc = kb.hazard_classes[hyp["hazard_class"]]
         try:
             bindings = bind_fix(hc, hyp["target_object"], graph, kb)
         except ItemFailed as exc:
-            problems.append(f"{hc.id} on {hyp['target_object']}: {exc}")
+            dropped.append(DroppedFix(hazard_class=hc.id, object=hyp["target_object"], reason=str(exc)))
             continue
         plans.append(plan_from_kb(task_id, hc.id, bindings, spec=spec, source="detected",
                                   sac_actions=settings.plan.sac_actions))
     if not plans:
-        raise ItemFailed("; ".join(problems))
-    return merge_plans(plans)
+        raise ItemFailed("; ".join(f"{d.hazard_class} on {d.object}: {d.reason}" for d in dropped))
+    return merge_plans(plans).model_copy(update={"dropped": dropped})
 
 
 def fixes_to_make(hypotheses: list[dict], kb, *, max_fixes: int, min_score: float) -> list[dict]:

@@ -189,7 +189,7 @@ def _same_category(catalogue: str, name: str) -> bool:
 
 
 def plausibility_problem(
-    asset, catalogue: str, kb, parts: list[ArticulationUse], *, cap: float | None, handle: bool = False
+    asset, catalogue: str, kb, parts: list[ArticulationUse], *, cap: float | None, states: frozenset[str] = frozenset()
 ) -> str | None:
     """The knowledge-based verification of a candidate: None when plausible, else why not."""
     rng = kb_size_range(kb, catalogue)
@@ -202,11 +202,13 @@ def plausibility_problem(
     for part in parts:
         if part.initial_state in ("open", "closed", "on", "off") and not joints_with_label(asset, part.part):
             return f"{catalogue} candidate has no '{part.part}' joint"
-    if handle:
-        from anomalygen.scene.states import handle_tip_x
+    if states:
+        from anomalygen.scene.states import why_cannot_show
 
-        if handle_tip_x(asset) is None:
-            return f"{catalogue} candidate has no long handle to stick out"
+        for state in sorted(states):
+            why = why_cannot_show(asset, state)
+            if why is not None:
+                return f"{catalogue} candidate {why}"
     return None
 
 
@@ -219,13 +221,15 @@ def joints_with_label(asset, label: str) -> list:
     return [j for j in asset.joints if part_labels.canonical(j.label) in wanted]
 
 
-def wants_handle_out(task: TaskProposal, catalogue: str, hc) -> bool:
-    """Does the task ask the object at fault to have its handle out (a pan on the hob)?"""
-    from anomalygen.scene.states import HANDLE_OUT
-
-    asked = HANDLE_OUT in task.scenario.states.get(catalogue, [])
-    return asked or (hc is not None and any(
-        c.name == "has_state" and not c.negate and c.args.get("state") == HANDLE_OUT for c in hc.preconditions))
+def wanted_states(task: TaskProposal, catalogue: str, hc, role: ObjectRole) -> frozenset[str]:
+    """The states the task asks this object to show (its scenario's states for the category; for the
+    object at fault, also its class's ``has_state`` preconditions): a candidate that cannot show one
+    (a pot with two side grips cannot have its handle out) gives way to another draw."""
+    asked = set(task.scenario.states.get(catalogue, []))
+    if role is ObjectRole.HAZARD and hc is not None:
+        asked |= {str(c.args.get("state")) for c in hc.preconditions
+                  if c.name == "has_state" and not c.negate and c.args.get("object") == hc.hazard_variable}
+    return frozenset(asked)
 
 
 def pick_asset(
@@ -251,7 +255,7 @@ def pick_asset(
     from anomalygen.assets.core import draw, generate
 
     parts = needed_parts(task, catalogue, hc, role)
-    handle = role is ObjectRole.HAZARD and wants_handle_out(task, catalogue, hc)
+    states = wanted_states(task, catalogue, hc, role)
     n = TARGET_CANDIDATES if rank else 2
     seeds = [int(s) for s in rng.integers(0, 2**31 - 1, size=n)]
     candidates, problems = [], []
@@ -263,14 +267,14 @@ def pick_asset(
         drawn += 1
         want = choose_size(kb, catalogue, rng, cap=cap, preferred=size)
         asset = draw(catalogue, s, size=want, real=real)
-        problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap, handle=handle)
+        problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap, states=states)
         if problem is None and asset.package is not None and room_for and asset.cavities \
                 and cavity_cap(asset) < room_for:
             problem = f"its interior takes {cavity_cap(asset):.2f} m, less than the {room_for:.2f} m to go in"
         if problem is not None and asset.package is not None:
             problems.append(f"real model {asset.asset_id}: {problem}")
             asset = generate(catalogue, s, size=want)
-            problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap, handle=handle)
+            problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap, states=states)
         if problem is None:
             candidates.append(asset)
         else:

@@ -9,6 +9,8 @@ that it really is none.
 
 from __future__ import annotations
 
+import math
+
 from anomalygen.errors import ItemFailed
 from anomalygen.knowledge import load_kb
 from anomalygen.knowledge.predicates import ROOM_FIXTURES
@@ -47,13 +49,45 @@ def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed]
         placed[p.name] = p
     if items.state is not None and surfaces:
         _place_state_near_miss(sel, lay, placed, surfaces, items.state, rng)
-    for cat, role, face in ((items.second_hazard, ObjectRole.HAZARD, False), (items.bin, ObjectRole.CONTAINER, True)):
-        if cat is None:
+    if items.second_hazard is not None:
+        _place_second_hazard(sel, lay, placed, items)
+
+
+def _place_second_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], items: mix.JudgementItems) -> None:
+    """The second hazard on the floor with a bin it goes into, so the robot can fix it: a bin of the
+    planner's kinds (``items.bin_kinds``) already in the scene, else one added and drawn again in other
+    sizes (then its largest) until the object fits; an object too big for every bin drawn is drawn smaller, and left out
+    when it cannot be (a flat 0.3 m bag never passes a 0.15 m mouth: a hazard nobody could fix)."""
+    rng = items.rng
+
+    def draw(cat: str, role: ObjectRole, cap: float | None = None, size: float | None = None):
+        return asset_choice.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng,
+                                       cap=cap, size=size, real=sel.real_assets)
+
+    litter = draw(items.second_hazard, ObjectRole.HAZARD)
+    room = max((container_room(p.asset) for p in placed.values()
+                if p.catalogue in items.bin_kinds and p.asset is not None and p.asset.cavities), default=0.0)
+    kind = items.bin or (items.bin_kinds[0] if items.bin_kinds else None)
+    bin_asset = None
+    for attempt in range(CONTAINER_REDRAWS + 1 if kind and litter.size > room else 0):
+        # first a bin of any size; then the largest of its kind (what a big bag needs), other shapes
+        cand = draw(kind, ObjectRole.CONTAINER, size=None if attempt == 0 else math.inf)
+        if cand.cavities and container_room(cand) > room:
+            bin_asset, room = cand, container_room(cand)
+        if litter.size <= room:
+            break
+    if litter.size > room:
+        try:
+            litter = draw(items.second_hazard, ObjectRole.HAZARD, cap=room)
+        except ItemFailed:
+            return
+        if litter.size > room:
+            return
+    for cat, role, asset in ((items.second_hazard, ObjectRole.HAZARD, litter), (kind, ObjectRole.CONTAINER, bin_asset)):
+        if asset is None:
             continue
-        asset = asset_choice.pick_asset(cat, role=role, kb=sel.kb, task=sel.task, hc=None, rng=rng,
-                                        real=sel.real_assets)
         p = placed_instance(asset_choice.Chosen(instance_name(cat, sel.used), cat, role, asset))
-        lay.place_on_floor(p, relevant=True, face=face)
+        lay.place_on_floor(p, relevant=True, face=role == ObjectRole.CONTAINER)
         if role == ObjectRole.HAZARD:
             p.intent = Intent("hazard", mix.SECOND_HAZARD_CLASS, "the judgement mix's second hazard")
         placed[p.name] = p

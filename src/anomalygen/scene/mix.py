@@ -134,6 +134,7 @@ class JudgementItems:
     near_misses: list[NearMissPick] = field(default_factory=list)
     second_hazard: str | None = None
     bin: str | None = None  # a container for the second hazard, when the scene has none
+    bin_kinds: list[str] = field(default_factory=list)  # every kind the planner would put it in
     state: StatePick | None = None
     rng: np.random.Generator | None = None
 
@@ -165,9 +166,11 @@ def choose_judgement_items(task_id: str, hazard_class: str, in_scene: set[str], 
                  and kb.objects[n].size_range[0] <= MAX_ITEM_SIZE]
         if cands:
             items.second_hazard = cands[int(rng.integers(len(cands)))]
-            bins = [c for c in hc.default_containers if c in kb.objects]
-            if bins and not set(bins) & in_scene:
-                items.bin = bins[0]
+            # the kinds the robot's planner will look for (``bind.choose_container`` asks the same
+            # question): a bucket in the room is no bin for a plastic bag the knowledge base throws away
+            items.bin_kinds = [c for c in kb.containers_for(hc, items.second_hazard) if c in kb.objects]
+            if items.bin_kinds and not set(items.bin_kinds) & in_scene:
+                items.bin = items.bin_kinds[0]
     return items
 
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from anomalygen.schema import JointState, part_labels
+from anomalygen.schema.part_labels import HANDLE_GEOM
 
 ON, OFF, LIT, RUNNING = "on", "off", "lit", "running"
 CONTAINS_WATER, WET = "contains_water", "wet"
@@ -33,7 +34,6 @@ HOLDS_WATER = frozenset({"Sink", "Bathtub"})  # their asset has a hidden ``water
 ALWAYS_WET = frozenset({"Puddle"})
 LIT_WHEN_ON = frozenset({"Stove", "candle"})  # an open flame or a glowing burner when on
 FACE_DOWN_CATEGORIES = frozenset({"iron"})
-HANDLE_GEOM = "handle"  # the geom of a pan's or pot's long handle
 WATER_GEOM = "water"
 GLOW_SUFFIX = "_glow"  # a geom "<control body>_glow" shows while that control is on
 WATER_ALPHA = 0.55
@@ -59,6 +59,19 @@ def handle_tip_x(asset) -> float | None:
     for geom in geoms_below(asset.spec.worldbody):
         if geom.name == HANDLE_GEOM:
             return float(geom.pos[0] + geom.size[0])
+    return None
+
+
+def why_cannot_show(asset, state: str) -> str | None:
+    """Why this variant of a category that can show ``state`` cannot (a pot with two side grips has no
+    handle to stick out; a sink model without the hidden water geom), None when it can. A category
+    that never can is refused by ``set_states`` with what can; states read from controls (on, lit,
+    running) are the part check's."""
+    if state == HANDLE_OUT and handle_tip_x(asset) is None:
+        return "has no long handle to stick out"
+    if state == CONTAINS_WATER and asset.category in HOLDS_WATER \
+            and not any(g.name == WATER_GEOM for g in geoms_below(asset.spec.worldbody)):
+        return "has no basin to fill with water"
     return None
 
 

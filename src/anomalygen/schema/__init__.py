@@ -76,6 +76,7 @@ from anomalygen.schema.scenes import (
     within_child_reach,
 )
 from anomalygen.schema.skills import (
+    DroppedFix,
     FixOutcome,
     HazardOutcome,
     Plan,
@@ -198,6 +199,7 @@ __all__ = [
     "SuccessSpec",
     "SubTask",
     "Plan",
+    "DroppedFix",
     "SubTaskResult",
     "HazardOutcome",
     "FixOutcome",

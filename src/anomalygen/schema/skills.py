@@ -46,6 +46,15 @@ class SubTask(Artefact):
     success: SuccessSpec = Field(default_factory=SuccessSpec)
 
 
+class DroppedFix(Strict):
+    """A detected hazard the planner could not make a fix for (no container it fits, no surface, ...),
+    kept beside the plan so reports show what was left unfixed and why, not only what was planned."""
+
+    hazard_class: str
+    object: str
+    reason: str
+
+
 class Plan(Artefact):
     task_id: str
     source: Literal["ground_truth", "detected"]
@@ -53,6 +62,8 @@ class Plan(Artefact):
     subtasks: list[SubTask]
     success: SuccessSpec
     bindings: dict[str, str] = Field(default_factory=dict)
+    dropped: list[DroppedFix] = Field(
+        default_factory=list, description="detected hazards left out of the plan, each with the planner's reason")
 
 
 class SubTaskResult(Strict):
