@@ -69,7 +69,7 @@ def judge(row: dict, kb, tg) -> dict:
     # the task the line becomes must put the state on that object too: a class about its target
     # (left on, left open) sets it on the task's target_asset
     task = tg.proposal(row["line"], 1)
-    built_on = task.target_asset if comp.hc.hazard_variable == "$target" else task.scenario.hazard_object
+    built_on = task.target_asset if comp.hc.about_target else task.scenario.hazard_object
     ok = ok and built_on == comp.fault.name
     out.update(outcome="composed", hazard_class=comp.hc.id, mechanism=mech, object=comp.fault.name,
                other=comp.other.name if comp.other else None, built_on=built_on,

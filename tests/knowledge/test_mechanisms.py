@@ -243,3 +243,18 @@ def test_a_chemical_shut_in_a_latched_safe_beside_the_crib_is_no_hazard():
     assert match_class(hc, POSITIVE["chemical_near_crib"]())
     locked = graph(obj("pod_0", "detergent_pod", at="floor", xy=NEAR, reachable=False), crib())
     assert not match_class(hc, locked)
+
+
+def test_a_composition_says_why_its_own_combination_is_dangerous():
+    """A mechanism's text may speak of several cases (a pan handle and an iron); a composition that
+    needs its own reason states it, and the others keep the mechanism's."""
+    kb = load_kb()
+    pan, iron = kb.hazard_classes["turn_pan_handle_inward"], kb.hazard_classes["stand_iron_upright"]
+    assert "iron" not in pan.why and "pan" in pan.why
+    assert "pan" not in iron.why and "iron" in iron.why
+    assert "microwave" not in kb.hazard_classes["remove_item_from_toaster"].why
+    assert "suffocat" in kb.hazard_classes["clear_soft_things_from_crib"].why
+    ms = load_mechanisms()
+    left_on = ms.mechanism("left_on")
+    heat_tool = next(c for c in left_on.compositions if c.id == "switch_off_heat_tool")
+    assert heat_tool.why is None and kb.hazard_classes["switch_off_heat_tool"].why == left_on.why

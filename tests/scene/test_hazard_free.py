@@ -67,3 +67,27 @@ def test_a_hazard_free_high_shelf_scene_has_the_hammer_down_on_the_table(tmp_pat
     assert any(n.startswith("table") for n in on), on
     assert hammer.position[2] < 1.1
     assert read_model(out / "truth.json", HazardManifest).hazards == []
+
+
+def test_a_task_object_that_could_fire_the_class_is_made_safe_with_the_hazard(tmp_path):
+    """A loose task object of a kind the class is about goes where the made-safe hazard went: the
+    target lighter shut in the safe beside the matches, the target camera on the table beside the bowl
+    (the seed-0 loop's t0109 and t0076 failed their hazard-free builds with them left on the floor)."""
+    from pathlib import Path
+
+    from anomalygen.scene.build import build_scene
+    from anomalygen.schema import TaskProposal
+
+    for fixture, hazard, extra in (("matches_on_floor_lighter_target", "matches", "Lighter"),
+                                   ("bowl_on_floor_camera_target", "bowl", "Camera")):
+        task = TaskProposal.model_validate_json((Path(__file__).parent / "fixtures" / f"{fixture}.json").read_text())
+        out = tmp_path / fixture
+        build_scene(task, seed=0, settings=SAFE, out_dir=out, hazard_free=True)
+        graph = read_model(out / "scene_graph.json", SceneGraph)
+        by_cat = {o.category: o for o in graph.objects}
+        assert not by_cat[hazard].on_floor and not by_cat[extra].on_floor, fixture
+        if extra == "Lighter":
+            assert not by_cat[extra].child_reachable
+            assert {r.object for r in graph.relations if r.subject == by_cat[extra].name and r.predicate == "inside"} \
+                == {r.object for r in graph.relations if r.subject == by_cat[hazard].name and r.predicate == "inside"} != set()
+        assert read_model(out / "truth.json", HazardManifest).hazards == [], fixture

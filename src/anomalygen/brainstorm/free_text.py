@@ -84,7 +84,7 @@ class TextGrounder:
         mentioned = [m.name for m in parsed.mentions]
         targets = class_targets(kb, hc)
         target = next((m for m in [hazard, *mentioned] if m in targets), targets[0] if targets else hazard)
-        if hc.hazard_variable == "$target":
+        if hc.about_target:
             # the class's state (on, open) is set on its target: the line's object at fault is the
             # target, a category of the paper's 44 or not (a space heater left on is not an oven left on)
             target = hazard

@@ -81,7 +81,7 @@ def ground_llm_names(raw: LLMProposal, g: NameGrounder, *, reader=None) -> Groun
     if target is None:
         from anomalygen.brainstorm.idea_sampler import class_targets
 
-        about_target = hc is not None and getattr(hc, "hazard_variable", "") == "$target"
+        about_target = hc is not None and hc.about_target
         options = ([hazard] if hazard and (hazard in kb.targets or about_target) else []) + (class_targets(kb, hc) if hc is not None and hc.id in kb.hazard_classes else [])
         target = options[0] if options else (hc.target_assets[0] if hc is not None and hc.target_assets else "Table")
         matches.append(GroundingMatch(field="target_asset", written=raw.target_asset, grounded=target, method="class_default"))

@@ -50,7 +50,7 @@ def _class_targets(kb: KnowledgeBase, hc: HazardClass) -> list[str]:
     pinned = {c for call in hc.preconditions if call.name == "category_is" and not call.negate
               and call.args.get("object") == "$target" for c in str(call.args.get("category", "")).split("|")}
     out = [t for t in out if t in pinned] or out if pinned else out
-    if hc.hazard_variable == "$target":  # the target is the object at fault: only those that can be
+    if hc.about_target:  # the target is the object at fault: only those that can be
         from anomalygen.brainstorm.drawable import hazards_for
 
         can = set(hazards_for(kb, hc))
@@ -156,7 +156,7 @@ class IdeaSampler:
 
         kb = self.kb
         candidates = hazards_for(kb, hc)
-        if hc.hazard_variable == "$target":
+        if hc.about_target:
             # the class is about the target itself (its door is open, it is on): a safe named beside a
             # table would be built as the table's open drawer, so the object at fault is the target
             # (class_targets offers only targets that can be)

@@ -255,7 +255,7 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     hazard = nice(idea.hazard)
     container = nice(idea.container) if idea.container else "a safe place"
     support = nice(idea.support) if idea.support else "a raised surface"
-    articulated = hc.articulation is not None and hc.hazard_variable == "$target"
+    articulated = hc.articulation is not None and hc.about_target
     part = (kb.articulation_part(hc, idea.hazard) or DOOR) if articulated else ""
     state = hc.articulation.initial_state if hc.articulation else ""
     person = idea.person or hc.at_risk

@@ -26,7 +26,7 @@ def proposal_problems(p: TaskProposal, kb: KnowledgeBase) -> list[str]:
     """Human-readable problems; empty when the proposal can be built."""
     names = set(kb.objects)
     out: list[str] = []
-    about_target = p.hazard_class in kb.hazard_classes and kb.hazard_classes[p.hazard_class].hazard_variable == "$target"
+    about_target = p.hazard_class in kb.hazard_classes and kb.hazard_classes[p.hazard_class].about_target
     # a class about the target itself (a heater left on) takes the object at fault as its target,
     # one of the 44 categories or not
     if p.target_asset not in kb.targets and not (about_target and p.target_asset == p.scenario.hazard_object

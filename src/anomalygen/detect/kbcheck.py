@@ -108,7 +108,7 @@ def _expected(hc_id: str, placement: str, inst: str) -> tuple[str, str]:
 def _hazard_objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObject], list[Relation], str]:
     name = f"{obj.lower()}_0"
     props = _props(kb, obj)
-    if hc.hazard_variable == "$target" and hc.articulation is not None:
+    if hc.about_target and hc.articulation is not None:
         label = kb.articulation_part(hc, obj) or part_labels.alternatives(hc.articulation.part)[0]
         frac = 0.8 if hc.articulation.initial_state in ("open", "on") else 0.0
         objs = [_obj(name, obj, props, pos=(1.0, -0.8, 0.5), size=(0.6, 0.6, 1.0), height=0.0, on_floor=True,

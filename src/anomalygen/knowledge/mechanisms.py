@@ -88,6 +88,8 @@ class Composition(KBModel):
     name: str | None = Field(None, description="the class's name (default: the fragments' words)")
     fault: str | None = None
     severity: float | None = None
+    why: str | None = Field(None, description="why this combination is dangerous, where the mechanism's "
+                            "own text speaks of other objects (default: the mechanism's)")
     containers: list[str] = Field(default_factory=list)
     supports: list[str] = Field(default_factory=list)
     targets: list[str] = Field(default_factory=list)
@@ -211,7 +213,7 @@ def compose(ms: MechanismSet, m: Mechanism, c: Composition, kind_id: str) -> Haz
         paper_class=False,
         at_risk=m.at_risk,
         people=list(m.people),
-        why=m.why,
+        why=c.why or m.why,
         severity=c.severity if c.severity is not None else m.severity,
         variables=variables,
         hazard_variable=fault,

@@ -16,6 +16,7 @@ from anomalygen.schema import HazardCategory, PredicateCall, ScalarArg
 
 DATA_DIR = Path(__file__).resolve().parent.parent / "data"
 KNOWLEDGE_DIR = DATA_DIR / "knowledge"
+TARGET_VARIABLE = "$target"  # the variable bound to a task's target asset
 
 #: Hazard-relevant object properties. Every ``has_property`` argument and every object's
 #: ``properties`` entry must be one of these.
@@ -200,6 +201,12 @@ class HazardClass(KBModel):
     solution: str = Field("", description="the fix in words, with {hazard}/{container}/{support} slots")
     success_text: str = Field("", description="the safe end state in words, same slots")
     composition: Composed | None = Field(None, description="the mechanism and fragments it is composed of")
+
+    @property
+    def about_target(self) -> bool:
+        """The task's target is the object at fault (a door left open, an oven left on): the state is
+        on the target itself, so the object a task names at fault must be its target."""
+        return self.hazard_variable == TARGET_VARIABLE
 
     def variable_names(self) -> list[str]:
         """Variables in first-use order across preconditions (the order match_class binds them)."""

@@ -196,7 +196,7 @@ def _looks_like(o, kb) -> str | None:
         hc = kb.hazard_classes[hc_id]
         if hc.hazard_variable == "$hazard" and o.category in kb.hazard_candidates(hc):
             return hc_id
-        if hc.hazard_variable == "$target" and o.category in _target_categories(hc):
+        if hc.about_target and o.category in _target_categories(hc):
             return hc_id
     return None
 

@@ -121,7 +121,7 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
                     real_assets=real_assets)
     hc, variables = sel.hc, sel.variables
     sel.hazard_is_target = asset_choice.resolve_name(sc.hazard_object) == asset_choice.resolve_name(task.target_asset)
-    if hc is not None and hc.hazard_variable == "$target" and not sel.hazard_is_target:
+    if hc is not None and hc.about_target and not sel.hazard_is_target:
         # built, the class's state would go on the target, not on the object the task is about
         raise ItemFailed(f"{hc.id} is about the target itself, but the task names {sc.hazard_object} at fault "
                          f"and {task.target_asset} as the target: it would be built as the {task.target_asset}'s hazard")

@@ -24,8 +24,10 @@ from anomalygen.scene.instances import (
     placed_instance,
     surface_of,
 )
-from anomalygen.scene.layout import Layout, Placed
+from anomalygen.scene.layout import Layout, Placed, overlaps
 from anomalygen.schema import ObjectRole, ValidationCheck, ValidationReport, part_labels
+
+CAVITY_TRIES = 8  # jittered spots tried for a second object shut in the hazard's container
 
 
 def place_judgement_items(sel: Selection, lay: Layout, placed: dict[str, Placed], surfaces: list[Placed],
@@ -127,6 +129,37 @@ def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], 
         lay.place_on_surface(hp, support, surface_of(support), inward=INWARD, near_side=HAZARD_NEAR_SIDE)
         return
     lay.place_beside(hp, room_fixtures(sel.kb, lay))
+
+
+def could_fire_the_class(sel: Selection, catalogue: str) -> bool:
+    """Whether an object of this kind can itself be the task class's object at fault (a camera for
+    'fragile thing on the floor', a lighter for 'fire starter within a child's reach')."""
+    return sel.hc is not None and catalogue in sel.kb.static_candidates(sel.hc, sel.hc.hazard_variable)
+
+
+def place_like_the_hazard(lay: Layout, placed: dict[str, Placed], p: Placed, hazard: Placed,
+                          support: Placed | None) -> bool:
+    """In a hazard-free scene, a loose task object that could fire the class goes where the made-safe
+    hazard went: shut in the same container beside it, else well inside the fix's support. False when
+    neither has room (the caller places it as usual and the hazard-free check judges the scene)."""
+    holder = placed.get(hazard.inside) if hazard.inside else None
+    if holder is not None:
+        cavity = cavity_world(holder)[:2]
+        for _ in range(CAVITY_TRIES):
+            try:
+                lay.place_in_cavity(p, holder, cavity)
+            except ItemFailed:
+                break
+            if not overlaps(p.footprint(), hazard.footprint(), margin=0.005):
+                return True
+            lay.items.remove(p)
+    if support is not None:
+        try:
+            lay.place_on_surface(p, support, surface_of(support), inward=INWARD)
+            return True
+        except ItemFailed:
+            pass
+    return False
 
 
 def child_safe_container(sel: Selection) -> asset_choice.Chosen | None:

@@ -24,9 +24,11 @@ from anomalygen.scene.instances import (
     surface_of,
 )
 from anomalygen.scene.judgement import (
+    could_fire_the_class,
     offer_child_safe_container,
     place_hazard_safely,
     place_judgement_items,
+    place_like_the_hazard,
     room_fixtures,
 )
 from anomalygen.scene.layout import Layout, Placed, face_robot_yaw, reached_from_front
@@ -102,20 +104,24 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
     if not sel.hazard_free:
         offer_child_safe_container(sel, lay, placed)
 
+    fix_support = placed.get(sel.support_var.name) if sel.support_var is not None else None
     if hazard.name not in placed:
         if sel.hazard_free:
             # where the fix would leave it: on the fix's own support (the table a hammer is taken down
             # onto), not the high shelf the hazardous version stands it on
-            fix_support = placed.get(sel.support_var.name) if sel.support_var is not None else None
             place_hazard_safely(sel, lay, placed, fix_support or support)
         else:
             _place_hazard(sel, lay, placed, support, support_kind)
 
-    # Remaining loose task objects: on the support (away from its edge) or on the floor.
+    # Remaining loose task objects: on the support (away from its edge) or on the floor; in a
+    # hazard-free scene, one that could fire the class itself goes where the made-safe hazard went.
     for ch in task_objects:
         if ch is None or ch.name in placed:
             continue
         p = placed[ch.name] = placed_instance(ch)
+        if sel.hazard_free and not ch.fixed and could_fire_the_class(sel, ch.catalogue) \
+                and place_like_the_hazard(lay, placed, p, placed[hazard.name], fix_support or support):
+            continue
         if support is not None and ch.size < LOOSE_ON_SUPPORT_MAX:
             try:
                 lay.place_on_surface(p, support, surface_of(support), inward=INWARD)

@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from anomalygen.schema import JointState, part_labels
+from anomalygen.schema.part_labels import HANDLE_GEOM
 
 ON, OFF, LIT, RUNNING = "on", "off", "lit", "running"
 CONTAINS_WATER, WET = "contains_water", "wet"
@@ -33,7 +34,6 @@ HOLDS_WATER = frozenset({"Sink", "Bathtub"})  # their asset has a hidden ``water
 ALWAYS_WET = frozenset({"Puddle"})
 LIT_WHEN_ON = frozenset({"Stove", "candle"})  # an open flame or a glowing burner when on
 FACE_DOWN_CATEGORIES = frozenset({"iron"})
-HANDLE_GEOM = "handle"  # the geom of a pan's or pot's long handle
 WATER_GEOM = "water"
 GLOW_SUFFIX = "_glow"  # a geom "<control body>_glow" shows while that control is on
 WATER_ALPHA = 0.55

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from anomalygen.schema.part_labels import HANDLE_GEOM
 from anomalygen.skills.geometry import NEAR_EDGE, box_gap, rated_spot, top_rect
 from anomalygen.skills.registry import SkillOutcome
 from anomalygen.skills.scripted import primitives
@@ -26,7 +27,6 @@ SAFE_SUPPORTS = ("Table", "counter", "shelf", "StorageFurniture")  # categories 
 UNSAFE_STATES = ("on", "lit", "running", "contains_water", "wet")  # a support showing one is no place to put things
 REACH_TOP = (0.3, 1.3)  # m: tops the arm sets things on (a low table to a shelf)
 LIFT = 0.05  # m a pan is lifted off its hob to be turned
-HANDLE_GEOM = "handle"  # the geom of a pan's long handle (the catalogue's name, scene/states.py reads it too)
 EDGE_CLEAR = 0.03  # m the turned handle's tip keeps inside the edge of the surface
 BACK_FROM_EDGE = 0.17  # m the turned pan's body is set down inside the top's edges, where there is room
 SHIFT_GRID = 15  # positions per axis tried for setting it down back from the edges
