@@ -1,7 +1,8 @@
-"""Moving a whole object somewhere safer: away from another by a distance, off what it lies on, or
-turned so its handle no longer sticks out over the edge.
+"""Moving a whole object somewhere safer: away from another by a distance, back from the edges of
+its top (onto another top when its own has no room), off what it lies on, or turned so its handle
+no longer sticks out over the edge.
 
-All three are a suction pick and a set-down with the motion primitives (``primitives.grasp``,
+All four are a suction pick and a set-down with the motion primitives (``primitives.grasp``,
 ``primitives.move_to``); what is new here is where to: a *safe support* is a surface made for
 setting things down (a table, counter, shelf or cabinet top, ``SAFE_SUPPORTS``) that is not switched
 on, lit, wet or full of water as the robot sees it (the scene graph's states): a stove, a sink's rim,
