@@ -72,3 +72,25 @@ def test_a_shelf_too_narrow_for_the_margin_sends_the_object_to_another_top(built
     assert first is not None and first.startswith("shelf")
     assert _support(graph, obj) not in (None, first)
     assert "no spot 0.15 m from the edges of" in res.subtasks[0].detail
+
+
+@pytest.mark.slow
+def test_the_support_to_set_back_on_is_where_the_object_rests_now_not_where_the_spec_put_it(built):
+    """A second edge step after the object moved (the loop's recheck of a laptop carried from the
+    sink to a table) must work on the table it is on now; it used to read the spec's first support."""
+    from anomalygen.perception import load_perceived_scene
+    from anomalygen.rng import item_rng
+    from anomalygen.skills import geometry
+    from anomalygen.skills.episode import Episode, EpisodeBudget, LearningSettings
+    from anomalygen.skills.scripted import relocate
+
+    scene_dir, spec, plan = built["shelf"]
+    obj = spec.bindings["$hazard"]
+    model, data, perceived = load_perceived_scene(scene_dir)
+    ep = Episode(model, data, perceived, seed=0, rng=item_rng(0, "recheck"), plan=plan, budget=EpisodeBudget(),
+                 learning=LearningSettings())
+    first = geometry.surface_centre_of(ep, obj)
+    assert first is not None and first.startswith("shelf")
+    assert relocate.back_from_edge(ep, obj, first).success
+    now = geometry.surface_centre_of(ep, obj)
+    assert now not in (None, first) and next(o.support for o in ep.spec.objects if o.name == obj) == first

@@ -351,11 +351,11 @@ NEAR_EDGE = 0.15  # m: the knowledge base's near_edge distance for fragile thing
 
 
 def surface_centre_of(ep: Episode, obj: str) -> str | None:
-    """The support under ``obj`` according to the scene spec."""
-    for o in ep.spec.objects:
-        if o.name == obj:
-            return o.support if o.support and o.support != "floor" else None
-    return None
+    """The support ``obj`` rests on now (the live scene graph's ``on``), None on the floor. Not the
+    spec's: an earlier step may have moved it (a laptop carried from the sink to a table, then set
+    back from that table's edge)."""
+    on = [r.object for r in ep.graph().relations if r.subject == obj and r.predicate == "on" and r.object]
+    return on[0].split(":")[0] if on else None
 
 
 def part_point_local(ep: Episode, joint: str) -> tuple[int, np.ndarray]:
