@@ -53,6 +53,11 @@ def main() -> int:
     tasks = [json.loads(line) for line in (run / "tasks.jsonl").read_text().splitlines() if line.strip()]
     wanted = set(a.classes.split(",")) if a.classes else None
     chosen = [t["id"] for t in tasks if wanted is None or t["hazard_class"] in wanted]
+    if not chosen:  # an empty --only would run every task
+        present = sorted({t["hazard_class"] for t in tasks})
+        print(f"no task of {', '.join(sorted(wanted or []))} in the {a.n} brainstormed tasks; "
+              f"classes present: {', '.join(present)}", file=sys.stderr)
+        return 2
     only = [x for tid in chosen for x in ("--only", tid)]
     t_build = time.perf_counter()
     _cli("build", "--run", str(run), "--workers", str(a.workers), "--seed", str(a.seed), *only, env=env)

@@ -145,12 +145,13 @@ def run_subtasks(ep: Episode, plan: Plan, retries: int = 1) -> list[SubTaskResul
         for attempt in range(1, 2 + (retries if st.method == SkillMethod.PRIMITIVE else 0)):
             res, by = _run_once(ep, st, plan)
             ep.settle(10)
+            ep.come_to_rest()  # judge the state that lasts, not a plate still toppling off its shelf
             ok = res.success
             detail = res.detail
             if st.success.predicates:
                 preds = _evaluate(st.success.predicates, ep, plan.bindings)
                 ok = all(p.holds for p in preds)
-                detail += "; " + "; ".join(f"{p.call.name}: {'yes' if p.holds else 'no'}" for p in preds)
+                detail += "; " + "; ".join(f"{'not ' if p.call.negate else ''}{p.call.name}: {'yes' if p.holds else 'no'}" for p in preds)
             details.append(detail if attempt == 1 else f"attempt {attempt}: {detail}")
             if ok or ep.budget.spent(ep.steps):
                 break

@@ -166,9 +166,18 @@ def top_rect(ep: Episode, support: str) -> tuple[np.ndarray, np.ndarray]:
 
 def free_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2, turned: bool = True,
               away: tuple[np.ndarray, np.ndarray, float] | None = None) -> np.ndarray:
-    """A drop point on the support's top that keeps ``edge_margin`` from its edges and misses the
-    other things standing there (a book in the middle of the table would leave the object perched
-    half on it), nearest the centre; the centre when the top is too small for the margin.
+    """The drop point of :func:`rated_spot` alone."""
+    return rated_spot(ep, support, obj, edge_margin=edge_margin, turned=turned, away=away)[0]
+
+
+def rated_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2, turned: bool = True,
+               away: tuple[np.ndarray, np.ndarray, float] | None = None) -> tuple[np.ndarray, float, int]:
+    """(drop point, its edge clearance in m, how many other things it lands on). The point is on the
+    support's top, keeps ``edge_margin`` from its edges and misses the other things standing there
+    (a book in the middle of the table would leave the object perched half on it), nearest the
+    centre; the centre when the top is too small for the margin. The clearance and the count say
+    whether the best the top offers is good enough (a crowded or narrow top may have no spot clear
+    of both its edges and its things).
 
     ``turned``: the object will be turned to lie along the top's long side (``move_to`` does that
     for objects with a long side); otherwise it keeps its present orientation. ``away``: (lo, hi,
@@ -192,7 +201,7 @@ def free_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2, 
             others.append((blo[:2], bhi[:2]))
     centre = (lo[:2] + hi[:2]) / 2
     inset = np.minimum(half + 0.02, (hi[:2] - lo[:2]) / 2)
-    best, best_score = centre, np.inf
+    best, best_score, best_edge, best_hits = centre, np.inf, 0.0, 0
     # Score a 31 x 31 grid (a 4 cm step can miss the one clear spot on a crowded table): landing on
     # something else (nearer it than HIT_GAP) costs most, then ending within NEAR_EDGE of an edge
     # (the hazard itself), then standing closer than CLEAR_GAP to something (on a crowded counter the
@@ -209,8 +218,9 @@ def free_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2, 
             if away is not None:
                 score += 100.0 * max(0.0, away[2] - box_gap((p - half, p + half), away))
             if score < best_score:
-                best, best_score = p, score
-    return np.array([best[0], best[1], hi[2] - 0.01])  # set down until it touches: a dropped globe topples
+                best, best_score, best_edge, best_hits = p, score, edge, hits
+    # set down until it touches: a dropped globe topples
+    return np.array([best[0], best[1], hi[2] - 0.01]), best_edge, best_hits
 
 
 def opening(ep: Episode, region: str) -> tuple[np.ndarray, np.ndarray]:
@@ -341,11 +351,11 @@ NEAR_EDGE = 0.15  # m: the knowledge base's near_edge distance for fragile thing
 
 
 def surface_centre_of(ep: Episode, obj: str) -> str | None:
-    """The support under ``obj`` according to the scene spec."""
-    for o in ep.spec.objects:
-        if o.name == obj:
-            return o.support if o.support and o.support != "floor" else None
-    return None
+    """The support ``obj`` rests on now (the live scene graph's ``on``), None on the floor. Not the
+    spec's: an earlier step may have moved it (a laptop carried from the sink to a table, then set
+    back from that table's edge)."""
+    on = [r.object for r in ep.graph().relations if r.subject == obj and r.predicate == "on" and r.object]
+    return on[0].split(":")[0] if on else None
 
 
 def part_point_local(ep: Episode, joint: str) -> tuple[int, np.ndarray]:

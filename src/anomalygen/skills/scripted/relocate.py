@@ -1,7 +1,8 @@
-"""Moving a whole object somewhere safer: away from another by a distance, off what it lies on, or
-turned so its handle no longer sticks out over the edge.
+"""Moving a whole object somewhere safer: away from another by a distance, back from the edges of
+its top (onto another top when its own has no room), off what it lies on, or turned so its handle
+no longer sticks out over the edge.
 
-All three are a suction pick and a set-down with the motion primitives (``primitives.grasp``,
+All four are a suction pick and a set-down with the motion primitives (``primitives.grasp``,
 ``primitives.move_to``); what is new here is where to: a *safe support* is a surface made for
 setting things down (a table, counter, shelf or cabinet top, ``SAFE_SUPPORTS``) that is not switched
 on, lit, wet or full of water as the robot sees it (the scene graph's states): a stove, a sink's rim,
@@ -16,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from anomalygen.schema.part_labels import HANDLE_GEOM
-from anomalygen.skills.geometry import box_gap, top_rect
+from anomalygen.skills.geometry import NEAR_EDGE, box_gap, rated_spot, top_rect
 from anomalygen.skills.registry import SkillOutcome
 from anomalygen.skills.scripted import primitives
 
@@ -31,6 +32,7 @@ EDGE_CLEAR = 0.03  # m the turned handle's tip keeps inside the edge of the surf
 BACK_FROM_EDGE = 0.17  # m the turned pan's body is set down inside the top's edges, where there is room
 SHIFT_GRID = 15  # positions per axis tried for setting it down back from the edges
 CLEAR_SLACK = 0.02  # m short of BACK_FROM_EDGE a spot still counts as clear (above the 0.15 m edge rule)
+EDGE_SLACK = 0.02  # m beyond NEAR_EDGE a rated spot must clear: the object comes to rest a cm or two off it
 TURNS = (0.0, np.pi / 4, -np.pi / 4, np.pi / 2, -np.pi / 2)  # tried around the inward direction, nearest first
 
 
@@ -98,6 +100,28 @@ def move_away(ep: Episode, obj: str, frm: str, distance: float) -> SkillOutcome:
     gap = box_gap(drv.aabb(obj), away)
     return SkillOutcome(res.success and gap >= distance, drv.steps - s0,
                         f"{res.detail}; {obj} {gap:.2f} m from {frm} (was {gap0:.2f}, asked {distance:.2f})")
+
+
+def back_from_edge(ep: Episode, obj: str, support: str, *, release_after: bool = True) -> SkillOutcome:
+    """Pick ``obj`` and set it down at least NEAR_EDGE (+ EDGE_SLACK) from every edge of a top and
+    clear of what stands there: on ``support``, its own, when that top has such a spot, else on the
+    nearest safe support that has one (a vase on a shelf narrower than twice the margin, a bowl on a
+    table crowded to its edges); the detail says so. With no such spot anywhere it takes the best
+    spot of its own top, which its check then reports as still near the edge. Spots are rated
+    before the pick, on the object's footprint as it rests (held, it tilts and looks wider)."""
+    chosen = support
+    for cand in (support, *safe_supports(ep, obj, avoid=(support,))):
+        _, edge, hits = rated_spot(ep, cand, obj, turned=False)
+        if hits == 0 and edge >= NEAR_EDGE + EDGE_SLACK:
+            chosen = cand
+            break
+    failed = _pick(ep, obj)
+    if failed is not None:
+        return failed
+    res = primitives.move_to(ep, obj, chosen, release_after=release_after, into=False)
+    if chosen != support:
+        res.detail += f" (no spot {NEAR_EDGE:.2f} m from the edges of {support} clear of what stands there)"
+    return res
 
 
 def take_off(ep: Episode, obj: str, support: str | None = None) -> SkillOutcome:
