@@ -227,3 +227,15 @@ def test_food_on_a_table_or_in_an_open_box_is_still_picked(inside, fridge_joints
     spec = _fridge_spec(door=0.0, inside=inside, fridge_joints=fridge_joints)
     plan = plan_from_kb("t", "dispose_spoiled_food", dict(spec.bindings), spec=spec)
     assert [s.id for s in plan.subtasks] == ["s0_open_container", "s1_pick", "s2_place_inside", "s9_close_container"]
+
+
+def test_what_holds_only_once_the_container_is_shut_is_checked_after_the_shut_step():
+    """keep_sharp_away_from_children also asks the knife out of a child's reach, which a safe standing
+    open for the place cannot give: the place checks 'inside', the shut step the rest."""
+    spec = _spec([_lid(0.0)])
+    plan = plan_from_kb("t", "keep_sharp_away_from_children", dict(spec.bindings), spec=spec)
+    place = next(s for s in plan.subtasks if s.id.endswith("place_inside"))
+    shut = plan.subtasks[-1]
+    assert [p.name for p in place.success.predicates] == ["inside"]
+    assert [(p.name, p.negate) for p in shut.success.predicates] == [("joint_closed", False), ("child_reachable", True)]
+    assert {p.name for p in plan.success.predicates} >= {"inside", "child_reachable"}  # the task's own is unchanged

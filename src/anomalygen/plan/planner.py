@@ -282,11 +282,27 @@ def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, s
             labels = closed_closures(spec, container)
             if labels:
                 opened, shut = access_steps(container, labels)
+                subtasks, after_shut = _checks_after_shutting(subtasks, container)
+                shut = shut.model_copy(update={"success": SuccessSpec(predicates=[*shut.success.predicates, *after_shut])})
                 subtasks = [opened, *subtasks, shut]
             break
     subtasks = _take_out_first(subtasks, cls, bindings, spec)
     return Plan(task_id=task_id, source=source, engine=Engine.KNOWLEDGE, subtasks=subtasks,
                 success=SuccessSpec(predicates=list(cls.success)), bindings=dict(bindings))
+
+
+def _checks_after_shutting(subtasks: list[SubTask], container: str) -> tuple[list[SubTask], list[PredicateCall]]:
+    """The place step into a container that is opened for it checks only ``inside``; what holds only
+    once the door is shut again (out of a child's reach: a safe stands open until then) moves to the
+    shut step, where it can hold. Otherwise every such place fails its first check and is redone."""
+    out, moved = [], []
+    for st in subtasks:
+        if st.primitive == "move_to" and st.params.get("region") == container:
+            keep = [p for p in st.success.predicates if p.name == "inside"]
+            moved += [p for p in st.success.predicates if p.name != "inside"]
+            st = st.model_copy(update={"success": SuccessSpec(predicates=keep)})
+        out.append(st)
+    return out, moved
 
 
 def _take_out_first(subtasks: list[SubTask], cls, bindings: dict[str, str], spec: SceneSpec | None) -> list[SubTask]:
