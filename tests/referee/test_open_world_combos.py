@@ -51,10 +51,8 @@ COMBOS = [
     ("The tap of the kitchen sink was left running.", "turn_off_running_tap", "Sink"),
     ("The bathtub tap was left running.", "turn_off_running_tap", "Bathtub"),
     ("A pot on the stove in the kitchen has its handle turned outward.", "turn_pan_handle_inward", "KitchenPot"),
-    pytest.param("A bottle of cleaning spray was put in the fridge.", "remove_chemical_from_fridge", "cleaning_spray",
-                 marks=pytest.mark.xfail(strict=True, reason=(
-                     "with real models in the scene the safe stands where the spray is not put fully through "
-                     "its door (place_inside: 'not fully into safe_0'); passes with procedural models only"))),
+    # with real models the safe in this scene is shallower than the spray is tall: it is laid on its side first
+    ("A bottle of cleaning spray was put in the fridge.", "remove_chemical_from_fridge", "cleaning_spray"),
 ]
 
 
