@@ -256,6 +256,40 @@ def _joint_states(model, data, obj, jids) -> list[JointState]:
     return out
 
 
+TOP_TOL = 0.01  # m: boards of one top are level and touch within this
+
+
+def top_surface(model, owner: np.ndarray, boxes, geom: int, root: int) -> tuple[np.ndarray, np.ndarray]:
+    """World box of the whole top that ``geom`` belongs to: the support's solid geoms of its fixed
+    frame that are level with it and touch it, or each other, within ``TOP_TOL``. A cabinet's top
+    may be several boards; measured against the one board a pan touches first, a pan in the middle
+    of the top read as 15 cm over its edge. Parts on a joint (a door swung open to the same height)
+    are not the top."""
+    glo, ghi = boxes
+
+    def fixed_frame(b: int) -> bool:
+        while b != root:
+            adr, n = int(model.body_jntadr[b]), int(model.body_jntnum[b])
+            if b == 0 or any(model.jnt_type[j] != 0 for j in range(adr, adr + n)):  # 0: mjJNT_FREE
+                return False
+            b = int(model.body_parentid[b])
+        return True
+
+    level = [g for g in np.flatnonzero(owner == owner[geom])
+             if abs(ghi[g][2] - ghi[geom][2]) <= TOP_TOL and (model.geom_contype[g] or model.geom_conaffinity[g])
+             and fixed_frame(int(model.geom_bodyid[g]))]
+    lo, hi = glo[geom].copy(), ghi[geom].copy()
+    grown = True
+    while grown:
+        grown = False
+        for g in level:
+            if np.all(glo[g][:2] <= hi[:2] + TOP_TOL) and np.all(ghi[g][:2] >= lo[:2] - TOP_TOL) \
+                    and (np.any(glo[g][:2] < lo[:2]) or np.any(ghi[g][:2] > hi[:2])):
+                lo[:2], hi[:2] = np.minimum(lo[:2], glo[g][:2]), np.maximum(hi[:2], ghi[g][:2])
+                grown = True
+    return lo, hi
+
+
 def _support_contacts(model, data, owner: np.ndarray, floor: int, n: int):
     """For each object, the objects (and floor) below it that it touches: {obj: {support: geom}}."""
     supports: list[dict[str, int]] = [dict() for _ in range(n)]
@@ -365,14 +399,15 @@ def scene_graph(model: mujoco.MjModel, data: mujoco.MjData, spec: SceneSpec) -> 
         on_floor = i not in held and ("floor" in supports[i] or (height < ON_FLOOR_TOL and not inside))
         edge = surface = None
         # distance from the object's footprint to the edge of its main support's top (the widest
-        # supporting geom; a laptop also touching a mug in the middle of the table is not at an
-        # edge), in x/y; negative when the object overhangs.
+        # supporting geom, grown by the level boards it adjoins; a laptop also touching a mug in the
+        # middle of the table is not at an edge), in x/y; negative when the object overhangs.
         below = [g for sup, g in supports[i].items() if sup != "floor"]
         if below:
             geom = max(below, key=lambda g: float(np.prod(geom_hi[g][:2] - geom_lo[g][:2])))
-            d = np.minimum(lo[i][:2] - geom_lo[geom][:2], geom_hi[geom][:2] - hi[i][:2])
+            surface = top_surface(model, idx.geom_owner, (geom_lo, geom_hi), geom,
+                                  model.body(spec.objects[int(idx.geom_owner[geom])].name).id)
+            d = np.minimum(lo[i][:2] - surface[0][:2], surface[1][:2] - hi[i][:2])
             edge = float(np.min(d))
-            surface = (geom_lo[geom], geom_hi[geom])
         objects.append(
             GraphObject(
                 name=obj.name,
