@@ -380,3 +380,24 @@ def test_a_detected_fix_that_cannot_be_bound_is_recorded_in_the_plan_not_dropped
     assert isinstance(dropped, DroppedFix)
     assert (dropped.hazard_class, dropped.object) == ("pick_up_floor_litter", "apple_0")
     assert "no reachable container for apple_0" in dropped.reason and "TrashCan" in dropped.reason
+
+
+def test_when_an_objects_most_severe_class_cannot_be_bound_its_next_class_is_planned(tmp_path):
+    """Toys on the stairs are also a choking hazard; with no box to put a toy in, the plan takes it off
+    the stairs instead of failing the scene. Here: a class with nothing to bind it to (no bin) ranks
+    above the fridge's own; the fridge is still closed and the other class is named as dropped."""
+    from anomalygen.schema import Detection, Hypothesis
+
+    run = _run(tmp_path)
+    hyps = [Hypothesis(rank=1, problem="p", solution="s", target_object="refrigerator_0",
+                       hazard_class="dispose_spoiled_food", score=0.9),
+            Hypothesis(rank=2, problem="p", solution="s", target_object="refrigerator_0",
+                       hazard_class="close_open_refrigerator", score=0.9)]
+    write_jsonl(run.detections_path, [Detection(task_id="t-fridge", scene_id="t-fridge", detector="rules",
+                                                hypotheses=hyps)])
+    settings = load_settings(None, {"quiet": True, "workers": 1, "plan.source": "detected"})
+    assert run_stage(run, settings, only=["t-fridge"]).done == 1
+    plan = read_model(run.plan_path("t-fridge"), Plan)
+    assert plan.bindings.get("$target") == "refrigerator_0"
+    assert [s.id for s in plan.subtasks] == ["s1_close_joint"]
+    assert [(d.hazard_class, d.object) for d in plan.dropped] == [("dispose_spoiled_food", "refrigerator_0")]

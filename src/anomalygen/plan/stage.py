@@ -83,15 +83,19 @@ def _plan_from_perception(task_id: str, payload: dict, ctx: StageContext) -> Pla
         bindings = bind_fix(kb.hazard_classes[top["hazard_class"]], top["target_object"], graph, kb)
         return _plan_with_llm(task_id, payload, ctx, top["hazard_class"], bindings, spec, top)
     plans, dropped = [], []
-    for hyp in chosen:
-        hc = kb.hazard_classes[hyp["hazard_class"]]
-        try:
-            bindings = bind_fix(hc, hyp["target_object"], graph, kb)
-        except ItemFailed as exc:
-            dropped.append(DroppedFix(hazard_class=hc.id, object=hyp["target_object"], reason=str(exc)))
-            continue
-        plans.append(plan_from_kb(task_id, hc.id, bindings, spec=spec, source="detected",
-                                  sac_actions=settings.plan.sac_actions))
+    for first in chosen:
+        # the object's most severe class first; when its fix cannot be bound here (no container the
+        # toy fits), the object's next detected class (the toy taken off the stairs)
+        for hyp in [first, *other_classes_of(det["hypotheses"], kb, first, min_score=settings.plan.min_score)]:
+            hc = kb.hazard_classes[hyp["hazard_class"]]
+            try:
+                bindings = bind_fix(hc, hyp["target_object"], graph, kb)
+            except ItemFailed as exc:
+                dropped.append(DroppedFix(hazard_class=hc.id, object=hyp["target_object"], reason=str(exc)))
+                continue
+            plans.append(plan_from_kb(task_id, hc.id, bindings, spec=spec, source="detected",
+                                      sac_actions=settings.plan.sac_actions))
+            break
     if not plans:
         raise ItemFailed("; ".join(f"{d.hazard_class} on {d.object}: {d.reason}" for d in dropped))
     return merge_plans(plans).model_copy(update={"dropped": dropped})
@@ -110,6 +114,14 @@ def fixes_to_make(hypotheses: list[dict], kb, *, max_fixes: int, min_score: floa
         seen.add(h["target_object"])
         out.append(h)
     return out[:max_fixes]
+
+
+def other_classes_of(hypotheses: list[dict], kb, chosen: dict, *, min_score: float) -> list[dict]:
+    """The other usable hypotheses about ``chosen``'s object, most severe class first."""
+    same = [h for h in hypotheses if h is not chosen and h.get("target_object") == chosen["target_object"]
+            and h.get("hazard_class") in kb.hazard_classes and h.get("hazard_class") != chosen.get("hazard_class")
+            and float(h.get("score") or 0.0) >= min_score]
+    return sorted(same, key=lambda h: (-kb.hazard_classes[h["hazard_class"]].severity, h["rank"]))
 
 
 def _plan_with_llm(task_id: str, payload: dict, ctx: StageContext, hazard_class: str, bindings: dict[str, str],
