@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from anomalygen.scene.states import object_states
+from anomalygen.scene.tops import top_surface
 from anomalygen.schema import (
     LATCHING_PROPERTY,
     GraphObject,
@@ -254,40 +255,6 @@ def _joint_states(model, data, obj, jids) -> list[JointState]:
         value = float(data.qpos[model.jnt_qposadr[jid]])
         out.append(js.model_copy(update={"value": value}))
     return out
-
-
-TOP_TOL = 0.01  # m: boards of one top are level and touch within this
-
-
-def top_surface(model, owner: np.ndarray, boxes, geom: int, root: int) -> tuple[np.ndarray, np.ndarray]:
-    """World box of the whole top that ``geom`` belongs to: the support's solid geoms of its fixed
-    frame that are level with it and touch it, or each other, within ``TOP_TOL``. A cabinet's top
-    may be several boards; measured against the one board a pan touches first, a pan in the middle
-    of the top read as 15 cm over its edge. Parts on a joint (a door swung open to the same height)
-    are not the top."""
-    glo, ghi = boxes
-
-    def fixed_frame(b: int) -> bool:
-        while b != root:
-            adr, n = int(model.body_jntadr[b]), int(model.body_jntnum[b])
-            if b == 0 or any(model.jnt_type[j] != 0 for j in range(adr, adr + n)):  # 0: mjJNT_FREE
-                return False
-            b = int(model.body_parentid[b])
-        return True
-
-    level = [g for g in np.flatnonzero(owner == owner[geom])
-             if abs(ghi[g][2] - ghi[geom][2]) <= TOP_TOL and (model.geom_contype[g] or model.geom_conaffinity[g])
-             and fixed_frame(int(model.geom_bodyid[g]))]
-    lo, hi = glo[geom].copy(), ghi[geom].copy()
-    grown = True
-    while grown:
-        grown = False
-        for g in level:
-            if np.all(glo[g][:2] <= hi[:2] + TOP_TOL) and np.all(ghi[g][:2] >= lo[:2] - TOP_TOL) \
-                    and (np.any(glo[g][:2] < lo[:2]) or np.any(ghi[g][:2] > hi[:2])):
-                lo[:2], hi[:2] = np.minimum(lo[:2], glo[g][:2]), np.maximum(hi[:2], ghi[g][:2])
-                grown = True
-    return lo, hi
 
 
 def _support_contacts(model, data, owner: np.ndarray, floor: int, n: int):
