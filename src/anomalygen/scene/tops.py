@@ -8,6 +8,17 @@ import numpy as np
 TOP_TOL = 0.01  # m: boards of one top are level and touch within this
 
 
+def on_fixed_frame(model, body: int, root: int) -> bool:
+    """``body`` is ``root`` or welded to it: no joint between them but the root's own free joint (a
+    door on its hinge is not part of a cabinet's top)."""
+    while body != root:
+        adr, n = int(model.body_jntadr[body]), int(model.body_jntnum[body])
+        if body == 0 or any(model.jnt_type[j] != 0 for j in range(adr, adr + n)):  # 0: mjJNT_FREE
+            return False
+        body = int(model.body_parentid[body])
+    return True
+
+
 def top_surface(model, owner: np.ndarray, boxes, geom: int, root: int) -> tuple[np.ndarray, np.ndarray]:
     """World box of the whole top that ``geom`` belongs to: the support's solid geoms of its fixed
     frame that are level with it and touch it, or each other, within ``TOP_TOL``. A cabinet's top
@@ -16,17 +27,9 @@ def top_surface(model, owner: np.ndarray, boxes, geom: int, root: int) -> tuple[
     are not the top."""
     glo, ghi = boxes
 
-    def fixed_frame(b: int) -> bool:
-        while b != root:
-            adr, n = int(model.body_jntadr[b]), int(model.body_jntnum[b])
-            if b == 0 or any(model.jnt_type[j] != 0 for j in range(adr, adr + n)):  # 0: mjJNT_FREE
-                return False
-            b = int(model.body_parentid[b])
-        return True
-
     level = [g for g in np.flatnonzero(owner == owner[geom])
              if abs(ghi[g][2] - ghi[geom][2]) <= TOP_TOL and (model.geom_contype[g] or model.geom_conaffinity[g])
-             and fixed_frame(int(model.geom_bodyid[g]))]
+             and on_fixed_frame(model, int(model.geom_bodyid[g]), root)]
     lo, hi = glo[geom].copy(), ghi[geom].copy()
     grown = True
     while grown:

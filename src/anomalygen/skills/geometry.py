@@ -140,6 +140,7 @@ def top_rect(ep: Episode, support: str) -> tuple[np.ndarray, np.ndarray]:
     reaches the same height, and counting it moved the middle of the "top" out over the doorway (a
     dumbbell taken down onto the Franka Kitchen cabinet was set on its front edge)."""
     from anomalygen.scene.graph import geom_world_aabbs
+    from anomalygen.scene.tops import on_fixed_frame
 
     drv = ep.driver
     m = drv.model
@@ -147,17 +148,9 @@ def top_rect(ep: Episode, support: str) -> tuple[np.ndarray, np.ndarray]:
     glo, ghi = geom_world_aabbs(m, drv.data)
     root = drv.body_id(support)
 
-    def fixed_frame(b: int) -> bool:  # the support's root, or a body welded to it (no joint between)
-        while b != root:
-            adr, n = int(m.body_jntadr[b]), int(m.body_jntnum[b])
-            if b == 0 or any(m.jnt_type[j] != 0 for j in range(adr, adr + n)):  # 0: mjJNT_FREE
-                return False
-            b = int(m.body_parentid[b])
-        return True
-
     top_geoms = [g for g in range(m.ngeom) if m.body(int(m.geom_bodyid[g])).name.startswith(support + "/")
                  and ghi[g, 2] > hi[2] - 0.01 and (m.geom_contype[g] or m.geom_conaffinity[g])
-                 and fixed_frame(int(m.geom_bodyid[g]))]
+                 and on_fixed_frame(m, int(m.geom_bodyid[g]), root)]
     if top_geoms:
         lo = np.min(glo[top_geoms], axis=0)
         hi = np.array([*np.max(ghi[top_geoms], axis=0)[:2], hi[2]])
