@@ -360,21 +360,26 @@ def test_plan_stage_on_the_bundled_gguf_ends_each_item_cleanly(tmp_path):
     assert usage.requests >= 1 and usage.completion_tokens > 0
 
 
-def test_a_detected_fix_that_cannot_be_bound_is_recorded_in_the_plan_not_dropped_silently(tmp_path):
-    """Two detected hazards, one with nothing in the scene to fix it with (litter, no bin): the plan
-    makes the other fix and names the dropped one with the planner's reason, for reports to show."""
-    from anomalygen.schema import Detection, DroppedFix, Hypothesis
+def _fridge_plan_from(tmp_path, claims: list[tuple[str, str]]) -> Plan:
+    """The plan from perception for the fridge scene, given the detector's (object, class) claims in rank order."""
+    from anomalygen.schema import Detection, Hypothesis
 
     run = _run(tmp_path)
-    hyps = [Hypothesis(rank=1, problem="p", solution="s", target_object="refrigerator_0",
-                       hazard_class="close_open_refrigerator", score=0.9),
-            Hypothesis(rank=2, problem="p", solution="s", target_object="apple_0",
-                       hazard_class="pick_up_floor_litter", score=0.9)]
+    hyps = [Hypothesis(rank=k, problem="p", solution="s", target_object=obj, hazard_class=cls, score=0.9)
+            for k, (obj, cls) in enumerate(claims, start=1)]
     write_jsonl(run.detections_path, [Detection(task_id="t-fridge", scene_id="t-fridge", detector="rules",
                                                 hypotheses=hyps)])
     settings = load_settings(None, {"quiet": True, "workers": 1, "plan.source": "detected"})
     assert run_stage(run, settings, only=["t-fridge"]).done == 1
-    plan = read_model(run.plan_path("t-fridge"), Plan)
+    return read_model(run.plan_path("t-fridge"), Plan)
+
+
+def test_a_detected_fix_that_cannot_be_bound_is_recorded_in_the_plan_not_dropped_silently(tmp_path):
+    """Two detected hazards, one with nothing in the scene to fix it with (litter, no bin): the plan
+    makes the other fix and names the dropped one with the planner's reason, for reports to show."""
+    from anomalygen.schema import DroppedFix
+
+    plan = _fridge_plan_from(tmp_path, [("refrigerator_0", "close_open_refrigerator"), ("apple_0", "pick_up_floor_litter")])
     assert plan.subtasks and all(s.params.get("object") == "refrigerator_0" for s in plan.subtasks)
     (dropped,) = plan.dropped
     assert isinstance(dropped, DroppedFix)
@@ -386,18 +391,7 @@ def test_when_an_objects_most_severe_class_cannot_be_bound_its_next_class_is_pla
     """Toys on the stairs are also a choking hazard; with no box to put a toy in, the plan takes it off
     the stairs instead of failing the scene. Here: a class with nothing to bind it to (no bin) ranks
     above the fridge's own; the fridge is still closed and the other class is named as dropped."""
-    from anomalygen.schema import Detection, Hypothesis
-
-    run = _run(tmp_path)
-    hyps = [Hypothesis(rank=1, problem="p", solution="s", target_object="refrigerator_0",
-                       hazard_class="dispose_spoiled_food", score=0.9),
-            Hypothesis(rank=2, problem="p", solution="s", target_object="refrigerator_0",
-                       hazard_class="close_open_refrigerator", score=0.9)]
-    write_jsonl(run.detections_path, [Detection(task_id="t-fridge", scene_id="t-fridge", detector="rules",
-                                                hypotheses=hyps)])
-    settings = load_settings(None, {"quiet": True, "workers": 1, "plan.source": "detected"})
-    assert run_stage(run, settings, only=["t-fridge"]).done == 1
-    plan = read_model(run.plan_path("t-fridge"), Plan)
+    plan = _fridge_plan_from(tmp_path, [("refrigerator_0", "dispose_spoiled_food"), ("refrigerator_0", "close_open_refrigerator")])
     assert plan.bindings.get("$target") == "refrigerator_0"
     assert [s.id for s in plan.subtasks] == ["s1_close_joint"]
     assert [(d.hazard_class, d.object) for d in plan.dropped] == [("dispose_spoiled_food", "refrigerator_0")]
