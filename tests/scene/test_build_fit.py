@@ -150,3 +150,28 @@ def test_a_task_naming_another_object_at_fault_than_its_target_is_refused():
     """Built, the open drawer would be the table's while the task speaks of the safe."""
     with pytest.raises(ItemFailed, match="about the target itself"):
         build._plan(_open_drawer("Table", "Safe"), SETTINGS, item_rng(0, "x", 0))
+
+
+def _crib_strip() -> TaskProposal:
+    return TaskProposal(
+        id="t-fit-strip-safe", name="strip by the crib", explanation="test",
+        description="A power strip lies beside the crib.", category="child_safety",
+        hazard_class="cable_near_crib", target_asset="Safe",
+        scenario=dict(hazard_object="PowerStrip", room="bedroom", placement="near:Crib", container="Safe",
+                      co_objects=["Crib"]),
+        provenance=dict(engine="knowledge", mode="brainstorm"))
+
+
+def test_target_container_is_drawn_with_room_for_the_hazard():
+    """The safe is the task's target, so it keeps its draw: it is drawn with room for the smallest
+    power strip (0.30 m; a 0.3 m safe holds 0.18-0.23 m). Before, 3 safes in 4 were too small and the
+    item failed "does not fit ... the task names the Safe"."""
+    task = _crib_strip()
+    from anomalygen.knowledge import load_kb
+
+    least = asset_choice.size_bounds(load_kb(), "PowerStrip")[0]
+    outcomes = _outcomes(task)
+    fits = [o for o in outcomes if o[0] == "fit"]
+    assert len(fits) >= 3 and all(o[1] <= o[2] and o[2] >= least for o in fits), outcomes
+    # an attempt may still fail (no base pose reaches the strip), never for want of room
+    assert not [o for o in outcomes if o[0] == "failed" and "does not fit" in o[1]], outcomes

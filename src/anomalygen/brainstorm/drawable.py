@@ -93,6 +93,28 @@ def has_interior(obj: str) -> bool:
     return bool(generate(obj, 0).cavities)
 
 
+INTERIOR_VARIANTS = 4  # variants of a holder looked at for its roomiest interior
+
+
+@functools.cache
+def _roomiest_interior(kb: KnowledgeBase, obj: str) -> float:
+    """The most an ``inside:obj`` placement takes (the builder's cap), over ``obj``'s variants at
+    its largest size."""
+    from anomalygen.assets.core import generate
+    from anomalygen.scene.asset_choice import cavity_cap, size_bounds
+
+    largest = size_bounds(kb, obj)[1]
+    return max(cavity_cap(generate(obj, seed, size=largest)) for seed in range(INTERIOR_VARIANTS))
+
+
+def fits_inside(kb: KnowledgeBase, hazard: str, holder: str) -> bool:
+    """Can the smallest ``hazard`` go inside the roomiest ``holder``? A 0.15 m spoon never fits a
+    toaster's 2 cm slot, and a task drawn that way fails every build."""
+    from anomalygen.scene.asset_choice import size_bounds
+
+    return size_bounds(kb, hazard)[0] <= _roomiest_interior(kb, holder)
+
+
 def hazards_for(kb: KnowledgeBase, hc: HazardClass) -> list[str]:
     """The class's hazard candidates that have an asset and can show the states asked of them."""
     states = needed_states(kb, hc).get(hc.hazard_variable, [])
@@ -109,6 +131,8 @@ def placements_for(kb: KnowledgeBase, hc: HazardClass, hazard: str) -> list[str]
         if not buildable_placement(p):
             continue
         parent = p.split(":", 1)[1] if ":" in p else None
+        if p.startswith("inside:") and not fits_inside(kb, hazard, parent):
+            continue
         if parent is not None and var is not None and not (all(state_shown(kb, parent, s) for s in states)
                                                            and _part_ok(hc, var, parent)):
             continue
@@ -149,5 +173,5 @@ def _why_not(kb: KnowledgeBase, hc: HazardClass) -> str | None:
         if v != "$target" and not [o for o in kb.static_candidates(hc, v) if o in cat]:
             return f"no asset can play {hc.id}'s {v}"
     if not any(placements_for(kb, hc, h) for h in hazards_for(kb, hc)):
-        return f"no object of {hc.id} with an asset has a placement (and states) the builder can set up"
+        return f"no object of {hc.id} with an asset has a placement (states, room inside) the builder can set up"
     return None

@@ -245,24 +245,28 @@ def pick_asset(
     size: float | None = None,
     real: bool = True,
     room_for: float | None = None,
+    stores: float | None = None,
 ):
     """Generate candidates, verify them, rank the target ones by SBERT; the first plausible one wins.
 
     A category with real (packaged) models draws those (``real``: ``build.real_assets``); a real
     candidate that does not fit here (too big for the space, without the part the task needs, an
     interior too small for the ``room_for`` m thing to go in it) gives way to the procedural one
-    drawn with the same seed and size."""
+    drawn with the same seed and size. ``stores``: the least size of what the task puts away in
+    it; a container with less room gives way to one with enough (more are drawn), and when none
+    has it the roomiest is returned, for the caller to say what does not fit."""
     from anomalygen.assets.core import draw, generate
+    from anomalygen.scene.instances import container_room
 
     parts = needed_parts(task, catalogue, hc, role)
     states = wanted_states(task, catalogue, hc, role)
     n = TARGET_CANDIDATES if rank else 2
     seeds = [int(s) for s in rng.integers(0, 2**31 - 1, size=n)]
-    candidates, problems = [], []
+    candidates, problems, cramped = [], [], []
     drawn = 0
     # a needed part may be on only some variants (one table in three has a drawer): draw on, up to
     # EXTRA_DRAWS_FOR_PARTS more, until one has it; a scene whose first draws pass is unchanged
-    while drawn < n or (parts and not candidates and drawn < n + EXTRA_DRAWS_FOR_PARTS):
+    while drawn < n or ((parts or stores) and not candidates and drawn < n + EXTRA_DRAWS_FOR_PARTS):
         s = seeds[drawn] if drawn < n else int(rng.integers(0, 2**31 - 1))
         drawn += 1
         want = choose_size(kb, catalogue, rng, cap=cap, preferred=size)
@@ -275,10 +279,15 @@ def pick_asset(
             problems.append(f"real model {asset.asset_id}: {problem}")
             asset = generate(catalogue, s, size=want)
             problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap, states=states)
+        if problem is None and stores and asset.cavities and container_room(asset) < stores:
+            cramped.append(asset)
+            continue
         if problem is None:
             candidates.append(asset)
         else:
             problems.append(problem)
+    if not candidates and cramped:
+        candidates = [max(cramped, key=container_room)]
     if not candidates:
         raise ItemFailed(f"every {catalogue} candidate was rejected: {problems[0]}")
     if rank and len(candidates) > 1:

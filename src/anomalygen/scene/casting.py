@@ -84,17 +84,20 @@ class Selection:
     def variables(self) -> set[str]:
         return set(self.hc.variables) if self.hc is not None else set()
 
-    def choose(self, raw: str, role: ObjectRole, *, cap=None, rank=False, room_for=None) -> asset_choice.Chosen:
+    def choose(self, raw: str, role: ObjectRole, *, cap=None, rank=False, room_for=None,
+               stores=None) -> asset_choice.Chosen:
         """The asset for a name (one per catalogue category: a second mention reuses it).
 
         ``room_for``: the least size of what will be put inside it (a real model with too small an
-        interior gives way to the procedural one)."""
+        interior gives way to the procedural one). ``stores``: the least size of what the fix puts
+        away in it (a smaller container is drawn again)."""
         cat = asset_choice.resolve_name(raw)
         if cat in self.by_catalogue:
             return self.by_catalogue[cat]
         want = self.hints.size_for(cat) if self.hints is not None else None
         asset = asset_choice.pick_asset(cat, role=role, kb=self.kb, task=self.task, hc=self.hc, rng=self.rng,
-                                        cap=cap, rank=rank, size=want, real=self.real_assets, room_for=room_for)
+                                        cap=cap, rank=rank, size=want, real=self.real_assets, room_for=room_for,
+                                        stores=stores)
         if want is not None and abs(asset.size - want) > 1e-3:
             self.hints.note(f"size:{cat}", f"size {want:.3f} m does not fit the generator's range or the space "
                             f"available; built at {asset.size:.3f} m", value=want, limit=round(float(asset.size), 4))
@@ -127,11 +130,17 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
                          f"and {task.target_asset} as the target: it would be built as the {task.target_asset}'s hazard")
     # what goes inside the parent needs room there (only a real model is turned down for lacking it)
     holder = asset_choice.resolve_name(parent_raw) if kind == "inside" and parent_raw else None
-    room_for = asset_choice.size_bounds(kb, asset_choice.resolve_name(sc.hazard_object))[0] if holder else None
+    # a target that is also the named container must have room for the hazard: it keeps its draw
+    stores_hazard = bool(sc.container) and not sel.hazard_is_target and \
+        asset_choice.resolve_name(sc.container) == asset_choice.resolve_name(task.target_asset)
+    least_hazard = asset_choice.size_bounds(kb, asset_choice.resolve_name(sc.hazard_object))[0] \
+        if holder or stores_hazard else None
+    room_for = least_hazard if holder else None
     # Big things first: they bound what fits in/on them.
     target = sel.target = sel.choose(
         task.target_asset, ObjectRole.HAZARD if sel.hazard_is_target else ObjectRole.TARGET, rank=True,
         room_for=room_for if asset_choice.resolve_name(task.target_asset) == holder else None,
+        stores=least_hazard if stores_hazard else None,
     )
     parent = sel.parent = sel.choose(parent_raw, ObjectRole.AUXILIARY, room_for=room_for) if parent_raw else None
     cap = None
