@@ -26,3 +26,25 @@ def test_an_object_longer_than_every_interior_is_never_placed_inside():
 
         biggest = generate("Toaster", seed, size=asset_choice.size_bounds(kb, "Toaster")[1])
         assert asset_choice.cavity_cap(biggest) < asset_choice.size_bounds(kb, "spoon")[0]
+
+
+def test_a_hazard_the_fix_puts_away_is_drawn_only_with_a_container_it_fits():
+    """The crib's cables are put away in a safe (it latches); a cable lies straight, 0.5 m and more,
+    and the roomiest safe holds 0.46 m: two extension cords of the loop at bf44e13 failed their
+    builds, "does not fit a 0.31 m space: the task names the Safe". The power strip fits."""
+    from anomalygen.brainstorm.drawable import containers_for, hazards_for
+
+    kb = load_kb()
+    crib = kb.hazard_classes["cable_near_crib"]
+    assert containers_for(kb, crib, "PowerStrip") == ["Safe"]
+    assert containers_for(kb, crib, "extension_cord") == []
+    assert hazards_for(kb, crib) == ["PowerStrip"]
+    # the sampler names only a container that fits
+    litter = kb.hazard_classes["pick_up_floor_litter"]
+    for hazard in hazards_for(kb, litter):
+        least = asset_choice.size_bounds(kb, hazard)[0]
+        assert containers_for(kb, litter, hazard), hazard
+        for c in containers_for(kb, litter, hazard):
+            from anomalygen.brainstorm.drawable import _roomiest_store
+
+            assert _roomiest_store(kb, c) >= least

@@ -107,6 +107,28 @@ def _roomiest_interior(kb: KnowledgeBase, obj: str) -> float:
     return max(cavity_cap(generate(obj, seed, size=largest)) for seed in range(INTERIOR_VARIANTS))
 
 
+@functools.cache
+def _roomiest_store(kb: KnowledgeBase, obj: str) -> float:
+    """The longest thing a container ``obj`` stores (the builder's ``container_room``), over its
+    variants at its largest size; 0 without an interior."""
+    from anomalygen.assets.core import generate
+    from anomalygen.scene.asset_choice import size_bounds
+    from anomalygen.scene.instances import container_room
+
+    largest = size_bounds(kb, obj)[1]
+    assets = [generate(obj, seed, size=largest) for seed in range(INTERIOR_VARIANTS)]
+    return max((container_room(a) for a in assets if a.cavities), default=0.0)
+
+
+def containers_for(kb: KnowledgeBase, hc: HazardClass, hazard: str) -> list[str]:
+    """The containers the fix may put ``hazard`` away in (``kb.safe_containers_for``) that have an
+    asset with room for it: a 1 m extension cord lies straight and no safe holds it."""
+    from anomalygen.scene.asset_choice import size_bounds
+
+    least = size_bounds(kb, hazard)[0]
+    return [c for c in kb.safe_containers_for(hc, hazard) if c in catalogue() and _roomiest_store(kb, c) >= least]
+
+
 def fits_inside(kb: KnowledgeBase, hazard: str, holder: str) -> bool:
     """Can the smallest ``hazard`` go inside the roomiest ``holder``? A 0.15 m spoon never fits a
     toaster's 2 cm slot, and a task drawn that way fails every build."""
@@ -116,10 +138,12 @@ def fits_inside(kb: KnowledgeBase, hazard: str, holder: str) -> bool:
 
 
 def hazards_for(kb: KnowledgeBase, hc: HazardClass) -> list[str]:
-    """The class's hazard candidates that have an asset and can show the states asked of them."""
+    """The class's hazard candidates that have an asset, can show the states asked of them and, when
+    the fix puts them away, fit one of its containers."""
     states = needed_states(kb, hc).get(hc.hazard_variable, [])
+    stored = bool(hc.default_containers) and any("$container" in str(step.args) for step in hc.recipe)
     return [o for o in kb.hazard_candidates(hc) if o in catalogue() and all(state_shown(kb, o, s) for s in states)
-            and _part_ok(hc, hc.hazard_variable, o)]
+            and _part_ok(hc, hc.hazard_variable, o) and (not stored or containers_for(kb, hc, o))]
 
 
 def placements_for(kb: KnowledgeBase, hc: HazardClass, hazard: str) -> list[str]:

@@ -152,7 +152,7 @@ class IdeaSampler:
         round_: int,
         avoid_hazard: str | None = None,
     ) -> Idea:
-        from anomalygen.brainstorm.drawable import hazards_for, placements_for, relation_variable
+        from anomalygen.brainstorm.drawable import containers_for, hazards_for, placements_for, relation_variable
 
         kb = self.kb
         candidates = hazards_for(kb, hc)
@@ -170,7 +170,8 @@ class IdeaSampler:
         placement = weighted(rng, placements, self._w("placement", placements))
         rooms = [r for r in hc.rooms if r in kb.objects[hazard].rooms] or list(hc.rooms)
         room = weighted(rng, rooms, self._w("room", rooms))
-        containers = kb.safe_containers_for(hc, hazard)  # the fix the text promises must end the hazard
+        # the fix the text promises must end the hazard, and the hazard must fit in
+        containers = containers_for(kb, hc, hazard) if hc.default_containers else kb.safe_containers_for(hc, hazard)
         container = (target if target in containers else weighted(rng, containers)) if containers else None
         support = None
         if hc.default_supports:
