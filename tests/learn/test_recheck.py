@@ -5,7 +5,7 @@ from __future__ import annotations
 from tests.knowledge.graphs import furniture, graph, joint, obj
 
 from anomalygen.knowledge import load_kb
-from anomalygen.learn.recheck import new_hazards, repair_plan
+from anomalygen.learn.recheck import hazards_seen, new_hazards, repair_plan
 
 
 def _scene(door: float, knife_on_floor: bool):
@@ -32,3 +32,17 @@ def test_the_repair_plan_closes_what_was_left_open_under_its_own_step_ids():
     assert plan.subtasks and all(st.id.startswith("recheck_") for st in plan.subtasks)
     assert {st.params.get("object") for st in plan.subtasks} == {"cab_0"}
     assert plan.subtasks[0].primitive == "push"  # close_joint is a push on the open part
+
+
+def test_a_hazard_still_firing_on_an_object_the_robot_moved_counts_as_new():
+    """The knife was within reach at the start; the robot carried it 1 m and set it down, again within
+    reach: that is its own doing and is planned again. Left where it was, it is not."""
+    kb = load_kb()
+    before = _scene(door=0.0, knife_on_floor=True)
+    knife = obj("knife_0", "Knife", at="floor", xy=(2.0, 0.0))
+    cab = furniture("cab_0", "StorageFurniture", joints=[joint("door", 0.0), joint("drawer", 0.0)])
+    moved = graph(cab, knife)
+    found = new_hazards(before, moved, kb)
+    assert [o for o, _ in found] == ["knife_0"]
+    assert found[0] in set(hazards_seen(before, kb))  # the same class as at the start, at a new place
+    assert new_hazards(before, before, kb) == []

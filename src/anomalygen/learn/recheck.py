@@ -5,8 +5,10 @@ can jam half open; a bottle that slips from the cup lands on the floor within a 
 careful person glances back at the scene before walking away, and so does the robot: it reads the
 scene graph of the simulator state after the plan (what it perceives, never the truth file), runs the
 same rules it detected with, and plans a fix (from the knowledge base, roles bound from perception)
-for each hazard that was not there before it started. One such pass; what is still wrong after it is
-left for the referee to count.
+for each hazard that was not there before it started. A hazard on an object the robot moved counts as
+new too: a hammer taken down off a shelf's edge and set down at the edge of a low cabinet is a heavy
+thing at an edge again, at a new place, although the rules saw "heavy at an edge" on it at the start.
+One such pass; what is still wrong after it is left for the referee to count.
 """
 
 from __future__ import annotations
@@ -22,13 +24,27 @@ def hazards_seen(graph: SceneGraph, kb) -> dict[tuple[str, str], float]:
     return {(c.object, c.hazard_class): c.severity for c in candidates(graph, kb)}
 
 
+MOVED = 0.05  # m an object's centre travels before what fires on it is the robot's doing
+
+
+def moved_objects(before: SceneGraph, after: SceneGraph) -> set[str]:
+    """Objects whose perceived centre moved more than MOVED between the two graphs."""
+    import numpy as np
+
+    start = {o.name: np.asarray(o.position) for o in before.objects}
+    return {o.name for o in after.objects
+            if o.name in start and float(np.linalg.norm(np.asarray(o.position) - start[o.name])) > MOVED}
+
+
 def new_hazards(before: SceneGraph, after: SceneGraph, kb) -> list[tuple[str, str]]:
-    """Hazards on ``after`` that were not on ``before``, most severe first (one per object)."""
+    """Hazards on ``after`` that were not on ``before`` or are on an object that moved, most severe
+    first (one per object)."""
     seen = hazards_seen(before, kb)
     now = hazards_seen(after, kb)
+    moved = moved_objects(before, after)
     out: list[tuple[str, str]] = []
     for (obj, cls), _sev in sorted(now.items(), key=lambda kv: (-kv[1], kv[0])):
-        if (obj, cls) not in seen and all(obj != o for o, _ in out):
+        if ((obj, cls) not in seen or obj in moved) and all(obj != o for o, _ in out):
             out.append((obj, cls))
     return out
 
