@@ -94,3 +94,23 @@ def test_the_support_to_set_back_on_is_where_the_object_rests_now_not_where_the_
     assert relocate.back_from_edge(ep, obj, first).success
     now = geometry.surface_centre_of(ep, obj)
     assert now not in (None, first) and next(o.support for o in ep.spec.objects if o.name == obj) == first
+
+
+@pytest.mark.slow
+def test_an_object_on_no_top_is_set_back_on_the_nearest_safe_one(built):
+    """A vase knocked to the floor (no support to re-centre on: the skill used to fail, "stands on no
+    support") is set on the nearest safe top, back from its edges."""
+    from anomalygen.perception import load_perceived_scene
+    from anomalygen.rng import item_rng
+    from anomalygen.skills.episode import Episode, EpisodeBudget, LearningSettings
+    from anomalygen.skills.scripted import relocate
+
+    scene_dir, spec, plan = built["table"]
+    obj = spec.bindings["$hazard"]
+    model, data, perceived = load_perceived_scene(scene_dir)
+    ep = Episode(model, data, perceived, seed=0, rng=item_rng(0, "floor"), plan=plan, budget=EpisodeBudget(),
+                 learning=LearningSettings())
+    out = relocate.back_from_edge(ep, obj, None)
+    assert out.success and "was on the floor, no top to re-centre on" in out.detail, out.detail
+    after = ep.graph().get(obj)
+    assert not after.on_floor and after.distance_to_edge is not None and after.distance_to_edge >= NEAR_EDGE - 0.03

@@ -68,9 +68,7 @@ class Place(Skill):
         prm, obj = subtask.params, _object(episode, subtask)
         region = str(prm.get("region") or prm.get("container") or prm.get("support") or "")
         if region == "surface_centre":  # back from the edges (move_away_from_edge): its own top, if it has room
-            support = geometry.surface_centre_of(episode, obj)
-            if not support:
-                return SkillOutcome(False, 0, f"{obj} stands on no support to re-centre it on")
+            support = geometry.surface_centre_of(episode, obj)  # None on the floor: the nearest safe top
             return relocate.back_from_edge(episode, obj, support, release_after=bool(prm.get("release", True)))
         if episode.driver.held != obj:  # move_to without a preceding grasp: pick first
             g = primitives.grasp(episode, obj)

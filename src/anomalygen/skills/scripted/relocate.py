@@ -102,15 +102,24 @@ def move_away(ep: Episode, obj: str, frm: str, distance: float) -> SkillOutcome:
                         f"{res.detail}; {obj} {gap:.2f} m from {frm} (was {gap0:.2f}, asked {distance:.2f})")
 
 
-def back_from_edge(ep: Episode, obj: str, support: str, *, release_after: bool = True) -> SkillOutcome:
+def back_from_edge(ep: Episode, obj: str, support: str | None, *, release_after: bool = True) -> SkillOutcome:
     """Pick ``obj`` and set it down at least NEAR_EDGE (+ EDGE_SLACK) from every edge of a top and
     clear of what stands there: on ``support``, its own, when that top has such a spot, else on the
     nearest safe support that has one (a vase on a shelf narrower than twice the margin, a bowl on a
     table crowded to its edges); the detail says so. With no such spot anywhere it takes the best
-    spot of its own top, which its check then reports as still near the edge. Spots are rated
-    before the pick, on the object's footprint as it rests (held, it tilts and looks wider)."""
-    chosen = support
-    for cand in (support, *safe_supports(ep, obj, avoid=(support,))):
+    spot of the first candidate, which its check then reports as still near the edge. Spots are rated
+    before the pick, on the object's footprint as it rests (held, it tilts and looks wider).
+
+    ``support`` None (the object fell to the floor) or a thing that itself lies on something (a
+    laptop come to rest on a towel on the table) is no top to re-centre on: the safe supports are
+    tried, nearest first."""
+    kinds = {o.name: o.asset.category for o in ep.spec.objects}
+    own = support if support and (kinds.get(support) in SAFE_SUPPORTS or _holder(ep, support) is None) else None
+    cands = [*([own] if own else []), *safe_supports(ep, obj, avoid=tuple(x for x in (support,) if x))]
+    if not cands:
+        return SkillOutcome(False, 0, f"no safe support to set {obj} on, back from the edges")
+    chosen = cands[0]
+    for cand in cands:
         _, edge, hits = rated_spot(ep, cand, obj, turned=False)
         if hits == 0 and edge >= NEAR_EDGE + EDGE_SLACK:
             chosen = cand
@@ -120,7 +129,8 @@ def back_from_edge(ep: Episode, obj: str, support: str, *, release_after: bool =
         return failed
     res = primitives.move_to(ep, obj, chosen, release_after=release_after, into=False)
     if chosen != support:
-        res.detail += f" (no spot {NEAR_EDGE:.2f} m from the edges of {support} clear of what stands there)"
+        res.detail += (f" (no spot {NEAR_EDGE:.2f} m from the edges of {support} clear of what stands there)"
+                       if own else f" ({obj} was on {support or 'the floor'}, no top to re-centre on)")
     return res
 
 
