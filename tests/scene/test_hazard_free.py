@@ -91,3 +91,22 @@ def test_a_task_object_that_could_fire_the_class_is_made_safe_with_the_hazard(tm
             assert {r.object for r in graph.relations if r.subject == by_cat[extra].name and r.predicate == "inside"} \
                 == {r.object for r in graph.relations if r.subject == by_cat[hazard].name and r.predicate == "inside"} != set()
         assert read_model(out / "truth.json", HazardManifest).hazards == [], fixture
+
+
+def test_a_hazard_too_tall_for_its_container_is_made_safe_beside_the_furniture(tmp_path):
+    """A backpack (0.4 m and more, standing) does not stand in a cabinet's compartment; its safe
+    state is then out of the walkway, not a failed build (the seed-0 loop's t0092 at bf44e13 failed,
+    "backpack_0 does not fit inside storagefurniture_0"). The task is that loop's, verbatim."""
+    from pathlib import Path
+
+    from anomalygen.scene.build import build_scene
+    from anomalygen.schema import TaskProposal
+
+    task = TaskProposal.model_validate_json(
+        (Path(__file__).parent / "fixtures" / "backpack_in_walkway_cabinet_container.json").read_text())
+    out = tmp_path / "backpack"
+    build_scene(task, seed=0, settings=SAFE, out_dir=out, hazard_free=True)
+    graph = read_model(out / "scene_graph.json", SceneGraph)
+    backpack = next(o for o in graph.objects if o.category == "backpack")
+    assert not any(r.subject == backpack.name and r.predicate in ("inside", "in_walkway") for r in graph.relations)
+    assert read_model(out / "truth.json", HazardManifest).hazards == []

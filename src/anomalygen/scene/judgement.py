@@ -141,8 +141,8 @@ def room_fixtures(kb, lay: Layout) -> list[Placed]:
 
 
 def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None) -> None:
-    """The task's object where it is no hazard: shut inside its container, else well inside the
-    surface, else on the floor beside a piece of furniture, out of the walkway. For a class whose
+    """The task's object where it is no hazard: shut inside its container (when it fits there), else
+    well inside the surface, else on the floor beside a piece of furniture, out of the walkway. For a class whose
     danger is a child reaching it, only a container that latches keeps it safe (a toddler opens a
     cupboard or a box): such a container is added when the task's own does not latch."""
     hazard, container = sel.hazard, child_safe_container(sel) or sel.container
@@ -153,12 +153,16 @@ def place_hazard_safely(sel: Selection, lay: Layout, placed: dict[str, Placed], 
             holder = placed[container.name] = placed_instance(container)
             lay.place_on_floor(holder, relevant=True, face=True)
         lo, hi, _ = cavity_world(holder)
-        lay.place_in_cavity(hp, holder, (lo, hi))
-        for joint in container.asset.joints:  # shut every lid, door and drawer of the container
-            if part_labels.encloses(joint.label):
-                holder.joint_values[joint.name] = float(joint.closed_value)
-        holder.sweep = 0.0
-        return
+        try:
+            lay.place_in_cavity(hp, holder, (lo, hi))
+        except ItemFailed:
+            pass  # it does not stand in there (a 0.4 m backpack, a 0.35 m compartment): put it down safe
+        else:
+            for joint in container.asset.joints:  # shut every lid, door and drawer of the container
+                if part_labels.encloses(joint.label):
+                    holder.joint_values[joint.name] = float(joint.closed_value)
+            holder.sweep = 0.0
+            return
     if support is not None:
         lay.place_on_surface(hp, support, surface_of(support), inward=INWARD, near_side=HAZARD_NEAR_SIDE)
         return
