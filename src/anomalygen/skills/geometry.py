@@ -164,7 +164,8 @@ def free_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2, 
 
 
 def rated_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2, turned: bool = True,
-               away: tuple[np.ndarray, np.ndarray, float] | None = None) -> tuple[np.ndarray, float, int]:
+               away: tuple[np.ndarray, np.ndarray, float] | None = None,
+               crosswise: bool = False) -> tuple[np.ndarray, float, int]:
     """(drop point, its edge clearance in m, how many other things it lands on). The point is on the
     support's top, keeps ``edge_margin`` from its edges and misses the other things standing there
     (a book in the middle of the table would leave the object perched half on it), nearest the
@@ -175,7 +176,9 @@ def rated_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2,
     ``turned``: the object will be turned to lie along the top's long side (``move_to`` does that
     for objects with a long side); otherwise it keeps its present orientation. ``away``: (lo, hi,
     gap) of a box the object must end at least ``gap`` from, horizontally (a candle moved away from
-    the curtains); falling short costs more than anything else."""
+    the curtains); falling short costs more than anything else. ``crosswise`` (with ``turned``
+    False): rated as if turned a quarter turn from how it rests (a dumbbell set across a crowded
+    table, where lengthwise the clear room is near an edge)."""
     drv = ep.driver
 
     lo, hi = top_rect(ep, support)
@@ -185,6 +188,8 @@ def rated_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2,
     else:
         olo, ohi = drv.aabb(obj)
         half = (ohi[:2] - olo[:2]) / 2
+        if crosswise:
+            half = half[::-1]
     others = []
     for o in ep.spec.objects:
         if o.name in (obj, support):

@@ -118,20 +118,42 @@ def back_from_edge(ep: Episode, obj: str, support: str | None, *, release_after:
     cands = [*([own] if own else []), *safe_supports(ep, obj, avoid=tuple(x for x in (support,) if x))]
     if not cands:
         return SkillOutcome(False, 0, f"no safe support to set {obj} on, back from the edges")
-    chosen = cands[0]
-    for cand in cands:
-        _, edge, hits = rated_spot(ep, cand, obj, turned=False)
-        if hits == 0 and edge >= NEAR_EDGE + EDGE_SLACK:
-            chosen = cand
-            break
+    chosen, pose = _set_back_spot(ep, obj, cands)
     failed = _pick(ep, obj)
     if failed is not None:
         return failed
-    res = primitives.move_to(ep, obj, chosen, release_after=release_after, into=False)
+    res = primitives.move_to(ep, obj, chosen, release_after=release_after, into=False, pose=pose)
+    if pose is not None:
+        res.detail += " (set down crosswise)"
     if chosen != support:
         res.detail += (f" (no spot {NEAR_EDGE:.2f} m from the edges of {support} clear of what stands there)"
                        if own else f" ({obj} was on {support or 'the floor'}, no top to re-centre on)")
     return res
+
+
+def _set_back_spot(ep: Episode, obj: str, cands: list[str]) -> tuple[str, tuple | None]:
+    """(support, move_to pose or None) for ``back_from_edge``: the first candidate top with a spot
+    NEAR_EDGE + EDGE_SLACK from its edges and clear of what stands there, as the object rests or, if
+    it is long, turned a quarter turn (a dumbbell across a crowded table). With none, the clear spot
+    farthest from any edge (the slack is the first thing to give), else the first top's best."""
+    options = [False, True] if _elongated(ep, obj) else [False]
+    best, best_edge = (cands[0], None), -np.inf
+    for cand in cands:
+        for crosswise in options:
+            spot, edge, hits = rated_spot(ep, cand, obj, turned=False, crosswise=crosswise)
+            pose = (spot, np.pi / 2) if crosswise else None
+            if hits == 0 and edge >= NEAR_EDGE + EDGE_SLACK:
+                return cand, pose
+            if hits == 0 and edge > best_edge:
+                best, best_edge = (cand, pose), edge
+    return best
+
+
+def _elongated(ep: Episode, obj: str) -> bool:
+    """Is the object's resting footprint long enough that a quarter turn changes where it fits?"""
+    lo, hi = ep.driver.aabb(obj)
+    x, y = float(hi[0] - lo[0]), float(hi[1] - lo[1])
+    return max(x, y) > primitives.SQUARE_RATIO * min(x, y)
 
 
 def take_off(ep: Episode, obj: str, support: str | None = None) -> SkillOutcome:
