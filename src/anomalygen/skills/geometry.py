@@ -158,14 +158,14 @@ def top_rect(ep: Episode, support: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def free_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2, turned: bool = True,
-              away: tuple[np.ndarray, np.ndarray, float] | None = None) -> np.ndarray:
+              away: tuple[np.ndarray, np.ndarray, float] | None = None, square: bool = False) -> np.ndarray:
     """The drop point of :func:`rated_spot` alone."""
-    return rated_spot(ep, support, obj, edge_margin=edge_margin, turned=turned, away=away)[0]
+    return rated_spot(ep, support, obj, edge_margin=edge_margin, turned=turned, away=away, square=square)[0]
 
 
 def rated_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2, turned: bool = True,
                away: tuple[np.ndarray, np.ndarray, float] | None = None,
-               crosswise: bool = False) -> tuple[np.ndarray, float, int]:
+               crosswise: bool = False, square: bool = False) -> tuple[np.ndarray, float, int]:
     """(drop point, its edge clearance in m, how many other things it lands on). The point is on the
     support's top, keeps ``edge_margin`` from its edges and misses the other things standing there
     (a book in the middle of the table would leave the object perched half on it), nearest the
@@ -178,7 +178,8 @@ def rated_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2,
     gap) of a box the object must end at least ``gap`` from, horizontally (a candle moved away from
     the curtains); falling short costs more than anything else. ``crosswise`` (with ``turned``
     False): rated as if turned a quarter turn from how it rests (a dumbbell set across a crowded
-    table, where lengthwise the clear room is near an edge)."""
+    table, where lengthwise the clear room is near an edge). ``square``: it may end either way round,
+    so it is rated as a square of its half length (``move_away`` checks the distance that way)."""
     drv = ep.driver
 
     lo, hi = top_rect(ep, support)
@@ -190,6 +191,8 @@ def rated_spot(ep: Episode, support: str, obj: str, *, edge_margin: float = 0.2,
         half = (ohi[:2] - olo[:2]) / 2
         if crosswise:
             half = half[::-1]
+    if square:
+        half = np.full(2, float(footprint(ep, obj)[1]))
     others = []
     for o in ep.spec.objects:
         if o.name in (obj, support):

@@ -86,7 +86,7 @@ def move_away(ep: Episode, obj: str, frm: str, distance: float) -> SkillOutcome:
     half = np.array([a, a])  # either way round: move_to may turn it to lie along the top
     chosen = None
     for support in safe_supports(ep, obj, avoid=(frm,)):
-        spot = free_spot(ep, support, obj, away=away)
+        spot = free_spot(ep, support, obj, away=away, square=True)  # rated as it is checked
         if box_gap((spot[:2] - half, spot[:2] + half), away) >= distance:
             chosen = support
             break
