@@ -7,7 +7,7 @@ import pytest
 
 from anomalygen.assets.core import generate
 from anomalygen.knowledge import load_kb
-from anomalygen.scene.instances import container_room
+from anomalygen.scene.asset_choice import container_room
 
 SEEDS = range(4)  # generator variants of a container at its largest size; the roomiest one counts
 # Cables are laid along a wall, never stored (clear_cable_from_walkway has no container), and a coiled

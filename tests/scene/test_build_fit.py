@@ -15,7 +15,7 @@ import pytest
 from anomalygen.config import Settings
 from anomalygen.errors import ItemFailed
 from anomalygen.rng import item_rng
-from anomalygen.scene import asset_choice, build, instances
+from anomalygen.scene import asset_choice, build
 from anomalygen.schema import TaskProposal
 
 ATTEMPTS = 4  # a build makes repair_attempts + 1 = 4 by default
@@ -43,7 +43,7 @@ def _outcomes(task: TaskProposal, attempts: int = ATTEMPTS):
             out.append(("failed", str(exc)))
             continue
         hazard, container = placed[bindings["$hazard"]], placed[bindings["$container"]]
-        out.append(("fit", float(hazard.asset.size), instances.container_room(container.asset)))
+        out.append(("fit", float(hazard.asset.size), asset_choice.container_room(container.asset)))
     return out
 
 
@@ -61,15 +61,15 @@ def test_container_room_is_the_long_side_of_the_biggest_cavity():
     for name in ("Bucket", "storage_box", "StorageFurniture"):
         asset = generate(name, 0)
         cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
-        room = instances.container_room(asset)
+        room = asset_choice.container_room(asset)
         assert room == pytest.approx(0.95 * 2 * max(cav.half_extents[0], cav.half_extents[1]))
         # it lies inside the object's own footprint
         ext = np.asarray(asset.aabb[1]) - np.asarray(asset.aabb[0])
         assert 0.05 < room < max(ext[0], ext[1])
     # a bigger bucket has more room; the generator scales the cavity with the asset
     small, big = generate("Bucket", 3, size=0.25), generate("Bucket", 3, size=0.4)
-    assert instances.container_room(small) < instances.container_room(big)
-    assert instances.container_room(big) / instances.container_room(small) == pytest.approx(0.4 / 0.25, rel=0.15)
+    assert asset_choice.container_room(small) < asset_choice.container_room(big)
+    assert asset_choice.container_room(big) / asset_choice.container_room(small) == pytest.approx(0.4 / 0.25, rel=0.15)
 
 
 def test_bag_and_bucket_fail_with_does_not_fit_after_redrawing_the_bucket(monkeypatch, tmp_path):
@@ -95,7 +95,7 @@ def test_bag_and_bucket_fail_with_does_not_fit_after_redrawing_the_bucket(monkey
     buckets = [a for c, a in drawn if c == "Bucket"]
     assert len(buckets) == 1
     cap = float(re.search(r"does not fit a ([0-9.]+) m space", str(exc.value)).group(1))
-    assert cap == pytest.approx(instances.container_room(buckets[-1]), abs=0.006)
+    assert cap == pytest.approx(asset_choice.container_room(buckets[-1]), abs=0.006)
     # the whole build fails with the same reason (selection fails before anything is compiled)
     once = Settings(build={"clutter": 0, "repair_attempts": 0})
     with pytest.raises(ItemFailed, match="does not fit"):

@@ -157,8 +157,8 @@ def test_a_plastic_bag_second_hazard_comes_with_a_bin_it_goes_into_in_the_simula
     from anomalygen.plan.bind import bind_fix
     from anomalygen.plan.planner import plan_from_kb
     from anomalygen.runfolder import read_model
+    from anomalygen.scene.asset_choice import container_room
     from anomalygen.scene.build import build_scene
-    from anomalygen.scene.instances import container_room
     from anomalygen.schema import SceneGraph
 
     kb = load_kb()

@@ -112,8 +112,7 @@ def _roomiest_store(kb: KnowledgeBase, obj: str) -> float:
     """The longest thing a container ``obj`` stores (the builder's ``container_room``), over its
     variants at its largest size; 0 without an interior."""
     from anomalygen.assets.core import generate
-    from anomalygen.scene.asset_choice import size_bounds
-    from anomalygen.scene.instances import container_room
+    from anomalygen.scene.asset_choice import container_room, size_bounds
 
     largest = size_bounds(kb, obj)[1]
     assets = [generate(obj, seed, size=largest) for seed in range(INTERIOR_VARIANTS)]

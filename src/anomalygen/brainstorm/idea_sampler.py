@@ -152,7 +152,12 @@ class IdeaSampler:
         round_: int,
         avoid_hazard: str | None = None,
     ) -> Idea:
-        from anomalygen.brainstorm.drawable import containers_for, hazards_for, placements_for, relation_variable
+        from anomalygen.brainstorm.drawable import (
+            containers_for,
+            hazards_for,
+            placements_for,
+            relation_variable,
+        )
 
         kb = self.kb
         candidates = hazards_for(kb, hc)

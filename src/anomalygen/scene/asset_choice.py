@@ -133,6 +133,12 @@ def cavity_cap(asset) -> float:
     return 0.8 * 2 * float(min(cav.half_extents))
 
 
+def container_room(asset) -> float:
+    """Longest thing that lies flat in the container's biggest cavity (along its long side)."""
+    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+    return 0.95 * 2 * float(max(cav.half_extents[0], cav.half_extents[1]))
+
+
 def choose_size(
     kb, catalogue: str, rng: np.random.Generator, *, cap: float | None = None, preferred: float | None = None
 ) -> float:
@@ -256,7 +262,6 @@ def pick_asset(
     it; a container with less room gives way to one with enough (more are drawn), and when none
     has it the roomiest is returned, for the caller to say what does not fit."""
     from anomalygen.assets.core import draw, generate
-    from anomalygen.scene.instances import container_room
 
     parts = needed_parts(task, catalogue, hc, role)
     states = wanted_states(task, catalogue, hc, role)

@@ -16,7 +16,8 @@ import numpy as np
 from anomalygen.errors import ItemFailed
 from anomalygen.knowledge import load_kb
 from anomalygen.scene import asset_choice
-from anomalygen.scene.instances import container_room, instance_name
+from anomalygen.scene.asset_choice import container_room
+from anomalygen.scene.instances import instance_name
 from anomalygen.scene.layout import Placed
 from anomalygen.scene.set_states import set_initial_states
 from anomalygen.schema import ObjectRole, TaskProposal, part_labels

@@ -179,9 +179,3 @@ def cavity_world(holder: Placed):
     h = np.asarray(cav.half_extents, float)
     wh = np.array([abs(c) * h[0] + abs(s) * h[1], abs(s) * h[0] + abs(c) * h[1], h[2]])
     return wc - wh, wc + wh, cav
-
-
-def container_room(asset) -> float:
-    """Longest thing that lies flat in the container's biggest cavity (along its long side)."""
-    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
-    return 0.95 * 2 * float(max(cav.half_extents[0], cav.half_extents[1]))

@@ -16,12 +16,12 @@ from anomalygen.knowledge import load_kb
 from anomalygen.knowledge.predicates import ROOM_FIXTURES
 from anomalygen.referee.truth import Intent
 from anomalygen.scene import asset_choice, mix
+from anomalygen.scene.asset_choice import container_room
 from anomalygen.scene.casting import CONTAINER_REDRAWS, Selection
 from anomalygen.scene.instances import (
     HAZARD_NEAR_SIDE,
     INWARD,
     cavity_world,
-    container_room,
     instance_name,
     placed_instance,
     surface_of,
