@@ -45,6 +45,6 @@ def test_a_hazard_the_fix_puts_away_is_drawn_only_with_a_container_it_fits():
         least = asset_choice.size_bounds(kb, hazard)[0]
         assert containers_for(kb, litter, hazard), hazard
         for c in containers_for(kb, litter, hazard):
-            from anomalygen.brainstorm.drawable import _roomiest_store
+            from anomalygen.brainstorm.drawable import _roomiest
 
-            assert _roomiest_store(kb, c) >= least
+            assert _roomiest(kb, c, asset_choice.container_room) >= least

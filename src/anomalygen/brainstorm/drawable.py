@@ -97,43 +97,34 @@ INTERIOR_VARIANTS = 4  # variants of a holder looked at for its roomiest interio
 
 
 @functools.cache
-def _roomiest_interior(kb: KnowledgeBase, obj: str) -> float:
-    """The most an ``inside:obj`` placement takes (the builder's cap), over ``obj``'s variants at
-    its largest size."""
+def _roomiest(kb: KnowledgeBase, obj: str, measure) -> float:
+    """The most ``measure`` (the builder's ``cavity_cap`` for an ``inside:obj`` placement, its
+    ``container_room`` for putting things away in ``obj``) gives over ``obj``'s variants at its
+    largest size; 0 without an interior."""
     from anomalygen.assets.core import generate
-    from anomalygen.scene.asset_choice import cavity_cap, size_bounds
-
-    largest = size_bounds(kb, obj)[1]
-    return max(cavity_cap(generate(obj, seed, size=largest)) for seed in range(INTERIOR_VARIANTS))
-
-
-@functools.cache
-def _roomiest_store(kb: KnowledgeBase, obj: str) -> float:
-    """The longest thing a container ``obj`` stores (the builder's ``container_room``), over its
-    variants at its largest size; 0 without an interior."""
-    from anomalygen.assets.core import generate
-    from anomalygen.scene.asset_choice import container_room, size_bounds
+    from anomalygen.scene.asset_choice import size_bounds
 
     largest = size_bounds(kb, obj)[1]
     assets = [generate(obj, seed, size=largest) for seed in range(INTERIOR_VARIANTS)]
-    return max((container_room(a) for a in assets if a.cavities), default=0.0)
+    return max((measure(a) for a in assets if a.cavities), default=0.0)
 
 
 def containers_for(kb: KnowledgeBase, hc: HazardClass, hazard: str) -> list[str]:
     """The containers the fix may put ``hazard`` away in (``kb.safe_containers_for``) that have an
     asset with room for it: a 1 m extension cord lies straight and no safe holds it."""
-    from anomalygen.scene.asset_choice import size_bounds
+    from anomalygen.scene.asset_choice import container_room, size_bounds
 
     least = size_bounds(kb, hazard)[0]
-    return [c for c in kb.safe_containers_for(hc, hazard) if c in catalogue() and _roomiest_store(kb, c) >= least]
+    return [c for c in kb.safe_containers_for(hc, hazard)
+            if c in catalogue() and _roomiest(kb, c, container_room) >= least]
 
 
 def fits_inside(kb: KnowledgeBase, hazard: str, holder: str) -> bool:
     """Can the smallest ``hazard`` go inside the roomiest ``holder``? A 0.15 m spoon never fits a
     toaster's 2 cm slot, and a task drawn that way fails every build."""
-    from anomalygen.scene.asset_choice import size_bounds
+    from anomalygen.scene.asset_choice import cavity_cap, size_bounds
 
-    return size_bounds(kb, hazard)[0] <= _roomiest_interior(kb, holder)
+    return size_bounds(kb, hazard)[0] <= _roomiest(kb, holder, cavity_cap)
 
 
 def hazards_for(kb: KnowledgeBase, hc: HazardClass) -> list[str]:

@@ -124,10 +124,15 @@ def size_bounds(kb, catalogue: str) -> tuple[float, float]:
     return lo, hi
 
 
+def biggest_cavity(asset):
+    """The cavity things go in and are put away in: the roomiest by volume."""
+    return max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+
+
 def cavity_cap(asset) -> float:
     """Largest thing the biggest cavity takes: a fifth less than its smallest extent, or than its
     floor's long side when it is open above (a power strip lies flat in a sink, turned to fit)."""
-    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+    cav = biggest_cavity(asset)
     if cav.open_above:
         return 0.8 * 2 * float(max(cav.half_extents[0], cav.half_extents[1]))
     return 0.8 * 2 * float(min(cav.half_extents))
@@ -135,7 +140,7 @@ def cavity_cap(asset) -> float:
 
 def container_room(asset) -> float:
     """Longest thing that lies flat in the container's biggest cavity (along its long side)."""
-    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+    cav = biggest_cavity(asset)
     return 0.95 * 2 * float(max(cav.half_extents[0], cav.half_extents[1]))
 
 

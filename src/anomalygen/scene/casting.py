@@ -267,7 +267,7 @@ def set_initial_joints(sel: Selection) -> None:
                 (hc.articulation.part, hc.articulation.initial_state)
             )
     if sel.kind == "inside" and parent is not None:
-        cav = max(parent.asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+        cav = asset_choice.biggest_cavity(parent.asset)
         if cav.joint is not None and not any(
             part_labels.encloses(p) and s == "closed" for p, s in uses.get(parent.catalogue, [])
         ):

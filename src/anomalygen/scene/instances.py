@@ -167,7 +167,7 @@ def cavity_world(holder: Placed):
     asset = holder.asset
     if not asset.cavities:
         raise ItemFailed(f"{holder.catalogue} has no interior to put things in")
-    cav = max(asset.cavities, key=lambda c: float(np.prod(c.half_extents)))
+    cav = asset_choice.biggest_cavity(asset)
     center = np.asarray(cav.center, float).copy()
     if cav.joint is not None:
         j = asset.joint(cav.joint)
