@@ -123,21 +123,10 @@ def test_a_long_thing_on_a_crowded_table_is_set_down_crosswise_back_from_the_edg
     (the robot tried twice and the referee said 0.13 m); turned a quarter turn it is 0.16 m."""
     from pathlib import Path
 
-    from anomalygen.config import Settings
-    from anomalygen.perception import load_perceived_scene
-    from anomalygen.rng import item_rng
-    from anomalygen.scene.build import build_scene
-    from anomalygen.schema import Plan, TaskProposal
-    from anomalygen.skills.episode import Episode, EpisodeBudget, LearningSettings
     from anomalygen.skills.scripted import relocate
+    from support.built_task import episode_on_built_task
 
-    task = TaskProposal.model_validate_json((Path(__file__).parent / "fixtures" / "dumbbell_crowded_table.json").read_text())
-    out = tmp_path / "scene"
-    build_scene(task, seed=0, settings=Settings(), out_dir=out)
-    model, data, perceived = load_perceived_scene(out)
-    plan = Plan(task_id=task.id, source="detected", engine="knowledge", subtasks=[], success={"predicates": []})
-    ep = Episode(model, data, perceived, seed=0, rng=item_rng(0, task.id), plan=plan, budget=EpisodeBudget(),
-                 learning=LearningSettings())
+    ep = episode_on_built_task(Path(__file__).parent / "fixtures" / "dumbbell_crowded_table.json", tmp_path / "scene")
     before = ep.graph().get("dumbbell_0")
     assert before.distance_to_edge is not None and before.distance_to_edge < NEAR_EDGE
     res = relocate.back_from_edge(ep, "dumbbell_0", "table_0")

@@ -14,22 +14,11 @@ def test_a_phone_is_moved_the_full_distance_from_the_bathtub_onto_the_one_table(
     bathtub, one table 0.14 m from the tub. The spot was rated with the phone lying along the table
     (0.61 m from the tub) and checked either way round (0.56 m), so the table was turned down and the
     skill failed: "no safe support has a spot ... at least 0.60 m from bathtub_0"."""
-    from anomalygen.config import Settings
-    from anomalygen.perception import load_perceived_scene
-    from anomalygen.rng import item_rng
-    from anomalygen.scene.build import build_scene
-    from anomalygen.schema import Plan, TaskProposal
-    from anomalygen.skills.episode import Episode, EpisodeBudget, LearningSettings
     from anomalygen.skills.geometry import box_gap
     from anomalygen.skills.scripted import relocate
+    from support.built_task import episode_on_built_task
 
-    task = TaskProposal.model_validate_json((Path(__file__).parent / "fixtures" / "phone_by_bathtub.json").read_text())
-    out = tmp_path / "scene"
-    build_scene(task, seed=0, settings=Settings(), out_dir=out)
-    model, data, perceived = load_perceived_scene(out)
-    plan = Plan(task_id=task.id, source="detected", engine="knowledge", subtasks=[], success={"predicates": []})
-    ep = Episode(model, data, perceived, seed=0, rng=item_rng(0, task.id), plan=plan, budget=EpisodeBudget(),
-                 learning=LearningSettings())
+    ep = episode_on_built_task(Path(__file__).parent / "fixtures" / "phone_by_bathtub.json", tmp_path / "scene")
     res = relocate.move_away(ep, "phone_0", "bathtub_0", 0.6)
     assert res.success, res.detail
     lo, hi = ep.driver.aabb("bathtub_0")

@@ -1,0 +1,24 @@
+"""An Episode on a scene built from a task the benchmark loop drew, verbatim: the skill tests rerun
+a real failure on the very scene it happened in."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def episode_on_built_task(fixture: Path, out: Path):
+    """Build the task in ``fixture`` (a TaskProposal JSON) at seed 0 with the default settings, as the
+    loop does, into ``out``, and return an Episode on its perceived scene with an empty plan."""
+    from anomalygen.config import Settings
+    from anomalygen.perception import load_perceived_scene
+    from anomalygen.rng import item_rng
+    from anomalygen.scene.build import build_scene
+    from anomalygen.schema import Plan, TaskProposal
+    from anomalygen.skills.episode import Episode, EpisodeBudget, LearningSettings
+
+    task = TaskProposal.model_validate_json(fixture.read_text())
+    build_scene(task, seed=0, settings=Settings(), out_dir=out)
+    model, data, perceived = load_perceived_scene(out)
+    plan = Plan(task_id=task.id, source="detected", engine="knowledge", subtasks=[], success={"predicates": []})
+    return Episode(model, data, perceived, seed=0, rng=item_rng(0, task.id), plan=plan, budget=EpisodeBudget(),
+                   learning=LearningSettings())
