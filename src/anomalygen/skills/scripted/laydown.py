@@ -1,4 +1,5 @@
-"""Lay a held object on its side before it goes through a low, shallow door.
+"""Lay a held object on its side before it goes through a low, shallow door, or into a lidded box
+it would stand out of.
 
 Put through a low door (a floor safe) the object goes in ahead of a horizontal cup: held by its top
 and tipped 90 degrees, its height then runs into the compartment. A spray bottle 0.23 m tall does
@@ -6,6 +7,10 @@ not fit a safe 0.16 m deep that way (it stood out of the door, and the door shov
 closing), though lying on its side it fits easily. So when the held object is taller than the
 compartment is deep it is first laid on its side on the floor in front of the opening and taken
 again by its new top: its long side then runs across the opening and only its thickness goes in.
+
+The same holds for a box that shuts with a lid on top: a watering can 0.2 m tall stood in a storage
+box 0.17 m deep, and the lid, shut on it, shoved it back out. Tipped along its short side it lies
+0.16 m high and the lid shuts over it.
 """
 
 from __future__ import annotations
@@ -16,13 +21,14 @@ import numpy as np
 
 from anomalygen.robot.frames import subtree_geoms
 from anomalygen.skills.episode import Episode
-from anomalygen.skills.geometry import floor_below
+from anomalygen.skills.geometry import HINGE, floor_below, footprint, static_box
 
 DEPTH_MARGIN = 0.02  # m the object's extent along the cup must stay short of the compartment's depth
 LAY_DOWN_OUT = 0.35  # m in front of the opening where the object is laid down
 LAY_DOWN_HIGH = 0.25  # m over the floor where the object is tipped over, clear of everything
 LYING_TOL = np.radians(25)  # rad the cup's axis may stay off horizontal: the object still falls on its side
-LYING_HEIGHT = 0.8  # an object laid down whose height is still more than this part of its upright one stood up
+LYING_TURN = np.radians(45)  # rad an object laid down must have turned over by, else it landed upright
+# (by turn, not height: a watering can 0.2 m tall lies 0.16 m high)
 
 
 def depth_inside(ep: Episode, lo: np.ndarray, hi: np.ndarray, out: np.ndarray, obj: str) -> float:
@@ -57,6 +63,40 @@ def too_tall_to_go_in(ep: Episode, obj: str, depth: float) -> bool:
     return drv.site[2] - drv.aabb(obj)[0][2] + DEPTH_MARGIN > depth
 
 
+LID_HEADROOM = 0.01  # m the object must stay under the rim of a box whose lid shuts on top
+
+
+def tip_direction_for_lid(ep: Episode, obj: str, region: str) -> np.ndarray | None:
+    """The horizontal direction (the held object's short side, towards the robot) to lay it down along
+    when, standing as it hangs, it would stand above the rim of ``region`` whose opened lid is to shut
+    on top, while on its side it fits under; None when it goes in as it is (or lying does not help)."""
+    drv = ep.driver
+    m = drv.model
+    if not any(m.jnt_type[m.joint(j).id] == HINGE for j in ep.memory.opened.get(region, [])):
+        return None
+    lo, hi = static_box(ep, region)
+    centre = (lo + hi) / 2
+    floor = floor_below(ep, np.array([centre[0], centre[1], hi[2] + 0.04]), obj)
+    if floor is None:
+        return None
+    depth = float(hi[2]) - floor
+    olo, ohi = drv.aabb(obj)
+    yaw, _, half_width = footprint(ep, obj)
+    if ohi[2] - olo[2] + LID_HEADROOM <= depth or 2 * half_width + LID_HEADROOM > depth:
+        return None
+    short = np.array([-np.sin(yaw), np.cos(yaw), 0.0])
+    base = drv.agent.base_pose(drv.data)[:2]
+    return short if float(np.dot(base - centre[:2], short[:2])) >= 0 else -short
+
+
+def beside(ep: Episode, region: str, out: np.ndarray) -> np.ndarray:
+    """A floor spot ``LAY_DOWN_OUT`` beyond ``region``'s side that faces ``out``."""
+    lo, hi = static_box(ep, region)
+    centre = (lo + hi) / 2
+    half = 0.5 * float(abs(out[0]) * (hi[0] - lo[0]) + abs(out[1]) * (hi[1] - lo[1]))
+    return centre + out * (half + LAY_DOWN_OUT)
+
+
 def lay_on_side(ep: Episode, obj: str, spot: np.ndarray, out: np.ndarray, take_again: Callable[[], bool]) -> bool:
     """Tip the held object over (its top towards ``-out``) at ``spot`` on the floor, set it down
     there lying on its side, let go and take it again from above (``take_again``, the grasp primitive). True when it is held again and
@@ -67,7 +107,7 @@ def lay_on_side(ep: Episode, obj: str, spot: np.ndarray, out: np.ndarray, take_a
     from anomalygen.skills.scripted.setdown import let_swing_die, lower_until_contact, turn_until_there
 
     drv = ep.driver
-    tall = float(np.ptp(np.array(drv.aabb(obj))[:, 2]))
+    up = drv.data.xmat[drv.body_id(obj)].reshape(3, 3)[:, 2].copy()  # the object's own up, as held
     down = quat_z_to(np.array([0.0, 0.0, -1.0]))
     floor = floor_below(ep, np.array([spot[0], spot[1], spot[2] + 1.0]), obj)
     floor = 0.0 if floor is None else floor
@@ -92,6 +132,5 @@ def lay_on_side(ep: Episode, obj: str, spot: np.ndarray, out: np.ndarray, take_a
     drv.goto(drv.site + out * 0.08, side, max_steps=40)
     drv.goto(drv.site + np.array([0.0, 0.0, 0.2]), side, max_steps=100)
     drv.straighten_wrist()
-    olo, ohi = drv.aabb(obj)
-    lying = ohi[2] - olo[2] < LYING_HEIGHT * tall
+    lying = float(np.dot(up, drv.data.xmat[drv.body_id(obj)].reshape(3, 3)[:, 2])) < np.cos(LYING_TURN)
     return take_again() and lying

@@ -28,7 +28,14 @@ from anomalygen.skills.geometry import (
     top_rect,
 )
 from anomalygen.skills.registry import SkillOutcome
-from anomalygen.skills.scripted.laydown import LAY_DOWN_OUT, depth_inside, lay_on_side, too_tall_to_go_in
+from anomalygen.skills.scripted.laydown import (
+    LAY_DOWN_OUT,
+    beside,
+    depth_inside,
+    lay_on_side,
+    tip_direction_for_lid,
+    too_tall_to_go_in,
+)
 from anomalygen.skills.scripted.setdown import (
     centre_over,
     let_swing_die,
@@ -183,6 +190,20 @@ def move_to(ep: Episode, obj: str, region: str, *, release_after: bool = True, i
         return SkillOutcome(False, 0, f"{obj} is not held")
     if into and region in ep.memory.compartments:
         return place_through_door(ep, obj, region, release_after=release_after)
+    laid, tried = "", False
+    for side in (1.0, -1.0):
+        # towards the robot first; where the arm cannot turn the cup far enough (a wall close behind
+        # the spot) the object lands upright and is taken again, and the other side is tried
+        out = tip_direction_for_lid(ep, obj, region) if into and drv.held == obj else None
+        if out is None:
+            break
+        tried = True
+        if lay_on_side(ep, obj, beside(ep, region, side * out), side * out, lambda: grasp(ep, obj).success):
+            laid = "laid on its side, "
+            break
+    if tried and not laid:
+        return SkillOutcome(False, drv.steps - s0, f"{obj} stands taller than {region} is deep and was not "
+                                                   "laid on its side and taken again")
     face_down = drv.cup_down(0.7)
     yaw, a, b = footprint(ep, obj)
     # Turn the object so its long side runs along the long side of the opening (or of the table top),
@@ -261,7 +282,7 @@ def move_to(ep: Episode, obj: str, region: str, *, release_after: bool = True, i
             miss = short + (olo[:2] + ohi[:2]) / 2 - goal[:2]
             if np.linalg.norm(miss) < MAX_SET_DOWN_CORRECTION:
                 ep.memory.set_down_error[obj] = (region, miss)
-    return SkillOutcome(ok, drv.steps - s0, f"{obj} {'lowered' if ok else 'not fully lowered'} over {region}")
+    return SkillOutcome(ok, drv.steps - s0, f"{obj} {laid}{'lowered' if ok else 'not fully lowered'} over {region}")
 
 
 def _compartment(ep: Episode, region: str):
