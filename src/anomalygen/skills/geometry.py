@@ -245,7 +245,7 @@ def opening(ep: Episode, region: str) -> tuple[np.ndarray, np.ndarray]:
         if np.linalg.norm(u) < 0.5:
             continue  # a vertical hinge: a door, beside the opening rather than over it
         u = u / np.linalg.norm(u)
-        pts = _body_corners(ep, int(m.jnt_bodyid[j]))[:, :2] @ u
+        pts = body_corners(ep, int(m.jnt_bodyid[j]))[:, :2] @ u
         plo, phi = float(pts.min()), float(pts.max())
         along = poly @ u
         if phi + LID_CLEARANCE <= along.min() or plo - LID_CLEARANCE >= along.max():
@@ -303,7 +303,7 @@ def _clip(poly: np.ndarray, n: np.ndarray, c: float) -> np.ndarray:
     return np.array(out) if out else np.zeros((0, 2))
 
 
-def _body_corners(ep: Episode, body: int) -> np.ndarray:
+def body_corners(ep: Episode, body: int) -> np.ndarray:
     """World corners of the boxes of a body's collision geoms (all its geoms if none collide)."""
     drv = ep.driver
     m, d = drv.model, drv.data

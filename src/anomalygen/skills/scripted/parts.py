@@ -24,10 +24,12 @@ import numpy as np
 from anomalygen.robot.agent import Agent
 from anomalygen.robot.frames import subtree_geoms
 from anomalygen.skills.episode import Episode
-from anomalygen.skills.geometry import HINGE, PRE_CONTACT, SLIDE, static_box
+from anomalygen.skills.geometry import HINGE, PRE_CONTACT, SLIDE, body_corners, static_box
 from anomalygen.skills.registry import SkillOutcome
 
 INNER_FACE_STOP = 0.4  # rad: a grasp on the inner face lets go this far from closed
+LEAVE_UNDER = 0.06  # m past a lid's free edge the cup moves, from under the lid it let go of, before it rises
+MAX_LEAVE_UNDER = 0.4  # m it moves at most
 LEAD_HINGE = 0.06
 MAX_DRAG = 0.10  # m the container may be dragged by its part before the drive gives up
 MAX_TILT = 0.35  # rad it may tip
@@ -335,6 +337,12 @@ def actuate_part(ep: Episode, joint: str, goal: float, *, closed: float, tol: fl
         else:  # the inner face looks into the cabinet: leave upwards, over the part's edge
             drv.goto(drv.site + n * 0.03, max_steps=15)
             drv.dp = dp
+            if hinge and n[2] < -0.3 and np.linalg.norm(n[:2]) > 1e-6:
+                # a lid led nearly shut from inside: the cup is under it, and rising straight up lifted
+                # a bin's lid from 0.41 to 0.67 rad open; first out from under it, past its free edge
+                u = np.array([*(n[:2] / np.linalg.norm(n[:2])), 0.0])
+                past = float(np.max((body_corners(ep, g.body) - drv.site) @ u)) + LEAVE_UNDER
+                drv.goto(drv.site + u * min(past, MAX_LEAVE_UNDER), max_steps=60)
             drv.goto(drv.site + np.array([0.0, 0.0, 0.25]), max_steps=40)
         drv.dp = dp
     drv.settle(10)
