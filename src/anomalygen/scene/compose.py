@@ -163,7 +163,10 @@ def _articulated_bodies(body) -> list[str]:
 
 def latch_switched_on(model, placed: dict[str, Placed], mjspec) -> None:
     """A spring-returned button set to 'on' is modelled as latched (a kettle's switch stays down):
-    its return spring is removed so the hazard state persists; friction keeps it where it is set."""
+    its return spring is removed so the hazard state persists; friction keeps it where it is set. The
+    latch holds either position, so the part's own weight is compensated too: MuJoCo's friction is a
+    soft constraint, and a coffee machine's 6 g top button, switched off, crept back in under gravity
+    (on again within 50 steps)."""
     import mujoco
 
     for p in placed.values():
@@ -184,6 +187,9 @@ def latch_switched_on(model, placed: dict[str, Placed], mjspec) -> None:
             sj = mjspec.joint(f"{p.name}/{j.name}")
             sj.stiffness = [0.0] * len(sj.stiffness) if hasattr(sj.stiffness, "__len__") else 0.0
             sj.frictionloss = float(model.dof_frictionloss[dof])
+            body = int(model.jnt_bodyid[jid])
+            model.body_gravcomp[body] = 1.0
+            mjspec.body(model.body(body).name).gravcomp = 1.0
 
 
 def hold_gravity_hinges(model, placed: dict[str, Placed], mjspec) -> None:
