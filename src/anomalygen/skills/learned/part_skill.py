@@ -141,13 +141,15 @@ def _holder_moved(model, data, body: int, pos0: np.ndarray, rot0: np.ndarray) ->
 
 
 def lead_held_part(ep: Episode, readout: PartReadout, act, *, horizon: int,
-                   tol: float = CLOSED_TOL) -> tuple[bool, int, str]:
+                   tol: float = CLOSED_TOL, past_ok: bool = False) -> tuple[bool, int, str]:
     """Drive the held part with ``act(observation) -> 7-D action`` on the Driver, at the env's frameskip,
     until it is within ``tol`` of its travel from off or ``horizon`` control steps pass: the learned
     skill's replay (a policy) and the scripted primitive (:func:`reference_action`) alike. The lead stops
     when the appliance carrying the part is being dragged or tipped (a cup running off a small dial's
     circle hauls a fan heater over by it): a stopped lead lets go and may try again, a tipped heater
-    stays tipped. Returns (off, control steps taken, why it stopped early or "")."""
+    stays tipped. With ``past_ok`` a part led beyond off (into its stop) is off too: a button pulled out
+    past its stop by the weld sprang back in when let go. Returns (off, control steps taken, why it
+    stopped early or "")."""
     from anomalygen.skills.learned.subtask_env import FRAMESKIP
 
     drv = ep.driver
@@ -155,13 +157,17 @@ def lead_held_part(ep: Episode, readout: PartReadout, act, *, horizon: int,
     holder = int(m.body_parentid[readout.body])
     pos0, rot0 = d.xpos[holder].copy(), d.xmat[holder].reshape(3, 3).copy()
     fs, drv.frameskip = drv.frameskip, FRAMESKIP
-    t, ok, why = 0, abs(readout.fraction(d)) <= tol, ""
+    def off() -> bool:
+        f = readout.fraction(d)
+        return f <= tol if past_ok else abs(f) <= tol
+
+    t, ok, why = 0, off(), ""
     try:
         while t < horizon and not ok:
             readout.agent.apply_action(d, act(readout.observation(m, d, t, horizon)))
             t += 1
             drv.step()
-            ok = abs(readout.fraction(d)) <= tol
+            ok = off()
             if not ok and holder and _holder_moved(m, d, holder, pos0, rot0):
                 why = f"stopped: {m.body(holder).name} was being dragged or tipped"
                 break
@@ -174,17 +180,28 @@ RELEASE_HOLD = 2  # control steps the arm holds still, target on the held point,
 BACK_OFF_STEP = 0.004  # m a control step while the cup backs away from the part (as parts.py backs off a lid)
 
 
-def let_go(ep: Episode, joint: str) -> None:
+def pulled_to_off(model, data, readout: "PartReadout") -> bool:
+    """Does the part come out towards the cup to go off (a latched push button: on is pressed in)?"""
+    if readout.hinge:
+        return False
+    j = readout.jid
+    towards_off = -np.sign(readout.far - readout.closed) * data.xaxis[j] / np.linalg.norm(data.xaxis[j])
+    return bool(np.dot(towards_off, part_geometry(model, data, readout.joint)["normal"]) > 0.5)
+
+
+def let_go(ep: Episode, joint: str, *, pulled: bool = False) -> None:
     """Bring the arm's target onto the held point and hold still, switch suction off and back the cup
     slowly away along the part's face normal, wrist straightened. A lead leaves the target ahead of the
     cup (up to the leash): released there, the arm lunges after it (its wrist knocked a fan heater
-    over); a target on the cup instead pulls the part back by the stretched weld (a dial sprang back)."""
+    over); a target on the cup instead pulls the part back by the stretched weld (a dial sprang back).
+    A part ``pulled`` out to off is let go as it is: the target ahead of it is away from the appliance,
+    and brought onto the held point it pressed a 5 mm button 1.5 mm back in."""
     drv = ep.driver
     m, d = drv.model, drv.data
     a = drv.agent
     body = int(m.jnt_bodyid[m.joint(joint).id])
     eq = a.suction_eq(m.body(body).name)
-    if eq >= 0 and d.eq_active[eq]:
+    if eq >= 0 and d.eq_active[eq] and not pulled:
         held = d.xpos[body] + d.xmat[body].reshape(3, 3) @ m.eq_data[eq, 0:3]
         d.mocap_pos[a.mocap], d.mocap_quat[a.mocap] = held, d.xquat[a.cup]
         for _ in range(RELEASE_HOLD):

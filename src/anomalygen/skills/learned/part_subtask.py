@@ -75,7 +75,7 @@ def run_part_subtask(ep: Episode, st: SubTask, plan: Plan, *, steps: int, seed: 
                      warm_start: Path | None | str = "shipped", log=None) -> SkillOutcome:
     """Grasp the part, fine-tune the family policy on this scene (if needed), execute it on the Driver."""
     from anomalygen.skills.learned.part_env import HORIZON, PartStart, make_part_env
-    from anomalygen.skills.learned.part_skill import PartReadout, grasp_part, lead_held_part, let_go
+    from anomalygen.skills.learned.part_skill import PartReadout, grasp_part, lead_held_part, let_go, pulled_to_off
     from anomalygen.skills.learned.sac import train_sac
 
     drv = ep.driver
@@ -116,9 +116,11 @@ def run_part_subtask(ep: Episode, st: SubTask, plan: Plan, *, steps: int, seed: 
     mujoco.mj_setState(drv.model, drv.data, snap, kind)
     mujoco.mj_forward(drv.model, drv.data)
     readout = PartReadout(drv.model, joint, closed, far)
-    ok, t, stopped = lead_held_part(ep, readout, lambda obs: policy.predict(obs, deterministic=True)[0], horizon=HORIZON)
+    pulled = pulled_to_off(drv.model, drv.data, readout)
+    ok, t, stopped = lead_held_part(ep, readout, lambda obs: policy.predict(obs, deterministic=True)[0], horizon=HORIZON,
+                                    past_ok=pulled)
     q = float(drv.data.joint(joint).qpos[0])
-    let_go(ep, joint)
+    let_go(ep, joint, pulled=pulled)
     after = float(drv.data.joint(joint).qpos[0])
     ok = ok and js.open_fraction_at(after) <= 0.05
     detail = (f"{why}; {tuned}; rollout {'turned' if ok else 'did not turn'} {joint} to off in {t} steps "

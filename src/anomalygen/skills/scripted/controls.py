@@ -50,7 +50,7 @@ def paced(readout):
 
 def switch_off_control(ep: Episode, joint: str, closed: float, far: float) -> SkillOutcome:
     """Hold the control ``joint`` (off at ``closed``, fully on at ``far``) and lead it to off."""
-    from anomalygen.skills.learned.part_skill import PartReadout, grasp_part, lead_held_part, let_go
+    from anomalygen.skills.learned.part_skill import PartReadout, grasp_part, lead_held_part, let_go, pulled_to_off
 
     drv = ep.driver
     s0 = drv.steps
@@ -63,8 +63,9 @@ def switch_off_control(ep: Episode, joint: str, closed: float, far: float) -> Sk
         if not held:
             notes.append(f"hold {attempt}: {why}")
             continue
-        ok, t, stopped = lead_held_part(ep, readout, paced(readout), horizon=HORIZON, tol=OFF_TOL)
-        let_go(ep, joint)
+        pulled = pulled_to_off(drv.model, drv.data, readout)
+        ok, t, stopped = lead_held_part(ep, readout, paced(readout), horizon=HORIZON, tol=OFF_TOL, past_ok=pulled)
+        let_go(ep, joint, pulled=pulled)
         notes.append(f"hold {attempt}: led {'to off' if ok else 'towards off'} in {t} steps" + (f" ({stopped})" if stopped else ""))
         if abs(readout.fraction(drv.data)) <= CLOSED_TOL:
             break
