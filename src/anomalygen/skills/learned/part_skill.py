@@ -180,7 +180,7 @@ RELEASE_HOLD = 2  # control steps the arm holds still, target on the held point,
 BACK_OFF_STEP = 0.004  # m a control step while the cup backs away from the part (as parts.py backs off a lid)
 
 
-def pulled_to_off(model, data, readout: "PartReadout") -> bool:
+def pulled_to_off(model, data, readout: PartReadout) -> bool:
     """Does the part come out towards the cup to go off (a latched push button: on is pressed in)?"""
     if readout.hinge:
         return False

@@ -75,7 +75,13 @@ def run_part_subtask(ep: Episode, st: SubTask, plan: Plan, *, steps: int, seed: 
                      warm_start: Path | None | str = "shipped", log=None) -> SkillOutcome:
     """Grasp the part, fine-tune the family policy on this scene (if needed), execute it on the Driver."""
     from anomalygen.skills.learned.part_env import HORIZON, PartStart, make_part_env
-    from anomalygen.skills.learned.part_skill import PartReadout, grasp_part, lead_held_part, let_go, pulled_to_off
+    from anomalygen.skills.learned.part_skill import (
+        PartReadout,
+        grasp_part,
+        lead_held_part,
+        let_go,
+        pulled_to_off,
+    )
     from anomalygen.skills.learned.sac import train_sac
 
     drv = ep.driver

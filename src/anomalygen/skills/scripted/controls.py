@@ -50,7 +50,13 @@ def paced(readout):
 
 def switch_off_control(ep: Episode, joint: str, closed: float, far: float) -> SkillOutcome:
     """Hold the control ``joint`` (off at ``closed``, fully on at ``far``) and lead it to off."""
-    from anomalygen.skills.learned.part_skill import PartReadout, grasp_part, lead_held_part, let_go, pulled_to_off
+    from anomalygen.skills.learned.part_skill import (
+        PartReadout,
+        grasp_part,
+        lead_held_part,
+        let_go,
+        pulled_to_off,
+    )
 
     drv = ep.driver
     s0 = drv.steps
