@@ -91,3 +91,21 @@ def test_a_flat_bag_wider_than_a_bin_has_no_container_however_tall_the_bin():
         assert "plastic_bag_0" in str(exc) and "TrashCan" in str(exc)
     wide = furniture("trashcan_1", "TrashCan", xy=(1.0, 0.0), size=(0.55, 0.54, 0.65), joints=[joint("lid", 0.0)])
     assert choose_container(hc, bag, graph(bag, narrow, wide), kb) == "trashcan_1"
+
+
+def test_a_bin_under_a_wall_shelf_gives_way_to_a_free_bin_its_lid_can_open_under():
+    """The seed-0 loop's t0048 at 4726c82: the nearer of two bins stood under a wall shelf, its lid
+    stopped half open against the shelf, and the spoiled carton landed on the lid. A bin with nothing
+    over it is chosen first; with only covered bins, the nearest still is."""
+    from anomalygen.schema import Relation
+
+    kb = load_kb()
+    hc = kb.hazard_classes["pick_up_floor_litter"]
+    paper = obj("paper_ball_0", "paper_ball", at="floor", xy=(0.0, 0.0), size=(0.08, 0.08, 0.08))
+    near = furniture("trashcan_1", "TrashCan", xy=(0.3, 0.0), size=(0.45, 0.45, 0.7), joints=[joint("lid", 0.0)])
+    far = furniture("trashcan_0", "TrashCan", xy=(1.2, 0.0), size=(0.6, 0.6, 0.7), joints=[joint("lid", 0.0)])
+    shelf = furniture("shelf_0", "shelf", xy=(0.3, 0.0), size=(0.36, 0.7, 0.28))
+    under = [Relation(subject="trashcan_1", predicate="under", object="shelf_0")]
+    assert choose_container(hc, paper, graph(paper, near, far, shelf, relations=under), kb) == "trashcan_0"
+    assert choose_container(hc, paper, graph(paper, near, far, shelf), kb) == "trashcan_1"
+    assert choose_container(hc, paper, graph(paper, near, shelf, relations=under), kb) == "trashcan_1"

@@ -8,7 +8,7 @@ relates to (the window of a stuffy room). The robot chooses them itself, here, f
   the object at fault fixed (the same reading of the scene that made the detection);
 - ``$container``: the nearest object of a kind the class puts such things in (the knowledge base's
   containers for the class and object) that the object fits and the arm can reach, preferring one
-  that ends the hazard once shut (``ends_hazard``);
+  that ends the hazard once shut (``ends_hazard``), then one whose lid has nothing over it;
 - ``$support``: the nearest surface of a kind the class lays things on, preferring one with nothing
   over it and room to leave the object clear of its edges.
 """
@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 
 from anomalygen.errors import ItemFailed
-from anomalygen.schema import LATCHING_PROPERTY, GraphObject, Relation, SceneGraph, within_child_reach
+from anomalygen.schema import LATCHING_PROPERTY, LID_LABELS, GraphObject, Relation, SceneGraph, within_child_reach
 
 REACH_BOTTOM_M = 1.2  # a container standing higher than this is out of the arm's comfortable reach
 AFTER_PLACE_LIFT_M = 0.02  # predicted height of a placed object above its container's base
@@ -63,8 +63,11 @@ def choose_container(hc, obj: GraphObject, graph: SceneGraph, kb) -> str:
         raise ItemFailed(f"no reachable container for {obj.name} in the scene (wanted: {', '.join(kinds) or 'none'})")
     classes = list(kb.hazard_classes.values())
     safe = [o for o in fits if ends_hazard(classes, obj, o, graph)]  # no hazard of any kind afterwards
-    ending = safe or [o for o in fits if ends_hazard([hc], obj, o, graph)]
-    return _nearest(obj, ending or fits)
+    ending = safe or [o for o in fits if ends_hazard([hc], obj, o, graph)] or fits
+    # a lid opens upwards: under a wall shelf a bin's lid stops half open and the carton lands on it
+    covered = {r.subject for r in graph.relations if r.predicate == "under"}
+    free = [o for o in ending if o.name not in covered or not any(j.label in LID_LABELS for j in o.joints)]
+    return _nearest(obj, free or ending)
 
 
 def ends_hazard(classes, obj: GraphObject, container: GraphObject, graph: SceneGraph) -> bool:
