@@ -18,7 +18,14 @@ from __future__ import annotations
 import math
 
 from anomalygen.errors import ItemFailed
-from anomalygen.schema import LATCHING_PROPERTY, LID_LABELS, GraphObject, Relation, SceneGraph, within_child_reach
+from anomalygen.schema import (
+    LATCHING_PROPERTY,
+    LID_LABELS,
+    GraphObject,
+    Relation,
+    SceneGraph,
+    within_child_reach,
+)
 
 REACH_BOTTOM_M = 1.2  # a container standing higher than this is out of the arm's comfortable reach
 AFTER_PLACE_LIFT_M = 0.02  # predicted height of a placed object above its container's base
