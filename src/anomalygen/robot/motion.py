@@ -137,6 +137,22 @@ def check_budget(count, max_checks: int, wall_s: float):
     return ob.plannerOrTerminationCondition(spent, ob.timedPlannerTerminationCondition(float(wall_s)))
 
 
+def restart_seed_sequence(seed: int) -> None:
+    """Start OMPL's process-global seed sequence over, as a fresh process seeded by :func:`plan_path`
+    with ``seed`` would have it. Called when an execution starts, so that what it plans depends on its
+    own seed alone and not on what the process planned before (a skill test that passed on its own
+    failed after another test file had planned in the same pytest worker). OMPL reports an error
+    when sampling has already started, but the restart takes effect: the same seed gives the same
+    draws again."""
+    from ompl import util as ou
+
+    global _SEEDED
+    ou.setLogLevel(ou.LogLevel.LOG_NONE)
+    ou.RNG.setSeed(int(seed) + 1)
+    ou.setLogLevel(ou.LogLevel.LOG_ERROR)
+    _SEEDED = True
+
+
 def plan_path(model, data, joint_names, q_goal, *, max_checks: int = PLAN_MAX_CHECKS, seed: int = 0,
               margin: float = 0.01, allowed_bodies=(), max_step: float = 0.05,
               checker: CollisionChecker | None = None) -> list[np.ndarray] | None:

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from anomalygen.robot.driver import Driver
+from anomalygen.robot.motion import restart_seed_sequence
 from anomalygen.schema import Plan, SceneSpec
 
 
@@ -95,6 +96,7 @@ class Episode:
         self.video = video  # a VideoRecorder (skills/video.py) fed every control step, or None
         on_step = (lambda drv: video.capture(drv.data)) if video is not None else None
         self.driver = Driver(model, data, rng=rng, on_step=on_step)
+        restart_seed_sequence(self.driver.plan_seed)  # its plans depend on its seed, not on the process's past
         self.agent = self.driver.agent
         self.memory = SkillMemory()
 
