@@ -49,10 +49,11 @@ def execute_plan(scene_dir: str | Path, plan: Plan, *, seed: int, video_path: st
     the edge is picked up and set down again; a door that sprang back is pushed again). The check is
     the sub-task's own SuccessSpec, evaluated on the scene graph the robot perceives.
 
-    With ``isolate`` (default) the execution runs in a fresh process: OMPL's random generator is
-    process-global and seeded once, so a path planned in a process that has planned before depends on
-    that history. In a fresh process the first seed is the item's, and the result is a function of
-    (scene, plan, seed) alone, whichever worker or test runs it. Costs about a second. No decision
+    With ``isolate`` (default) the execution runs in a fresh process, so native code that crashes or
+    leaks takes only the item with it. Its plans do not depend on the process: OMPL's random generator
+    is process-global, and every Episode restarts its seed sequence at the episode's own seed
+    (:func:`~anomalygen.robot.motion.restart_seed_sequence`), so the result is a function of (scene,
+    plan, seed) alone, whichever worker or test runs it. Costs about a second. No decision
     depends on wall time: the episode stops starting sub-tasks after
     :data:`~anomalygen.skills.episode.EPISODE_MAX_STEPS` control steps; ``max_wall_s`` (default
     :data:`~anomalygen.skills.episode.EPISODE_WALL_CAP_S`) is only a safety net against a hung item.

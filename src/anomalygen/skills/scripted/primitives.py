@@ -191,14 +191,14 @@ def move_to(ep: Episode, obj: str, region: str, *, release_after: bool = True, i
     if into and region in ep.memory.compartments:
         return place_through_door(ep, obj, region, release_after=release_after)
     laid, tried = "", False
-    for side in (1.0, -1.0):
+    for sign in (1.0, -1.0):
         # towards the robot first; where the arm cannot turn the cup far enough (a wall close behind
         # the spot) the object lands upright and is taken again, and the other side is tried
         out = tip_direction_for_lid(ep, obj, region) if into and drv.held == obj else None
         if out is None:
             break
         tried = True
-        if lay_on_side(ep, obj, beside(ep, region, side * out), side * out, lambda: grasp(ep, obj).success):
+        if lay_on_side(ep, obj, beside(ep, region, sign * out), sign * out, lambda: grasp(ep, obj).success):
             laid = "laid on its side, "
             break
     if tried and not laid:
@@ -327,7 +327,7 @@ def place_through_door(ep: Episode, obj: str, region: str, *, release_after: boo
     lengthwise = 2 * half_long + 2 * SIDE_ROOM > width and 2 * half_long + SIDE_ROOM <= depth
     turn = (across + (0.0 if lengthwise else np.pi / 2) - yaw + np.pi / 2) % np.pi - np.pi / 2
     final = _yawed(quat, turn)
-    z = floor + below + 0.015
+    z = floor + below + ENTER_CLEARANCE
     inside = np.array([centre[0], centre[1], z])
     front = inside + out * (depth / 2 + 0.2)
     drv.goto(np.array([*drv.site[:2], max(drv.site[2], z + 0.1)]), quat, max_steps=150)
@@ -419,7 +419,7 @@ def _place_sideways(ep: Episode, obj: str, region: str, floor: float, *, release
     olo, ohi = drv.aabb(obj)
     below = drv.site[2] - olo[2]
     off = (olo[:2] + ohi[:2]) / 2 - drv.site[:2]  # the object lies ahead of the cup
-    z = floor + below + 0.015
+    z = floor + below + ENTER_CLEARANCE
     inside = np.array([*(centre[:2] - off), z])
     front = inside + out * (float(np.dot(hi - lo, np.abs(out))) / 2 + 0.2)
     ok = _enter_and_set_down(ep, obj, front, inside, side, out, out * 0.01, release_after)
