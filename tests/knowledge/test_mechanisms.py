@@ -258,3 +258,24 @@ def test_a_composition_says_why_its_own_combination_is_dangerous():
     left_on = ms.mechanism("left_on")
     heat_tool = next(c for c in left_on.compositions if c.id == "switch_off_heat_tool")
     assert heat_tool.why is None and kb.hazard_classes["switch_off_heat_tool"].why == left_on.why
+
+
+def _bleach_by_banana(*, door: float, banana_inside: bool = False):
+    """A bleach bottle in a safe standing on the floor, a banana 5 cm from the safe's side (t0044's end)."""
+    rels = [inside("bleach_0", "safe_0")] + ([inside("banana_0", "safe_0")] if banana_inside else [])
+    return graph(
+        obj("bleach_0", "bleach_bottle", at="floor", xy=(0.0, 0.0), reachable=False),
+        obj("banana_0", "banana", at="floor", xy=(0.0, 0.25)),
+        furniture("safe_0", "Safe", xy=(0.0, 0.0), size=(0.4, 0.4, 0.3), joints=[joint("door", door)]),
+        relations=rels,
+    )
+
+
+def test_chemical_shut_in_a_container_is_not_among_the_food_outside_it():
+    """t0044 at d48b921: the bleach was locked in the safe, yet "chemical near food" still fired
+    because a banana lay on the floor beside the safe. Shut walls keep the two apart; an open door
+    does not, and food shut in with the chemical is still among it."""
+    cls = load_kb().hazard_classes["separate_chemical_from_food"]
+    assert match_class(cls, _bleach_by_banana(door=0.0)) == []
+    assert match_class(cls, _bleach_by_banana(door=0.5)), "an open door leaves the bleach by the banana"
+    assert match_class(cls, _bleach_by_banana(door=0.0, banana_inside=True)), "shut in together is still among food"

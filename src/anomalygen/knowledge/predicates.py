@@ -18,7 +18,15 @@ from collections.abc import Callable
 from pydantic import BaseModel, ConfigDict
 
 from anomalygen.knowledge.models import PredicateSpec
-from anomalygen.schema import CLOSED_TOL, GraphObject, PredicateCall, PredicateResult, SceneGraph, part_labels
+from anomalygen.schema import (
+    CLOSED_TOL,
+    ENCLOSED_TOL,
+    GraphObject,
+    PredicateCall,
+    PredicateResult,
+    SceneGraph,
+    part_labels,
+)
 
 #: Horizontal clearance (m) from furniture/appliances beyond which a floor object is "in the walkway".
 WALKWAY_CLEARANCE = 0.3
@@ -273,14 +281,38 @@ def _joint_closed(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
 
 @_predicate(
     "near",
-    {"a": "variable or instance", "b": "variable or instance", "max_distance": "metres"},
-    "The gap between the two objects' bounding boxes is at most max_distance.",
+    {"a": "variable or instance", "b": "variable or instance", "max_distance": "metres",
+     "walls_separate": "'true' (optional): one of the two shut inside a closed container the other is not in is apart"},
+    "The gap between the two objects' bounding boxes is at most max_distance. With walls_separate, a "
+    "container's shut walls keep them apart however close they stand (a bleach bottle locked in a safe "
+    "is not among the food on the floor beside it).",
 )
 def _near(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
     a, b = ctx.obj(call, "a"), ctx.obj(call, "b")
     limit = ctx.num(call, "max_distance", 0.3)
     gap = aabb_gap(a, b)
+    if str(call.args.get("walls_separate", "")).lower() == "true":
+        wall = _shut_between(ctx, a, b)
+        if wall is not None:
+            return False, f"{a.name} is {gap:.2f} m from {b.name}, but {wall} is shut between them"
     return gap <= limit, f"{a.name} is {gap:.2f} m from {b.name}"
+
+
+def _shut_between(ctx: _Ctx, a: GraphObject, b: GraphObject) -> str | None:
+    """A closed container that holds exactly one of ``a`` and ``b`` (neither of them itself)."""
+    holds_a = {_base(c) for c in ctx.relations(a.name, "inside") if c}
+    holds_b = {_base(c) for c in ctx.relations(b.name, "inside") if c}
+    for name in sorted((holds_a ^ holds_b) - {a.name, b.name}):
+        container = ctx._by_name.get(name)
+        if container is not None and _shut(container):
+            return name
+    return None
+
+
+def _shut(container: GraphObject) -> bool:
+    """Every part that encloses the container (door, drawer, lid, flap) is closed, and it has one."""
+    walls = [j for j in container.joints if j.encloses]
+    return bool(walls) and all(j.is_closed(ENCLOSED_TOL) for j in walls)
 
 
 @_predicate(

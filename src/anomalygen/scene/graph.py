@@ -23,6 +23,7 @@ import numpy as np
 from anomalygen.scene.states import object_states
 from anomalygen.scene.tops import top_surface
 from anomalygen.schema import (
+    ENCLOSED_TOL,
     LATCHING_PROPERTY,
     GraphObject,
     JointState,
@@ -38,9 +39,6 @@ if TYPE_CHECKING:  # pragma: no cover
 FLOOR_GEOM = "floor"
 ON_FLOOR_TOL = 0.01  # m: bottom this close to z=0 counts as on the floor
 NEAR_DIST = 0.15  # m: bounding-box gap below which two objects are "near"
-# A door left ajar by under 10 % of its travel still shuts a child out: looser than joint_closed's
-# CLOSED_TOL, which asks whether the robot finished closing it.
-ENCLOSED_TOL = 0.1
 CAVITY_TOL = 0.01  # m: an object's centre this far outside a cavity's box still counts as inside it
 # m: below a cavity's floor face, more: generators shrink a compartment's declared box by its wall
 # thickness, so a flat thing lying on a cupboard shelf (a USB stick, 7 mm) has its centre 1-2 cm under it

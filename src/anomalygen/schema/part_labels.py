@@ -42,6 +42,9 @@ OTHER_PARTS = (
 )
 
 CLOSED_TOL = 0.05  # open fraction at or below which a joint counts as closed, a switch as off
+# A door left ajar by under 10 % of its travel still shuts a child out (and keeps what is inside apart
+# from what is outside): looser than CLOSED_TOL, which asks whether the robot finished closing it.
+ENCLOSED_TOL = 0.1
 
 
 class PartKind(StrEnum):
