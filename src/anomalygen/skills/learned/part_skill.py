@@ -185,7 +185,7 @@ def pulled_to_off(model, data, readout: PartReadout) -> bool:
     if readout.hinge:
         return False
     j = readout.jid
-    towards_off = -np.sign(readout.far - readout.closed) * data.xaxis[j] / np.linalg.norm(data.xaxis[j])
+    towards_off = readout.off_sign() * data.xaxis[j] / np.linalg.norm(data.xaxis[j])
     return bool(np.dot(towards_off, part_geometry(model, data, readout.joint)["normal"]) > 0.5)
 
 
@@ -241,6 +241,11 @@ class PartReadout:
         """Signed fraction of the travel still to go to off (1 = fully on)."""
         return float((data.qpos[self.adr] - self.closed) / (self.far - self.closed)) if self.far != self.closed else 0.0
 
+    def off_sign(self, frac: float = 1.0) -> float:
+        """+1 or -1: the way along the joint's axis that takes the part towards off from a signed
+        travel ``frac`` (the on side by default; past off, the way back)."""
+        return float(-np.sign(self.far - self.closed) * (1.0 if frac >= 0 else -1.0))
+
     def held_point(self, model, data) -> np.ndarray | None:
         """World position of the suction anchor on the part, None when the part is not held."""
         if self.eq is None or self.eq < 0 or not data.eq_active[self.eq]:
@@ -254,7 +259,7 @@ class PartReadout:
         point = cup.copy() if held is None else held
         axis = data.xaxis[self.jid] / np.linalg.norm(data.xaxis[self.jid])
         frac = self.fraction(data)
-        towards_off = -np.sign(self.far - self.closed) * (1.0 if frac >= 0 else -1.0)
+        towards_off = self.off_sign(frac)
         if self.hinge:
             lever = point - data.xanchor[self.jid]
             lever = lever - np.dot(lever, axis) * axis
