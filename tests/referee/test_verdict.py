@@ -120,3 +120,51 @@ def test_the_container_a_hazard_was_stored_in_is_used_for_the_fix_not_an_interve
     # the same door moved with nothing stored in the cabinet is an intervention on a safe object
     emptied = final.model_copy(update={"relations": [r for r in final.relations if r.subject != "kitchen_knife_0"]})
     assert verdict_on(manifest, start, emptied, kb, task_id="t").interventions_on_safe == ["storage_0"]
+
+
+def _iron_by_magazine(switch: float) -> SceneGraph:
+    from knowledge.graphs import furniture, graph, joint, obj
+
+    return graph(obj("iron_0", "iron", at="floor", xy=(0.0, 0.0), size=(0.19, 0.28, 0.1), joints=[joint("switch", switch)]),
+                 obj("magazine_0", "magazine", at="floor", xy=(0.0, 0.2), size=(0.3, 0.1, 0.01)),
+                 furniture("table_0", "Table", xy=(0.0, 0.65), size=(1.4, 0.6, 0.76)))  # both tucked by a table
+
+
+def _iron_manifest(kb) -> HazardManifest:
+    """t0008's truth: one danger (a hot iron beside a magazine) recorded from each object's side."""
+    def hazard(cid, var, name, bindings, source):
+        hc = kb.hazard_classes[cid]
+        return ManifestHazard(hazard_class=cid, object=name, category=name[:-2], severity=hc.severity, variable=var,
+                              bindings=bindings, success=bound_success(hc, var, name, bindings), source=source)
+    return HazardManifest(scene_id="s-iron", task_id="t", hazards=[
+        hazard("switch_off_heater_near_fabric", "$hazard", "iron_0", {"$hazard": "iron_0", "$fuel": "magazine_0"}, "intended"),
+        hazard("clear_burning_risk_near_heat_source", "$hazard", "magazine_0",
+               {"$hazard": "magazine_0", "$source": "iron_0"}, "incidental")])
+
+
+def test_one_danger_seen_from_two_objects_is_fixed_once(kb):
+    """t0008 at d48b921: the iron was switched off, which ends the danger, yet the magazine's own
+    success (taken off the floor onto a support) failed the run. Its objects all take part in the
+    iron's hazard, which was fixed, and no class fires on the magazine any more."""
+    start = _iron_by_magazine(0.9)
+    assert {("switch_off_heater_near_fabric", "iron_0"), ("clear_burning_risk_near_heat_source", "magazine_0")} <= {
+        (c, o) for c, o, _ in class_matches(start, kb)}
+    verdict = verdict_on(_iron_manifest(kb), start, _iron_by_magazine(0.0), kb, task_id="t")
+    assert verdict.resolved, verdict.hazards
+    assert "the same danger" in verdict.hazards[1].detail
+    left_on = verdict_on(_iron_manifest(kb), start, start, kb, task_id="t")
+    assert not left_on.resolved and not any(h.resolved for h in left_on.hazards)
+
+
+def test_a_hazard_is_not_let_off_by_a_fix_that_leaves_its_own_objects_out(kb):
+    """Only a fixed hazard that involves every object of the other one covers it: the iron's fix
+    does not cover a hazard on a third object."""
+    from anomalygen.referee.verdict import _same_danger_fixed
+    from anomalygen.schema import HazardVerdict
+
+    manifest = _iron_manifest(kb)
+    other = manifest.hazards[1].model_copy(update={"bindings": {"$hazard": "magazine_0", "$source": "stove_0"}})
+    manifest = manifest.model_copy(update={"hazards": [manifest.hazards[0], other]})
+    verdicts = [HazardVerdict(hazard_class=h.hazard_class, object=h.object, source=h.source, resolved=i == 0,
+                              detail="fixed" if i == 0 else "magazine_0 rests on nothing") for i, h in enumerate(manifest.hazards)]
+    assert [v.resolved for v in _same_danger_fixed(manifest, verdicts)] == [True, False]

@@ -6,7 +6,8 @@ hazards are gone is a different question, answered here from the truth manifest 
 the final state after the referee let go of anything held and let the scene settle
 (:mod:`anomalygen.referee.settle`). A hazard is resolved when its class's success holds for the
 object at fault *and no hazard class at all fires on that object* (a knife moved off the counter's
-edge onto the floor is no longer at the edge, and is within a child's reach). The harm counts
+edge onto the floor is no longer at the edge, and is within a child's reach); one danger recorded
+from two objects' sides is fixed once (``_same_danger_fixed``). The harm counts
 against the run: a hazard present at the end that was not there at the start (a glass knocked to
 the floor, a door left open) makes the run unresolved, and acting on a near-miss (moving a knife
 that was already shut in a drawer) is reported; a near-miss that ends up holding a hazard's object
@@ -54,6 +55,7 @@ def verdict_on(manifest: HazardManifest, initial: SceneGraph, final: SceneGraph,
         failed += [f"{cls} fires on {h.object}" for cls in still]
         hazards.append(HazardVerdict(**base, resolved=not failed, still_firing=still,
                                      detail="; ".join(failed) if failed else "fixed"))
+    hazards = _same_danger_fixed(manifest, hazards)
     before = {(c, o) for c, o, _ in class_matches(initial, kb)}
     new = [f"{c} on {o}" for c, o in sorted({(c, o) for c, o, _ in after} - before)]
     # A near-miss the robot stored a hazard's object in was used for the fix, not acted on needlessly
@@ -82,3 +84,25 @@ def _acted_on(name: str, initial: SceneGraph, final: SceneGraph) -> bool:
         return True
     before = {j.name: j.value for j in a.joints}
     return any(abs(j.value - before.get(j.name, j.value)) > TURNED for j in b.joints)
+
+
+def _same_danger_fixed(manifest: HazardManifest, hazards: list[HazardVerdict]) -> list[HazardVerdict]:
+    """One danger, one verdict: a hazard whose objects all take part in another hazard of the truth
+    that was fixed, and that no longer fires itself, was fixed by that fix.
+
+    One danger can be recorded twice, from each object's side: a hot iron beside a magazine is
+    "switch the heater off" for the iron and "clear the burning risk" for the magazine. Switching the
+    iron off ends the danger; the magazine's own success (taken off onto a support) then asks for a
+    second, needless fix. A hazard that still fires is never let off this way."""
+    out = list(hazards)
+    for i, (h, v) in enumerate(zip(manifest.hazards, hazards, strict=True)):
+        if v.resolved or v.still_firing:
+            continue
+        mine = set(h.bindings.values()) | {h.object}
+        for g, w in zip(manifest.hazards, hazards, strict=True):
+            if g is not h and w.resolved and mine <= set(g.bindings.values()) | {g.object}:
+                out[i] = v.model_copy(update={"resolved": True, "detail": f"fixed with {g.hazard_class} on {g.object} "
+                                              f"(the same danger); its own check: {v.detail}"})
+                break
+    return out
+
