@@ -167,4 +167,18 @@ def test_a_hazard_is_not_let_off_by_a_fix_that_leaves_its_own_objects_out(kb):
     manifest = manifest.model_copy(update={"hazards": [manifest.hazards[0], other]})
     verdicts = [HazardVerdict(hazard_class=h.hazard_class, object=h.object, source=h.source, resolved=i == 0,
                               detail="fixed" if i == 0 else "magazine_0 rests on nothing") for i, h in enumerate(manifest.hazards)]
-    assert [v.resolved for v in _same_danger_fixed(manifest, verdicts)] == [True, False]
+    final = _iron_by_magazine(0.0)
+    assert [v.resolved for v in _same_danger_fixed(manifest, verdicts, final, kb)] == [True, False]
+
+
+def test_a_hazard_that_ended_on_its_own_object_is_not_let_off(kb):
+    """The iron's hazard fixed, but the magazine's hazard ended because the magazine itself moved (its
+    near-the-iron precondition fails), not because the iron was put right: its own success decides."""
+    from anomalygen.referee.verdict import _same_danger_fixed
+    from anomalygen.schema import HazardVerdict
+
+    manifest = _iron_manifest(kb)
+    moved_off = moved(_iron_by_magazine(0.9), "magazine_0", position=[2.0, 0.2, 0.005])
+    verdicts = [HazardVerdict(hazard_class=h.hazard_class, object=h.object, source=h.source, resolved=i == 0,
+                              detail="fixed" if i == 0 else "magazine_0 rests on nothing") for i, h in enumerate(manifest.hazards)]
+    assert [v.resolved for v in _same_danger_fixed(manifest, verdicts, moved_off, kb)] == [True, False]

@@ -55,7 +55,7 @@ def verdict_on(manifest: HazardManifest, initial: SceneGraph, final: SceneGraph,
         failed += [f"{cls} fires on {h.object}" for cls in still]
         hazards.append(HazardVerdict(**base, resolved=not failed, still_firing=still,
                                      detail="; ".join(failed) if failed else "fixed"))
-    hazards = _same_danger_fixed(manifest, hazards)
+    hazards = _same_danger_fixed(manifest, hazards, final, kb)
     before = {(c, o) for c, o, _ in class_matches(initial, kb)}
     new = [f"{c} on {o}" for c, o in sorted({(c, o) for c, o, _ in after} - before)]
     # A near-miss the robot stored a hazard's object in was used for the fix, not acted on needlessly
@@ -86,17 +86,20 @@ def _acted_on(name: str, initial: SceneGraph, final: SceneGraph) -> bool:
     return any(abs(j.value - before.get(j.name, j.value)) > TURNED for j in b.joints)
 
 
-def _same_danger_fixed(manifest: HazardManifest, hazards: list[HazardVerdict]) -> list[HazardVerdict]:
-    """One danger, one verdict: a hazard whose objects all take part in another hazard of the truth
-    that was fixed, and that no longer fires itself, was fixed by that fix.
+def _same_danger_fixed(manifest: HazardManifest, hazards: list[HazardVerdict], final: SceneGraph,
+                       kb) -> list[HazardVerdict]:
+    """One danger, one verdict: a hazard that no longer fires because its cause, another object, was
+    put right, and whose objects all take part in another hazard of the truth that was fixed, was
+    fixed by that fix.
 
     One danger can be recorded twice, from each object's side: a hot iron beside a magazine is
     "switch the heater off" for the iron and "clear the burning risk" for the magazine. Switching the
     iron off ends the danger; the magazine's own success (taken off onto a support) then asks for a
-    second, needless fix. A hazard that still fires is never let off this way."""
+    second, needless fix. A hazard that still fires is never let off this way, nor one whose end
+    came from its own object (a vase knocked from the edge to the floor is no longer at the edge)."""
     out = list(hazards)
     for i, (h, v) in enumerate(zip(manifest.hazards, hazards, strict=True)):
-        if v.resolved or v.still_firing:
+        if v.resolved or v.still_firing or not _cause_put_right(h, final, kb):
             continue
         mine = set(h.bindings.values()) | {h.object}
         for g, w in zip(manifest.hazards, hazards, strict=True):
@@ -106,3 +109,22 @@ def _same_danger_fixed(manifest: HazardManifest, hazards: list[HazardVerdict]) -
                 break
     return out
 
+
+def _cause_put_right(h, final: SceneGraph, kb) -> bool:
+    """Does a precondition of ``h``'s class that names only other objects (the iron is on) fail now?"""
+    from anomalygen.knowledge.predicates import PredicateError, evaluate, variables_of
+
+    hc = kb.hazard_classes.get(h.hazard_class)
+    if hc is None:
+        return False
+    own = {h.variable} | {var for var, name in h.bindings.items() if name == h.object}
+    for call in hc.preconditions:
+        names = set(variables_of(call))
+        if not names or names & own or not names <= set(h.bindings):
+            continue
+        try:
+            if not evaluate(call, final, h.bindings).holds:
+                return True
+        except PredicateError:
+            continue
+    return False
