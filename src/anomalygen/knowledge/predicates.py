@@ -20,12 +20,12 @@ from pydantic import BaseModel, ConfigDict
 from anomalygen.knowledge.models import PredicateSpec
 from anomalygen.schema import (
     CLOSED_TOL,
-    ENCLOSED_TOL,
     GraphObject,
     PredicateCall,
     PredicateResult,
     SceneGraph,
     part_labels,
+    shut_by,
 )
 
 #: Horizontal clearance (m) from furniture/appliances beyond which a floor object is "in the walkway".
@@ -311,8 +311,7 @@ def _shut_between(ctx: _Ctx, a: GraphObject, b: GraphObject) -> str | None:
 
 def _shut(container: GraphObject) -> bool:
     """Every part that encloses the container (door, drawer, lid, flap) is closed, and it has one."""
-    walls = [j for j in container.joints if j.encloses]
-    return bool(walls) and all(j.is_closed(ENCLOSED_TOL) for j in walls)
+    return shut_by((j, j.value) for j in container.joints if j.encloses)
 
 
 @_predicate(

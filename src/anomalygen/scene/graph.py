@@ -23,13 +23,13 @@ import numpy as np
 from anomalygen.scene.states import object_states
 from anomalygen.scene.tops import top_surface
 from anomalygen.schema import (
-    ENCLOSED_TOL,
     LATCHING_PROPERTY,
     GraphObject,
     JointState,
     Relation,
     SceneGraph,
     SceneSpec,
+    shut_by,
     within_child_reach,
 )
 
@@ -156,10 +156,6 @@ def cavity_closers(joint_states: list[JointState], cavity_joints: list[str | Non
     return out
 
 
-def cavity_shut(closers: list[tuple[JointState, float]]) -> bool:
-    """A cavity is shut when something shuts it and every joint that does is (nearly) closed at its
-    value (joint, value)."""
-    return bool(closers) and all(js.is_closed(ENCLOSED_TOL, float(v)) for js, v in closers)
 
 
 def _holding_welds(model, body_owner: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -285,7 +281,7 @@ def _support_contacts(model, data, owner: np.ndarray, floor: int, n: int):
 def _cavities_closed(idx: _Index, data) -> np.ndarray:
     """Per cavity: every joint that shuts it is (nearly) closed; a cavity nothing shuts is open."""
     qpos = data.qpos
-    return np.array([cavity_shut([(js, qpos[adr]) for adr, js in shut]) for shut in idx.cav_closers], dtype=bool)
+    return np.array([shut_by((js, qpos[adr]) for adr, js in shut) for shut in idx.cav_closers], dtype=bool)
 
 
 def _containment(idx: _Index, data, center: np.ndarray, held: set[int]) -> np.ndarray:

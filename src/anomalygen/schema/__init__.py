@@ -74,6 +74,7 @@ from anomalygen.schema.scenes import (
     SceneSpec,
     ValidationCheck,
     ValidationReport,
+    shut_by,
     within_child_reach,
 )
 from anomalygen.schema.skills import (
@@ -179,6 +180,7 @@ __all__ = [
     "FAUCET",
     "CHILD_REACH",
     "LATCHING_PROPERTY",
+    "shut_by",
     "within_child_reach",
     "JointState",
     "PlacedCavity",

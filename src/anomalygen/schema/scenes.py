@@ -6,13 +6,14 @@ is the table in ``part_labels.py``; ``JointState`` asks it. How high a child rea
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from typing import Any, Literal
 
 from pydantic import Field
 
 import anomalygen.schema.part_labels as part_labels
 from anomalygen.schema.base import Artefact, Quat, Strict, Vec3
-from anomalygen.schema.part_labels import CLOSED_TOL
+from anomalygen.schema.part_labels import CLOSED_TOL, ENCLOSED_TOL
 from anomalygen.schema.vocabulary import AssetSource, ObjectRole, PredicateCall
 
 
@@ -79,6 +80,14 @@ class JointState(Artefact):
     def is_off(self, tol: float = CLOSED_TOL, value: float | None = None) -> bool:
         """A switch's word for closed: at most ``tol`` of its travel from off, its closed value."""
         return self.is_closed(tol, value)
+
+
+def shut_by(closers: Iterable[tuple[JointState, float]]) -> bool:
+    """A space is shut when something shuts it and every joint that does is within ``ENCLOSED_TOL`` of
+    closed at its value (joint, value). One rule for the scene graph's cavities (a child kept out) and
+    the ``near`` predicate's walls (a chemical kept apart from food)."""
+    closers = list(closers)
+    return bool(closers) and all(js.is_closed(ENCLOSED_TOL, float(v)) for js, v in closers)
 
 
 class PlacedCavity(Strict):
