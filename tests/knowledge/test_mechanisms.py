@@ -279,3 +279,23 @@ def test_chemical_shut_in_a_container_is_not_among_the_food_outside_it():
     assert match_class(cls, _bleach_by_banana(door=0.0)) == []
     assert match_class(cls, _bleach_by_banana(door=0.5)), "an open door leaves the bleach by the banana"
     assert match_class(cls, _bleach_by_banana(door=0.0, banana_inside=True)), "shut in together is still among food"
+
+
+def test_walls_separate_takes_true_or_false_and_refuses_anything_else():
+    """A class (from the knowledge base or an LLM) that writes walls_separate='yes' is refused with a
+    reason, not read as 'false'."""
+    from anomalygen.knowledge.predicates import PredicateError
+
+    g = _bleach_by_banana(door=0.0)
+    args = {"a": "bleach_0", "b": "banana_0", "max_distance": 0.2}
+    assert evaluate(PredicateCall(name="near", args={**args, "walls_separate": "false"}), g).holds
+    assert not evaluate(PredicateCall(name="near", args={**args, "walls_separate": "true"}), g).holds
+    with pytest.raises(PredicateError, match="must be 'true' or 'false'"):
+        evaluate(PredicateCall(name="near", args={**args, "walls_separate": "yes"}), g)
+    kb = load_kb()
+    hc = kb.hazard_classes["separate_chemical_from_food"]
+    bad = [c.model_copy(update={"args": {**c.args, "walls_separate": "yes"}}) if c.name == "near" else c
+           for c in hc.preconditions]
+    assert any("walls_separate must be 'true' or 'false'" in p
+               for p in kb.class_problems(hc.model_copy(update={"preconditions": bad})))
+    assert kb.class_problems(hc) == []

@@ -36,6 +36,8 @@ ROOM_FIXTURES = ("furniture", "appliance")
 ON_FRACTION = 0.5
 #: Instance states that say a control-less thing is on (a lit candle).
 ON_STATES = ("on", "lit")
+#: The values a yes/no predicate argument (``near``'s ``walls_separate``) may take.
+FLAG_VALUES = ("true", "false")
 
 
 class PredicateError(ValueError):
@@ -85,6 +87,13 @@ class _Ctx:
             return float(call.args[arg])
         except (TypeError, ValueError):
             raise PredicateError(f"{call.name}: argument '{arg}' must be a number, got {call.args[arg]!r}") from None
+
+    def flag(self, call: PredicateCall, arg: str) -> bool:
+        """An optional yes/no argument: absent or 'false' is False, 'true' is True, anything else an error."""
+        value = str(call.args.get(arg, "false")).strip().lower()
+        if value not in FLAG_VALUES:
+            raise PredicateError(f"{call.name}: argument '{arg}' must be 'true' or 'false', got {call.args[arg]!r}")
+        return value == "true"
 
     def relations(self, subject: str, predicate: str) -> list[str | None]:
         return [r.object for r in self.graph.relations if r.subject == subject and r.predicate == predicate]
@@ -282,7 +291,8 @@ def _joint_closed(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
 @_predicate(
     "near",
     {"a": "variable or instance", "b": "variable or instance", "max_distance": "metres",
-     "walls_separate": "'true' (optional): one of the two shut inside a closed container the other is not in is apart"},
+     "walls_separate": "'true' or 'false' (optional, default 'false'): one of the two shut inside a closed "
+                       "container the other is not in is apart"},
     "The gap between the two objects' bounding boxes is at most max_distance. With walls_separate, a "
     "container's shut walls keep them apart however close they stand (a bleach bottle locked in a safe "
     "is not among the food on the floor beside it).",
@@ -291,7 +301,7 @@ def _near(ctx: _Ctx, call: PredicateCall) -> tuple[bool, str]:
     a, b = ctx.obj(call, "a"), ctx.obj(call, "b")
     limit = ctx.num(call, "max_distance", 0.3)
     gap = aabb_gap(a, b)
-    if str(call.args.get("walls_separate", "")).lower() == "true":
+    if ctx.flag(call, "walls_separate"):
         wall = _shut_between(ctx, a, b)
         if wall is not None:
             return False, f"{a.name} is {gap:.2f} m from {b.name}, but {wall} is shut between them"
