@@ -142,6 +142,14 @@ def _iron_manifest(kb) -> HazardManifest:
                {"$hazard": "magazine_0", "$source": "iron_0"}, "incidental")])
 
 
+def _iron_fixed_magazine_not(manifest: HazardManifest) -> list:
+    """The verdicts before the same-danger pass: the iron's hazard fixed, the magazine's own check failed."""
+    from anomalygen.schema import HazardVerdict
+
+    return [HazardVerdict(hazard_class=h.hazard_class, object=h.object, source=h.source, resolved=i == 0,
+                          detail="fixed" if i == 0 else "magazine_0 rests on nothing") for i, h in enumerate(manifest.hazards)]
+
+
 def test_one_danger_seen_from_two_objects_is_fixed_once(kb):
     """t0008 at d48b921: the iron was switched off, which ends the danger, yet the magazine's own
     success (taken off the floor onto a support) failed the run. Its objects all take part in the
@@ -160,13 +168,11 @@ def test_a_hazard_is_not_let_off_by_a_fix_that_leaves_its_own_objects_out(kb):
     """Only a fixed hazard that involves every object of the other one covers it: the iron's fix
     does not cover a hazard on a third object."""
     from anomalygen.referee.verdict import _same_danger_fixed
-    from anomalygen.schema import HazardVerdict
 
     manifest = _iron_manifest(kb)
     other = manifest.hazards[1].model_copy(update={"bindings": {"$hazard": "magazine_0", "$source": "stove_0"}})
     manifest = manifest.model_copy(update={"hazards": [manifest.hazards[0], other]})
-    verdicts = [HazardVerdict(hazard_class=h.hazard_class, object=h.object, source=h.source, resolved=i == 0,
-                              detail="fixed" if i == 0 else "magazine_0 rests on nothing") for i, h in enumerate(manifest.hazards)]
+    verdicts = _iron_fixed_magazine_not(manifest)
     final = _iron_by_magazine(0.0)
     assert [v.resolved for v in _same_danger_fixed(manifest, verdicts, final, kb)] == [True, False]
 
@@ -175,10 +181,8 @@ def test_a_hazard_that_ended_on_its_own_object_is_not_let_off(kb):
     """The iron's hazard fixed, but the magazine's hazard ended because the magazine itself moved (its
     near-the-iron precondition fails), not because the iron was put right: its own success decides."""
     from anomalygen.referee.verdict import _same_danger_fixed
-    from anomalygen.schema import HazardVerdict
 
     manifest = _iron_manifest(kb)
     moved_off = moved(_iron_by_magazine(0.9), "magazine_0", position=[2.0, 0.2, 0.005])
-    verdicts = [HazardVerdict(hazard_class=h.hazard_class, object=h.object, source=h.source, resolved=i == 0,
-                              detail="fixed" if i == 0 else "magazine_0 rests on nothing") for i, h in enumerate(manifest.hazards)]
+    verdicts = _iron_fixed_magazine_not(manifest)
     assert [v.resolved for v in _same_danger_fixed(manifest, verdicts, moved_off, kb)] == [True, False]
