@@ -98,7 +98,8 @@ def test_the_scan_catches_a_literal_copy(tmp_path, monkeypatch):
 
 def test_every_closure_the_planner_and_skills_use_is_enclosing_in_the_table_and_the_graph():
     from anomalygen.plan import planner
-    from anomalygen.scene.graph import cavity_closers, cavity_shut
+    from anomalygen.scene.graph import cavity_closers
+    from anomalygen.schema import shut_by
     from anomalygen.skills.scripted import access, joints
 
     used = {*planner.CLOSURES, *planner.LID_PARTS.split("|"), *access.CLOSURES_ALL, *access.LIDS,
@@ -111,13 +112,13 @@ def test_every_closure_the_planner_and_skills_use_is_enclosing_in_the_table_and_
                   for i in range(2)]
         (closers,) = cavity_closers(leaves, [leaves[0].name])
         assert {js.name for js in closers} == {js.name for js in leaves}, label
-        assert cavity_shut([(js, 0.0) for js in closers]), label
-        assert not cavity_shut([(js, 0.5 if js is leaves[1] else 0.0) for js in closers]), label
+        assert shut_by([(js, 0.0) for js in closers]), label
+        assert not shut_by([(js, 0.5 if js is leaves[1] else 0.0) for js in closers]), label
     # a part that does not enclose (an oven rack's slide, a window) leaves a cavity to the enclosing ones
     rack = JointState(name="rack", label="rack", value=0.0, range=(0.0, 0.3), closed_value=0.0)
     flap = JointState(name="flap_0", label=part_labels.FLAP, value=0.0, range=(0.0, 1.5), closed_value=0.0)
     assert [[js.name for js in c] for c in cavity_closers([rack, flap], ["rack", None])] == [["flap_0"], ["flap_0"]]
-    assert cavity_closers([rack], ["rack"]) == [[]] and not cavity_shut([])
+    assert cavity_closers([rack], ["rack"]) == [[]] and not shut_by([])
     # and the table's views are the same sets
     assert set(part_labels.ENCLOSING_LABELS) == used
     assert set(part_labels.LID_LABELS) == {part_labels.LID, part_labels.FLAP}
