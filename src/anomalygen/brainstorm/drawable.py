@@ -136,6 +136,38 @@ def hazards_for(kb: KnowledgeBase, hc: HazardClass) -> list[str]:
             and _part_ok(hc, hc.hazard_variable, o) and (not stored or containers_for(kb, hc, o))]
 
 
+_INTRINSIC = ("has_property", "category_is")
+
+
+@functools.lru_cache(maxsize=8)
+def _left_out_hazards(kb: KnowledgeBase) -> frozenset[str]:
+    """Objects that are a hazard of some class wherever they are left out of a container.
+
+    Such a class's preconditions name only its own object: what the object is, that it is not inside
+    something and, at most, a height band a table or counter falls in (leftovers, a knife, bleach).
+    """
+    out: set[str] = set()
+    for hc in kb.hazard_classes.values():
+        calls = hc.preconditions
+        named = {v for c in calls for v in c.args.values() if isinstance(v, str) and v.startswith("$")}
+        left_out = any(c.name == "inside" and c.negate for c in calls)
+        rest = [c for c in calls if not (c.name in _INTRINSIC or (c.name == "inside" and c.negate)
+                                         or c.name == "height_above_floor")]
+        if named == {hc.hazard_variable} and left_out and not rest:
+            out.update(kb.hazard_candidates(hc))
+    return frozenset(out)
+
+
+def harmless_first(kb: KnowledgeBase, objects: list[str]) -> list[str]:
+    """``objects`` without those that would be a second hazard of their own, unless none is left.
+
+    The object a hazard is beside (the food the bleach stands among) is scenery, not a fault: left-out
+    leftovers would make a second hazard, whose fix (a fridge) the scene need not hold.
+    """
+    bad = _left_out_hazards(kb)
+    return [o for o in objects if o not in bad] or objects
+
+
 def placements_for(kb: KnowledgeBase, hc: HazardClass, hazard: str) -> list[str]:
     """The class's placements for ``hazard`` that the builder can set up with objects it has."""
     var = relation_variable(hc)

@@ -154,6 +154,7 @@ class IdeaSampler:
     ) -> Idea:
         from anomalygen.brainstorm.drawable import (
             containers_for,
+            harmless_first,
             hazards_for,
             placements_for,
             relation_variable,
@@ -172,6 +173,8 @@ class IdeaSampler:
             pool = [c for c in candidates if c != avoid_hazard] or candidates
             hazard = weighted(rng, pool, self._w("object", pool))
         placements = placements_for(kb, hc, hazard)
+        parents = harmless_first(kb, [p.split(":", 1)[1] for p in placements if ":" in p])
+        placements = [p for p in placements if ":" not in p or p.split(":", 1)[1] in parents]
         placement = weighted(rng, placements, self._w("placement", placements))
         rooms = [r for r in hc.rooms if r in kb.objects[hazard].rooms] or list(hc.rooms)
         room = weighted(rng, rooms, self._w("room", rooms))
@@ -188,7 +191,7 @@ class IdeaSampler:
             if var == related and ":" in placement:  # the burner the towel is on: the placement's object
                 co.append(placement.split(":", 1)[1])
             else:
-                co.append(weighted(rng, self.kb.static_candidates(hc, var)))
+                co.append(weighted(rng, harmless_first(kb, self.kb.static_candidates(hc, var))))
         if self.rich:
             fitting = [b for b in self.benign if room in kb.objects[b].rooms and b not in co]
             for _ in range(int(rng.integers(0, 3))):
