@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from anomalygen.brainstorm.drawable import fits_inside, placements_for, why_not_drawable
 from anomalygen.knowledge import load_kb
 from anomalygen.scene import asset_choice
@@ -48,3 +50,39 @@ def test_a_hazard_the_fix_puts_away_is_drawn_only_with_a_container_it_fits():
             from anomalygen.brainstorm.drawable import _roomiest
 
             assert _roomiest(kb, c, asset_choice.container_room) >= least
+
+
+def test_the_food_a_chemical_stands_among_is_not_a_second_hazard():
+    """t0044 of the seed-0 loop at 8b4be29: the bleach was drawn beside a box of leftovers. Leftovers
+    left out are a hazard of their own (store_perishable_food), and the kitchen had no fridge, so
+    no robot could resolve the task. The object beside the hazard is now one that is harmless left
+    out, whenever there is such an object."""
+    import numpy as np
+
+    from anomalygen.brainstorm.drawable import harmless_first
+    from anomalygen.brainstorm.idea_sampler import IdeaSampler
+
+    kb = load_kb()
+    assert harmless_first(kb, ["leftover_container", "banana", "Knife"]) == ["banana"]
+    assert harmless_first(kb, ["leftover_container"]) == ["leftover_container"]  # nothing else: kept
+    chem = kb.hazard_classes["separate_chemical_from_food"]
+    sampler = IdeaSampler(kb, kb.roles[next(iter(kb.roles))])
+    rng = np.random.default_rng(0)
+    foods = set()
+    for _ in range(60):
+        idea = sampler.idea_for(rng, chem, "bleach_bottle", agent=None, agent_index=0, round_=1)
+        foods.add(idea.placement.split(":", 1)[1] if ":" in idea.placement else idea.co_objects[0])
+    assert foods and foods <= {"apple", "banana", "bread_loaf"}, foods
+
+
+def test_the_text_names_the_object_beside_the_hazard_once():
+    """'in the bathtub with a bathtub nearby': the place already names the object the hazard is
+    beside or in, so it is not listed again among the things nearby."""
+    from anomalygen.brainstorm.knowledge_engine import KnowledgeEngine
+    from anomalygen.brainstorm.realise import nice
+
+    for p in KnowledgeEngine(seed=0, embed_fn=lambda texts: np.eye(len(texts), 8)).run(40):
+        place = p.scenario.placement
+        if ":" in place:
+            name = nice(place.split(":", 1)[1])
+            assert p.description.lower().count(name) <= 1, (place, p.description)

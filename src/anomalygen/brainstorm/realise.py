@@ -272,7 +272,8 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     verb = _choice(rng, verbs)
     risk = _choice(rng, class_bank(b, "risk_word", hc))
     pshort = "" if articulated else place_phrase_bank(idea.placement, room, rng, fragment=_place_fragment(hc))
-    co_names = [nice(c) for c in idea.co_objects if c not in (idea.hazard, idea.container)]
+    beside = idea.placement.split(":", 1)[1] if ":" in idea.placement else None  # already said by the place
+    co_names = [nice(c) for c in idea.co_objects if c not in (idea.hazard, idea.container, beside)]
     if "co_objects" not in idea.borrowed and len(co_names) > 1:
         # background clutter is detail: name one piece, unless borrowing the setting is the idea's point
         co_names = [co_names[int(rng.integers(len(co_names)))]]
