@@ -175,3 +175,32 @@ def test_target_container_is_drawn_with_room_for_the_hazard():
     assert len(fits) >= 3 and all(o[1] <= o[2] and o[2] >= least for o in fits), outcomes
     # an attempt may still fail (no base pose reaches the strip), never for want of room
     assert not [o for o in outcomes if o[0] == "failed" and "does not fit" in o[1]], outcomes
+
+
+def test_an_object_put_in_through_a_front_door_lies_in_the_front_half():
+    """t0034 of the seed-0 loop at 8b4be29: a detergent pod at the back of a fridge's lowest
+    compartment, 0.4 m past the opening, where the arm cannot reach (it gets 0.33-0.36 m in, past the
+    shelf above). An object placed inside a front-opening cavity now lies in its front half."""
+    from anomalygen.scene.instances import cavity_front, cavity_world
+
+    task = TaskProposal(
+        id="t-fit-pod-fridge", name="pod in the fridge", explanation="test",
+        description="A detergent pod lies in the fridge.", category="household_hazard",
+        hazard_class="remove_chemical_from_fridge", target_asset="Refrigerator",
+        scenario=dict(hazard_object="detergent_pod", room="kitchen", placement="inside:Refrigerator",
+                      container="Safe", co_objects=[]),
+        provenance=dict(engine="knowledge", mode="brainstorm"))
+    depths = []
+    for seed in range(6):
+        _, bindings, placed = build._plan(task, SETTINGS, item_rng(seed, task.id, 0))
+        pod = placed[bindings["$hazard"]]
+        fridge = placed[pod.inside]
+        lo, hi, cav = cavity_world(fridge)
+        front = cavity_front(fridge, cav)
+        assert front is not None
+        k = int(np.argmax(np.abs(front[:2])))
+        mouth = hi[k] if front[k] > 0 else lo[k]
+        depth = abs(mouth - pod.world_center()[k])
+        assert depth <= (hi[k] - lo[k]) / 2 + 1e-6, f"seed {seed}: the pod's centre lies {depth:.2f} m past the opening"
+        depths.append(depth)
+    assert len({round(d, 3) for d in depths}) > 1  # still drawn, not pinned to one spot

@@ -163,6 +163,13 @@ def surface_of(holder: Placed):
     return layout.surface_world(holder, best.center, best.half_size)
 
 
+def cavity_front(holder: Placed, cav) -> np.ndarray | None:
+    """World direction out of a cavity's front opening (an asset's front is its -y), None if open on top."""
+    if cav.opening != "front":
+        return None
+    return np.array([math.sin(holder.yaw), -math.cos(holder.yaw)])
+
+
 def cavity_world(holder: Placed):
     asset = holder.asset
     if not asset.cavities:

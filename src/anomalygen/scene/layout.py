@@ -352,9 +352,16 @@ class Layout:
         raise ItemFailed(f"no free spot for {obj.name} on {holder.name}")
 
     def place_in_cavity(
-        self, obj: Placed, holder: Placed, cavity_world: tuple[np.ndarray, np.ndarray]
+        self, obj: Placed, holder: Placed, cavity_world: tuple[np.ndarray, np.ndarray],
+        front: np.ndarray | None = None,
     ) -> None:
-        """Put ``obj`` on the floor of a cavity (world AABB), centred with a little jitter."""
+        """Put ``obj`` on the floor of a cavity (world AABB), centred with a little jitter.
+
+        ``front`` (world, horizontal, out of a door's opening) keeps it in the front half: the arm
+        reaches 0.33-0.36 m past a fridge's opening into its lowest compartment
+        (``benchmarks/reach_into_compartment.py``), and a task must stay within what the robot can
+        do, as the paper's do. The draw is the same either way, only mapped onto the front half.
+        """
         lo, hi = cavity_world
         obj.yaw = holder.yaw
         half = obj.world_half()
@@ -365,7 +372,11 @@ class Layout:
             room = (hi[:2] - lo[:2]) / 2 - half[:2] - 0.01
         if np.any(room < 0) or (hi[2] - lo[2]) < 2 * half[2] + 0.01:
             raise ItemFailed(f"{obj.name} does not fit inside {holder.name}")
-        center = (lo[:2] + hi[:2]) / 2 + self.rng.uniform(-0.5, 0.5, size=2) * room
+        jitter = self.rng.uniform(-0.5, 0.5, size=2)
+        if front is not None:
+            k = int(np.argmax(np.abs(front[:2])))
+            jitter[k] = np.sign(front[k]) * (jitter[k] + 0.5) / 2  # [-0.5, 0.5] -> the front half
+        center = (lo[:2] + hi[:2]) / 2 + jitter * room
         cl = (obj.hi + obj.lo) / 2
         c, s = math.cos(obj.yaw), math.sin(obj.yaw)
         offset = np.array([c * cl[0] - s * cl[1], s * cl[0] + c * cl[1]])

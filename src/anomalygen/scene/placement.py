@@ -17,6 +17,7 @@ from anomalygen.scene.casting import Selection, clutter_names
 from anomalygen.scene.instances import (
     HAZARD_NEAR_SIDE,
     INWARD,
+    cavity_front,
     cavity_world,
     instance_name,
     placed_instance,
@@ -175,8 +176,8 @@ def _floor_the_holder(lay: Layout, holder: Placed, inside: Placed) -> None:
     deep counter the arm cannot reach past the counter's edge into it (welded, it stays put)."""
     lay.items = [p for p in lay.items if p is not holder and p is not inside]
     lay.place_on_floor(holder, relevant=True, face=True)
-    lo, hi, _ = cavity_world(holder)
-    lay.place_in_cavity(inside, holder, (lo, hi))
+    lo, hi, cav = cavity_world(holder)
+    lay.place_in_cavity(inside, holder, (lo, hi), front=cavity_front(holder, cav))
 
 
 def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None,
@@ -205,8 +206,8 @@ def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], suppor
         if kind == "near":
             _place_near(lay, hp, ppl, placed)
         elif kind == "inside":
-            lo, hi, _ = cavity_world(ppl)
-            lay.place_in_cavity(hp, ppl, (lo, hi))
+            lo, hi, cav = cavity_world(ppl)
+            lay.place_in_cavity(hp, ppl, (lo, hi), front=cavity_front(ppl, cav))
         else:
             lay.place_on_surface(hp, ppl, surface_of(ppl), inward=0.0)
     else:
