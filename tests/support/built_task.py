@@ -6,9 +6,10 @@ from __future__ import annotations
 from pathlib import Path
 
 
-def episode_on_built_task(fixture: Path, out: Path):
+def episode_on_built_task(fixture: Path, out: Path, settings=None):
     """Build the task in ``fixture`` (a TaskProposal JSON) at seed 0 with the default settings, as the
-    loop does, into ``out``, and return an Episode on its perceived scene with an empty plan."""
+    loop does (or ``settings``: the primitives benchmark turns the judgement mix off), into ``out``,
+    and return an Episode on its perceived scene with an empty plan."""
     from anomalygen.config import Settings
     from anomalygen.perception import load_perceived_scene
     from anomalygen.rng import item_rng
@@ -17,7 +18,7 @@ def episode_on_built_task(fixture: Path, out: Path):
     from anomalygen.skills.episode import Episode, EpisodeBudget, LearningSettings
 
     task = TaskProposal.model_validate_json(fixture.read_text())
-    build_scene(task, seed=0, settings=Settings(), out_dir=out)
+    build_scene(task, seed=0, settings=settings or Settings(), out_dir=out)
     model, data, perceived = load_perceived_scene(out)
     plan = Plan(task_id=task.id, source="detected", engine="knowledge", subtasks=[], success={"predicates": []})
     return Episode(model, data, perceived, seed=0, rng=item_rng(0, task.id), plan=plan, budget=EpisodeBudget(),

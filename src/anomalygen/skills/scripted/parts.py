@@ -281,6 +281,7 @@ def actuate_part(ep: Episode, joint: str, goal: float, *, closed: float, tol: fl
     def q() -> float:
         return float(d.qpos[adr])
 
+    missed: set[bool] = set()  # faces (outer or not) the cup failed to reach since the part last moved
     for attempt in range(attempts):
         if abs(q() - goal) <= tol or drv.steps - s0 > max_steps:
             break
@@ -288,6 +289,9 @@ def actuate_part(ep: Episode, joint: str, goal: float, *, closed: float, tol: fl
         if not grasps:
             notes.append("no reachable face")
             break
+        # a face the cup could not get at is tried again only after the other: a door swung onto its
+        # stop shows its outer face to whatever stands behind it, yet its inner face brings it back
+        grasps = [g for g in grasps if g.outer not in missed] + [g for g in grasps if g.outer in missed]
         for g in [_on_surface(ep, c) for c in grasps] + [_on_surface(ep, grasps[0])]:
             stop, placed = _place_base_for(ep, joint, g, goal, closed)
             if placed and _faces_base(ep, g):
@@ -318,8 +322,10 @@ def actuate_part(ep: Episode, joint: str, goal: float, *, closed: float, tol: fl
                     break
         if not grabbed:
             notes.append(f"attempt {attempt + 1}: cup did not reach the {'outer' if g.outer else 'inner'} face")
+            missed.add(g.outer)
             drv.goto(drv.site + n * 0.08, max_steps=40)
             continue
+        missed.clear()
         why = _drive(ep, joint, stop, tol=tol, max_drag=max_drag)
         if why:
             notes.append(f"attempt {attempt + 1}: {why}")
