@@ -31,3 +31,25 @@ def test_motion_direction_is_tangent_to_the_hinge():
     mujoco.mj_kinematics(env.model, env.data)
     step = env.data.site_xpos[env._site_h] - h
     assert np.dot(step / np.linalg.norm(step), v) > 0.99
+
+
+@pytest.mark.slow
+def test_after_pulling_a_floor_safe_open_the_arm_reaches_a_lighter_on_a_table(tmp_path):
+    """The seed-0 primitives run's t0029 at b6089cb, built verbatim: a lighter on a table, a safe on the
+    floor. Two tries at the safe's door left the cup 0.2 m above the floor; the base then moved beside
+    the table carrying the arm as it was, under the table top, from where it could not rise: the cup
+    came down beside the lighter, "suction did not catch" in 3 of 3 runs. A low cup is tucked in first."""
+    from pathlib import Path
+
+    from anomalygen.config import Settings
+    from anomalygen.skills.scripted import access, primitives
+    from support.built_task import episode_on_built_task
+
+    fixture = Path(__file__).parent / "fixtures" / "lighter_table_after_safe.json"
+    build = {"hazard_free": 0, "multi_hazard": 0, "near_misses": 0}  # bench_primitives.py's settings
+    ep = episode_on_built_task(fixture, tmp_path / "scene", Settings(build=build))
+    for _ in range(2):  # the executor's two attempts at the door, as in the failing runs
+        access.open_for_access(ep, "safe_0", ["door"])
+    assert ep.driver.site[2] < 0.6  # the situation this test is about: the cup low after the door
+    res = primitives.grasp(ep, "lighter_0")
+    assert res.success and ep.driver.held == "lighter_0", res.detail

@@ -43,6 +43,8 @@ from anomalygen.skills.scripted.setdown import (
     turn_until_there,
 )
 
+LOW_CUP = 0.1  # m: a cup this far below the grasp point is tucked in before the base moves
+
 
 def approach(ep: Episode, obj: str, point=None) -> SkillOutcome:
     """Base near ``obj``, cup to 0.03 m above its top face (grasp ``point``), cup facing the surface.
@@ -58,6 +60,10 @@ def approach(ep: Episode, obj: str, point=None) -> SkillOutcome:
     quat = quat_z_to(-normal)
     pre = point + normal * PRE_CONTACT
     hover = point + normal * (PRE_CONTACT + 0.12)
+    if drv.held is None and drv.site[2] < point[2] - LOW_CUP:
+        # the cup is low (it just pulled a safe's door near the floor): fold the arm in before the base
+        # moves, or the base carries it under the table the object stands on and it cannot rise (t0029)
+        drv.tuck()
     # a base pose from which the cup reaches the object face-down (a globe's top is 1.2 m up: from
     # the wrong spot the cup meets it tilted and the globe hangs crooked)
     if not drv.place_base_near(point, reach_poses=[(pre, quat), (hover, quat)]):
