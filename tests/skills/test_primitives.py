@@ -53,3 +53,23 @@ def test_after_pulling_a_floor_safe_open_the_arm_reaches_a_lighter_on_a_table(tm
     assert ep.driver.site[2] < 0.6  # the situation this test is about: the cup low after the door
     res = primitives.grasp(ep, "lighter_0")
     assert res.success and ep.driver.held == "lighter_0", res.detail
+
+
+@pytest.mark.slow
+def test_a_cord_in_a_bathtub_is_taken_out_by_a_point_the_arm_reaches(tmp_path):
+    """The seed-0 primitives run's t0002 at 99ecc74, built verbatim: a 1 m extension cord in a bathtub
+    between a counter and a table. Its second grasp point has no base pose from which the arm reaches
+    it, and the grasp gave up there ("no collision-free base pose", 3 of 3 runs); its 4th point is in
+    reach over the rim. A point with no base pose is now passed over."""
+    from pathlib import Path
+
+    from anomalygen.config import Settings
+    from anomalygen.skills.scripted import transfer
+    from support.built_task import episode_on_built_task
+
+    fixture = Path(__file__).parent / "fixtures" / "cord_in_bathtub.json"
+    build = {"hazard_free": 0, "multi_hazard": 0, "near_misses": 0}  # bench_primitives.py's settings
+    ep = episode_on_built_task(fixture, tmp_path / "scene", Settings(build=build))
+    res = transfer.take_out_of(ep, "extension_cord_0", "bathtub_0")
+    assert res.success and ep.driver.held == "extension_cord_0", res.detail
+    assert ep.driver.aabb("extension_cord_0")[0][2] > ep.driver.aabb("bathtub_0")[1][2]  # above the rim

@@ -43,6 +43,7 @@ from anomalygen.skills.scripted.setdown import (
     turn_until_there,
 )
 
+GRASP_POINTS = 5  # a 1 m cord in a bathtub: only its 4th point is in reach over the tub's rim
 LOW_CUP = 0.1  # m: a cup this far below the grasp point is tucked in before the base moves
 
 
@@ -82,18 +83,22 @@ def approach(ep: Episode, obj: str, point=None) -> SkillOutcome:
 def grasp(ep: Episode, obj: str, *, lift: float = 0.12) -> SkillOutcome:
     """Approach, move along the normal until the cup touches, switch suction on, lift by ``lift``.
 
-    Tries up to three grasp points (``grasp_points``) before giving up."""
+    Tries up to GRASP_POINTS grasp points (``grasp_points``) before giving up; a point with no base
+    pose from which the arm reaches it is passed over, not the end of the grasp."""
     from anomalygen.robot.ik import quat_z_to
 
     drv = ep.driver
     s0 = drv.steps
     normal = np.array([0.0, 0.0, 1.0])
     quat = quat_z_to(-normal)
-    grabbed, tried_side = False, False
-    for point in grasp_points(ep, obj):
+    grabbed, tried_side, no_base = False, False, None
+    for point in grasp_points(ep, obj, n=GRASP_POINTS):
         res = approach(ep, obj, point)
         if not res.success and "base" in res.detail:
-            return res
+            # no base pose for this point: another may have one (the far end of a cord in a bathtub)
+            no_base = no_base or res
+            continue
+        no_base = False  # a point had a base pose: a failure is the cup's, not the base's
         if (not drv.reaches and not tried_side and drv.aabb(obj)[1][2] - drv.aabb(obj)[0][2] > 0.2
                 and footprint(ep, obj)[2] > 0.09):  # bulky, not a thin screen that a side push would topple
             # a tall object whose top the cup cannot reach face-down: hold it by the side if possible
@@ -113,6 +118,8 @@ def grasp(ep: Episode, obj: str, *, lift: float = 0.12) -> SkillOutcome:
         if grabbed:
             break
         drv.goto(drv.site + normal * 0.06, quat, max_steps=40)
+    if not grabbed and no_base:
+        return no_base  # no point had a base pose
     if not grabbed:
         return SkillOutcome(False, drv.steps - s0, f"suction did not catch {obj} "
                                f"(cup-object distance {drv.agent.cup_distance(drv.data, obj):.3f} m)")
