@@ -73,8 +73,10 @@ def _pick(ep: Episode, obj: str) -> SkillOutcome | None:
 
 def move_away(ep: Episode, obj: str, frm: str, distance: float) -> SkillOutcome:
     """Pick ``obj`` and set it on a free spot of a safe support at least ``distance`` m (horizontal
-    box gap) from ``frm``: its own support when that has such a spot, else the nearest that does."""
-    from anomalygen.skills.geometry import footprint, free_spot
+    box gap) from ``frm``: its own support when that has such a spot, else the nearest that does. A
+    spot on something else standing on the top is no spot: a laptop set on a basket on the only
+    table lay at the basket's edge, a new hazard (t0062); with no clear spot the skill says so."""
+    from anomalygen.skills.geometry import footprint, rated_spot
 
     drv = ep.driver
     flo, fhi = drv.aabb(frm)
@@ -86,12 +88,13 @@ def move_away(ep: Episode, obj: str, frm: str, distance: float) -> SkillOutcome:
     half = np.array([a, a])  # either way round: move_to may turn it to lie along the top
     chosen = None
     for support in safe_supports(ep, obj, avoid=(frm,)):
-        spot = free_spot(ep, support, obj, away=away, square=True)  # rated as it is checked
-        if box_gap((spot[:2] - half, spot[:2] + half), away) >= distance:
+        spot, _, hits = rated_spot(ep, support, obj, away=away, square=True)  # rated as it is checked
+        if hits == 0 and box_gap((spot[:2] - half, spot[:2] + half), away) >= distance:
             chosen = support
             break
     if chosen is None:
-        return SkillOutcome(False, 0, f"no safe support has a spot for {obj} at least {distance:.2f} m from {frm}")
+        return SkillOutcome(False, 0, f"no safe support has a spot for {obj} at least {distance:.2f} m from {frm}, "
+                                      "clear of what stands on it")
     failed = _pick(ep, obj)
     if failed is not None:
         return failed
