@@ -91,14 +91,14 @@ def grasp(ep: Episode, obj: str, *, lift: float = 0.12) -> SkillOutcome:
     s0 = drv.steps
     normal = np.array([0.0, 0.0, 1.0])
     quat = quat_z_to(-normal)
-    grabbed, tried_side, no_base = False, False, None
+    grabbed, tried_side, no_base, based = False, False, None, False
     for point in grasp_points(ep, obj, n=GRASP_POINTS):
         res = approach(ep, obj, point)
         if not res.success and "base" in res.detail:
             # no base pose for this point: another may have one (the far end of a cord in a bathtub)
             no_base = no_base or res
             continue
-        no_base = False  # a point had a base pose: a failure is the cup's, not the base's
+        based = True  # a point had a base pose: a failure is the cup's, not the base's
         if (not drv.reaches and not tried_side and drv.aabb(obj)[1][2] - drv.aabb(obj)[0][2] > 0.2
                 and footprint(ep, obj)[2] > 0.09):  # bulky, not a thin screen that a side push would topple
             # a tall object whose top the cup cannot reach face-down: hold it by the side if possible
@@ -118,7 +118,7 @@ def grasp(ep: Episode, obj: str, *, lift: float = 0.12) -> SkillOutcome:
         if grabbed:
             break
         drv.goto(drv.site + normal * 0.06, quat, max_steps=40)
-    if not grabbed and no_base:
+    if not grabbed and not based and no_base is not None:
         return no_base  # no point had a base pose
     if not grabbed:
         return SkillOutcome(False, drv.steps - s0, f"suction did not catch {obj} "
