@@ -156,8 +156,6 @@ def cavity_closers(joint_states: list[JointState], cavity_joints: list[str | Non
     return out
 
 
-
-
 def _holding_welds(model, body_owner: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Weld constraints that tie an object's body to a robot body (the suction cup's welds), the
     object each holds, and the welds between robot bodies alone (the cup tracking its target).
