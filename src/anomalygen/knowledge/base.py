@@ -322,9 +322,9 @@ def _call_problems(call: PredicateCall, predicates, names: set[str], declared: s
         out += [f"unknown category {c}" for c in str(call.args.get("category", "")).split("|") if c not in names]
     if call.name == "room_is":
         out += [f"unknown room {r}" for r in str(call.args.get("room", "")).split("|") if r not in ROOMS]
-    from anomalygen.knowledge.predicates import FLAG_VALUES
+    from anomalygen.knowledge.predicates import parse_flag
 
-    if "walls_separate" in call.args and str(call.args["walls_separate"]).strip().lower() not in FLAG_VALUES:
+    if "walls_separate" in call.args and parse_flag(call.args["walls_separate"]) is None:
         out.append(f"{call.name}: walls_separate must be 'true' or 'false', not {call.args['walls_separate']!r}")
     return out
 

@@ -40,6 +40,13 @@ ON_STATES = ("on", "lit")
 FLAG_VALUES = ("true", "false")
 
 
+def parse_flag(raw: object) -> bool | None:
+    """A yes/no argument's value: True for 'true', False for 'false' (any case, spaces ignored), None
+    for anything else. One reading for the predicate and for the knowledge base's class check."""
+    value = str(raw).strip().lower()
+    return value == "true" if value in FLAG_VALUES else None
+
+
 class PredicateError(ValueError):
     """A call that cannot be evaluated: unknown predicate, missing argument, unbound variable."""
 
@@ -90,10 +97,10 @@ class _Ctx:
 
     def flag(self, call: PredicateCall, arg: str) -> bool:
         """An optional yes/no argument: absent or 'false' is False, 'true' is True, anything else an error."""
-        value = str(call.args.get(arg, "false")).strip().lower()
-        if value not in FLAG_VALUES:
+        value = parse_flag(call.args.get(arg, "false"))
+        if value is None:
             raise PredicateError(f"{call.name}: argument '{arg}' must be 'true' or 'false', got {call.args[arg]!r}")
-        return value == "true"
+        return value
 
     def relations(self, subject: str, predicate: str) -> list[str | None]:
         return [r.object for r in self.graph.relations if r.subject == subject and r.predicate == predicate]
