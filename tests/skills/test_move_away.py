@@ -33,13 +33,11 @@ def test_a_laptop_is_not_set_down_on_a_basket_for_want_of_a_clear_spot(tmp_path)
     the one table holds a 0.45 m basket in its middle, leaving no clear spot a 0.45 m laptop fits.
     The spot rated best lay over the basket, so the laptop ended on it, at its edge: a new hazard
     (move_fragile_from_edge) while the skill's own check passed. A spot on something else is no spot."""
-    from anomalygen.config import Settings
     from anomalygen.skills.scripted import relocate
     from support.built_task import episode_on_built_task
 
     fixture = Path(__file__).parent / "fixtures" / "laptop_by_sink_basket_table.json"
-    build = {"hazard_free": 0, "multi_hazard": 0, "near_misses": 0}  # bench_primitives.py's settings
-    ep = episode_on_built_task(fixture, tmp_path / "scene", Settings(build=build))
+    ep = episode_on_built_task(fixture, tmp_path / "scene", primitives=True)
     before = ep.driver.aabb("laptop_0")
     res = relocate.move_away(ep, "laptop_0", "sink_0", 0.6)
     assert not res.success and "clear of what stands on it" in res.detail, res.detail

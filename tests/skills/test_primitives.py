@@ -41,13 +41,11 @@ def test_after_pulling_a_floor_safe_open_the_arm_reaches_a_lighter_on_a_table(tm
     came down beside the lighter, "suction did not catch" in 3 of 3 runs. A low cup is tucked in first."""
     from pathlib import Path
 
-    from anomalygen.config import Settings
     from anomalygen.skills.scripted import access, primitives
     from support.built_task import episode_on_built_task
 
     fixture = Path(__file__).parent / "fixtures" / "lighter_table_after_safe.json"
-    build = {"hazard_free": 0, "multi_hazard": 0, "near_misses": 0}  # bench_primitives.py's settings
-    ep = episode_on_built_task(fixture, tmp_path / "scene", Settings(build=build))
+    ep = episode_on_built_task(fixture, tmp_path / "scene", primitives=True)
     for _ in range(2):  # the executor's two attempts at the door, as in the failing runs
         access.open_for_access(ep, "safe_0", ["door"])
     assert ep.driver.site[2] < 0.6  # the situation this test is about: the cup low after the door
@@ -63,13 +61,11 @@ def test_a_cord_in_a_bathtub_is_taken_out_by_a_point_the_arm_reaches(tmp_path):
     reach over the rim. A point with no base pose is now passed over."""
     from pathlib import Path
 
-    from anomalygen.config import Settings
     from anomalygen.skills.scripted import transfer
     from support.built_task import episode_on_built_task
 
     fixture = Path(__file__).parent / "fixtures" / "cord_in_bathtub.json"
-    build = {"hazard_free": 0, "multi_hazard": 0, "near_misses": 0}  # bench_primitives.py's settings
-    ep = episode_on_built_task(fixture, tmp_path / "scene", Settings(build=build))
+    ep = episode_on_built_task(fixture, tmp_path / "scene", primitives=True)
     res = transfer.take_out_of(ep, "extension_cord_0", "bathtub_0")
     assert res.success and ep.driver.held == "extension_cord_0", res.detail
     assert ep.driver.aabb("extension_cord_0")[0][2] > ep.driver.aabb("bathtub_0")[1][2]  # above the rim

@@ -30,22 +30,17 @@ def test_a_towel_as_wide_as_one_door_goes_in_lengthwise_and_the_door_shuts(tmp_p
     assert all(abs(j.value - j.closed_value) < 0.05 for j in cabinet.joints if j.label == "door")
 
 
-#: bench_primitives.py's build settings: one hazard, no second hazard, near-miss or hazard-free draw
-PRIMITIVES_BUILD = {"hazard_free": 0, "multi_hazard": 0, "near_misses": 0}
-
-
 @pytest.mark.slow
 def test_a_door_swung_onto_its_stop_is_brought_back_by_its_inner_face_and_shut(tmp_path):
     """The seed-0 primitives run's t0106 at 8b4be29, built verbatim: a safe beside a table. The arm
     coming round to close the safe's door sweeps it from 1.4 to 1.9 rad, onto its stop, where its outer
     face looks at the table. Every close attempt went for that face and missed it: 3 of 3 runs left
     the safe open. A face the cup missed is now tried after the other one."""
-    from anomalygen.config import Settings
     from anomalygen.skills.scripted import access, primitives
     from support.built_task import episode_on_built_task
 
     fixture = Path(__file__).parent / "fixtures" / "powerstrip_safe_by_table.json"
-    ep = episode_on_built_task(fixture, tmp_path / "scene", Settings(build=PRIMITIVES_BUILD))
+    ep = episode_on_built_task(fixture, tmp_path / "scene", primitives=True)
     drv = ep.driver
     assert access.open_for_access(ep, "safe_0", ["door"]).success
     assert primitives.grasp(ep, "powerstrip_0").success

@@ -5,10 +5,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+#: bench_primitives.py's build settings: one hazard, no second hazard, near-miss or hazard-free draw
+PRIMITIVES_BUILD = {"hazard_free": 0, "multi_hazard": 0, "near_misses": 0}
 
-def episode_on_built_task(fixture: Path, out: Path, settings=None):
+
+def episode_on_built_task(fixture: Path, out: Path, *, primitives: bool = False):
     """Build the task in ``fixture`` (a TaskProposal JSON) at seed 0 with the default settings, as the
-    loop does (or ``settings``: the primitives benchmark turns the judgement mix off), into ``out``,
+    loop does (``primitives``: as the primitives benchmark does, the judgement mix off), into ``out``,
     and return an Episode on its perceived scene with an empty plan."""
     from anomalygen.config import Settings
     from anomalygen.perception import load_perceived_scene
@@ -18,7 +21,8 @@ def episode_on_built_task(fixture: Path, out: Path, settings=None):
     from anomalygen.skills.episode import Episode, EpisodeBudget, LearningSettings
 
     task = TaskProposal.model_validate_json(fixture.read_text())
-    build_scene(task, seed=0, settings=settings or Settings(), out_dir=out)
+    settings = Settings(build=PRIMITIVES_BUILD) if primitives else Settings()
+    build_scene(task, seed=0, settings=settings, out_dir=out)
     model, data, perceived = load_perceived_scene(out)
     plan = Plan(task_id=task.id, source="detected", engine="knowledge", subtasks=[], success={"predicates": []})
     return Episode(model, data, perceived, seed=0, rng=item_rng(0, task.id), plan=plan, budget=EpisodeBudget(),
