@@ -91,7 +91,7 @@ def bench_env(scene_dir: Path, steps: int, frameskip: int = 2, blocks: int = 9) 
     import mujoco
     import numpy as np
 
-    from anomalygen.scene.env import make_env
+    from anomalygen.world.env import make_env
 
     env = make_env(scene_dir, frameskip=frameskip, horizon=10**9)  # the bare env: its own step cost
     rng = np.random.default_rng(0)

@@ -36,8 +36,8 @@ def ms_per_frame(model, data, render, frames: int) -> float:
 def main() -> None:
     import mujoco
 
-    from anomalygen.perception import load_perceived_scene
     from anomalygen.skills.video import VideoRecorder
+    from anomalygen.world.perception import load_perceived_scene
 
     ap = argparse.ArgumentParser()
     ap.add_argument("--run", type=Path, default=None)

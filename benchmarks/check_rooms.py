@@ -25,10 +25,11 @@ HEIGHT_TOL = 0.03  # m
 
 
 def check_scene(folder: Path, width: int, height: int) -> list[str]:
+    from anomalygen.mjgeom import FLOOR_GEOM
     from anomalygen.scene import viewpoint, walls
     from anomalygen.scene.build import at_fault
-    from anomalygen.scene.graph import FLOOR_GEOM, load_scene
-    from anomalygen.scene.render import SceneRenderer
+    from anomalygen.world.graph import load_scene
+    from anomalygen.world.render import SceneRenderer
 
     model, data, spec = load_scene(folder)
     problems = []

@@ -53,13 +53,13 @@ def _free_pose(drv, cup, axis, mouth_base, lateral, rng, restarts: int) -> bool:
 def main() -> None:
     import mujoco
 
-    from anomalygen.perception import perceived_spec
     from anomalygen.rng import item_rng
     from anomalygen.robot.agent import Agent
-    from anomalygen.scene.graph import load_scene
     from anomalygen.schema import Plan
     from anomalygen.skills.catalogue import skill_for
     from anomalygen.skills.episode import Episode
+    from anomalygen.world.graph import load_scene
+    from anomalygen.world.perception import perceived_spec
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--run", required=True)

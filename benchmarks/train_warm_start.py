@@ -51,15 +51,15 @@ def starts_of(run: Path, log=lambda m: print(m, file=sys.stderr)) -> list:
     import mujoco
     import numpy as np
 
-    from anomalygen.perception import perceived_spec
     from anomalygen.plan.planner import plan_from_kb
     from anomalygen.runfolder import read_model
-    from anomalygen.scene.graph import load_scene
     from anomalygen.schema import SceneSpec
     from anomalygen.skills.episode import Episode
     from anomalygen.skills.learned.part_env import PartStart
     from anomalygen.skills.learned.part_skill import grasp_part
     from anomalygen.skills.learned.part_subtask import far_value
+    from anomalygen.world.graph import load_scene
+    from anomalygen.world.perception import perceived_spec
 
     tasks = {json.loads(x)["id"]: json.loads(x) for x in (run / "tasks.jsonl").read_text().splitlines() if x.strip()}
     out = []

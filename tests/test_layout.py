@@ -1,8 +1,9 @@
 """The package layout's rules: imports form no cycles, counting imports inside functions and
 type-checking-only imports too; no module is longer than MAX_LINES, except catalogues of generators;
-and the robot's side reaches neither the referee nor the builder's internals, not even through a
-shared module; the robot's element names and controllers live in ``robot/`` only; the old homes of
-the skills are gone."""
+no package imports one on its own floor or above (``FLOORS``); the robot's side reaches neither the
+builder, the answer key nor the referee, not even through a shared module; the robot's element names
+and controllers live in ``robot/`` only; the old homes of the skills are gone; the scene folder's file
+names are spelled in one module."""
 
 import ast
 from pathlib import Path
@@ -13,22 +14,27 @@ ROOT = Path(anomalygen.__file__).parent
 MAX_LINES = 500
 # one generator function per vocabulary name: long, but a list, not a tangle
 CATALOGUES = {"assets/generators/household.py", "assets/generators/furniture.py"}
-# The robot's side: it perceives the scene (scene graph, renders, simulator state, the spec without the
-# answer key) and acts on it.
+# Packages from the bottom floor up. A module may import its own package and any package on a lower
+# floor, never one on its own floor or above: the packages of one floor know nothing of each other.
+FLOORS = (
+    ("version", "errors", "rng", "tables", "procs", "embedding", "scene_files", "mjgeom", "schema"),
+    ("config", "knowledge", "robot"),
+    ("llm", "runfolder"),
+    ("assets", "runner", "truth"),  # truth: the answer key, which the builder writes and the referee reads
+    ("world",),  # what a built scene is, as the robot perceives it
+    ("scene", "skills", "detect", "plan", "referee"),  # the builder, the robot's side, the referee: apart
+    ("learn", "evaluate"),
+    ("brainstorm",),
+    ("stages",),  # the stage table
+    ("pipeline",),
+    ("cli", ""),  # "": the package's own __init__ (make_env)
+)
+# The robot's side: it perceives the scene through the world package and acts on it.
 ROBOT_SIDE = ("anomalygen.detect", "anomalygen.plan", "anomalygen.learn", "anomalygen.robot", "anomalygen.skills")
-# The doors through which it (and a researcher's own policy) reads a built scene: held to the same rule.
-ROBOT_READS = ("anomalygen.perception", "anomalygen.scene.env")
-# What the robot's side may not reach: the referee (truth manifests, matching, scoring, judging), the
-# evaluation and report built on it, the task generator (task words), and the builder's internals
-# (what it chose, why, and how it checked it). The builder's shared products stay allowed: the scene
-# graph, the env, the robot, the room layout and furniture it composes, renders, sensors, saved states.
-FORBIDDEN = ("anomalygen.referee", "anomalygen.evaluate", "anomalygen.brainstorm",
-             "anomalygen.scene.build", "anomalygen.scene.stage", "anomalygen.scene.casting",
-             "anomalygen.scene.asset_choice", "anomalygen.scene.placement", "anomalygen.scene.instances",
-             "anomalygen.scene.judgement", "anomalygen.scene.mix", "anomalygen.scene.llm_engine",
-             "anomalygen.scene.hints", "anomalygen.scene.validate", "anomalygen.scene.verify",
-             "anomalygen.scene.set_states")
-
+# What it may not reach, directly or through any module in between: the builder, the answer key, the
+# referee, and what is built on them (the evaluation and report, the task generator and its words).
+FORBIDDEN = ("anomalygen.scene", "anomalygen.truth", "anomalygen.referee", "anomalygen.evaluate",
+             "anomalygen.brainstorm")
 
 def _module_graph() -> dict[str, set[str]]:
     mods = {}
@@ -137,23 +143,60 @@ def _forbidden_paths(edges: dict[str, set[str]], sources: tuple[str, ...], forbi
     return found
 
 
-def test_the_robot_side_reaches_neither_the_referee_nor_the_builders_internals():
+def _package(module: str) -> str:
+    """The top-level package (or module) of ``anomalygen`` a module belongs to ("" for the root)."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else ""
+
+
+def _floor_of() -> dict[str, int]:
+    return {pkg: i for i, floor in enumerate(FLOORS) for pkg in floor}
+
+
+def _upward_imports(edges: dict[str, set[str]]) -> list[str]:
+    floor = _floor_of()
+    bad = []
+    for src, targets in sorted(edges.items()):
+        for dst in sorted(targets):
+            a, b = _package(src), _package(dst)
+            if a != b and dst != "anomalygen" and floor[b] >= floor[a]:
+                bad.append(f"{src} -> {dst} (floor {floor[a]} imports floor {floor[b]})")
+    return bad
+
+
+def test_every_package_has_a_floor():
+    assert {_package(m) for m in _module_graph()} == set(_floor_of())
+
+
+def test_no_package_imports_one_on_its_own_floor_or_above():
+    assert _upward_imports(_module_graph()) == []
+
+
+def test_the_floor_check_sees_an_upward_import_and_one_between_neighbours():
+    edges = {"anomalygen.world.graph": {"anomalygen.scene.build"}, "anomalygen.skills.x": {"anomalygen.referee.y"},
+             "anomalygen.scene.build": {"anomalygen.world.graph"}, "anomalygen.referee.y": set()}
+    assert _upward_imports(edges) == [
+        "anomalygen.skills.x -> anomalygen.referee.y (floor 5 imports floor 5)",
+        "anomalygen.world.graph -> anomalygen.scene.build (floor 4 imports floor 5)"]
+
+
+def test_the_robot_side_reaches_neither_the_builder_nor_the_answer_key_nor_the_referee():
     edges = _module_graph()
     robot = [m for m in edges if _under(m, ROBOT_SIDE)]
     assert "anomalygen.learn.stage" in robot and "anomalygen.detect.stage" in robot
-    # the answer-key side is real and reaches what it must: the builder writes truth.json through the referee
-    assert _forbidden_paths(edges, ("anomalygen.scene.build",), ("anomalygen.referee",))
-    assert "anomalygen.perception" in edges and "anomalygen.scene.env" in edges
-    paths = _forbidden_paths(edges, ROBOT_SIDE + ROBOT_READS, FORBIDDEN)
+    # the answer-key side is real and reaches what it must: the builder writes truth.json, the referee reads it
+    assert _forbidden_paths(edges, ("anomalygen.scene.build",), ("anomalygen.truth",))
+    assert _forbidden_paths(edges, ("anomalygen.referee.stage",), ("anomalygen.truth",))
+    paths = _forbidden_paths(edges, ROBOT_SIDE + ("anomalygen.world",), FORBIDDEN)
     assert paths == [], "robot side reaches the answer key: " + "; ".join(" -> ".join(p) for p in paths)
 
 
 def test_the_reach_check_follows_imports_through_shared_modules():
-    edges = {"anomalygen.plan.x": {"anomalygen.shared"}, "anomalygen.shared": {"anomalygen.referee.truth"},
-             "anomalygen.referee.truth": set(), "anomalygen.detect.y": {"anomalygen.scene.graph"},
-             "anomalygen.scene.graph": set()}
+    edges = {"anomalygen.plan.x": {"anomalygen.shared"}, "anomalygen.shared": {"anomalygen.truth.manifest"},
+             "anomalygen.truth.manifest": set(), "anomalygen.detect.y": {"anomalygen.world.graph"},
+             "anomalygen.world.graph": set()}
     assert _forbidden_paths(edges, ROBOT_SIDE, FORBIDDEN) == [
-        ["anomalygen.plan.x", "anomalygen.shared", "anomalygen.referee.truth"]]
+        ["anomalygen.plan.x", "anomalygen.shared", "anomalygen.truth.manifest"]]
 def _string_constants(tree: ast.AST) -> list[str]:
     """Every string literal of a module, f-string pieces included."""
     return [n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)]
@@ -195,3 +238,20 @@ def test_skills_have_one_home():
     layer in ``robot/``."""
     assert not (ROOT / "control").exists() and not (ROOT / "rl").exists()
     assert (ROOT / "robot" / "agent.py").is_file() and (ROOT / "skills" / "registry.py").is_file()
+
+
+def test_the_scene_folders_file_names_are_spelled_in_one_module():
+    """``scene_files`` owns every name of a scene's and a run's files: no other module spells one."""
+    from anomalygen import scene_files
+
+    names = {v for k, v in vars(scene_files).items() if k.isupper() and isinstance(v, str)}
+    assert {"scene.json", "scene_graph.json", "truth.json", "verdict.json", "final_state.npz"} <= names
+    spelled = {}
+    for path in ROOT.rglob("*.py"):
+        rel = path.relative_to(ROOT).as_posix()
+        if rel == "scene_files.py":
+            continue
+        hits = {c for c in _string_constants(ast.parse(path.read_text())) if c in names}
+        if hits:
+            spelled[rel] = sorted(hits)
+    assert spelled == {}

@@ -98,9 +98,9 @@ def test_the_scan_catches_a_literal_copy(tmp_path, monkeypatch):
 
 def test_every_closure_the_planner_and_skills_use_is_enclosing_in_the_table_and_the_graph():
     from anomalygen.plan import planner
-    from anomalygen.scene.graph import cavity_closers
     from anomalygen.schema import shut_by
     from anomalygen.skills.scripted import access, joints
+    from anomalygen.world.graph import cavity_closers
 
     used = {*planner.CLOSURES, *planner.LID_PARTS.split("|"), *access.CLOSURES_ALL, *access.LIDS,
             *joints.ACCESS_LABELS}

@@ -164,7 +164,7 @@ def test_doors_close_their_cavities(built):
 
 
 def test_cavities_stay_with_the_carcass_when_a_door_slides_across_them(built):
-    from anomalygen.scene.cavities import placed_cavities
+    from anomalygen.world.cavities import placed_cavities
 
     for key in ("franka_kitchen/slide_cabinet", "franka_kitchen/hinge_cabinet", "franka_kitchen/microwave"):
         a = built[key]

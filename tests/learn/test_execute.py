@@ -22,7 +22,7 @@ def built(tmp_path_factory):
 
 
 def _joint(scene_dir, name):
-    from anomalygen.scene.graph import load_scene
+    from anomalygen.world.graph import load_scene
 
     m, d, _ = load_scene(scene_dir)
     return float(d.joint(name).qpos[0])
@@ -54,7 +54,7 @@ def test_fridge_door_gets_closed(built, tmp_path):
 @pytest.mark.slow
 def test_litter_is_picked_off_the_floor_into_the_bucket(built):
     from anomalygen.learn.execute import execute_plan
-    from anomalygen.scene.graph import load_scene
+    from anomalygen.world.graph import load_scene
 
     scene_dir, spec, plan = built["litter"]
     hazard = spec.bindings["$hazard"]

@@ -107,8 +107,8 @@ def test_a_lighter_locked_in_a_safe_is_judged_resolved_by_the_referee(built, tmp
 
     from anomalygen.learn.execute import execute_plan
     from anomalygen.referee import judge
-    from anomalygen.scene.graph import load_scene
-    from anomalygen.scene.state import restore_state
+    from anomalygen.world.graph import load_scene
+    from anomalygen.world.state import restore_state
 
     scene_dir, spec, plan = built["lighter"]
     container = spec.bindings["$container"]

@@ -46,8 +46,8 @@ def test_two_hazards_are_both_found_planned_and_judged(tmp_path):
     from anomalygen.knowledge import load_kb
     from anomalygen.referee import load_verdict
     from anomalygen.referee.stage import run_stage as judge
-    from anomalygen.referee.truth import class_matches
     from anomalygen.schema import SceneGraph
+    from anomalygen.truth.manifest import class_matches
 
     assert judge(run, settings).done == 1
     verdict = load_verdict(run, "m", 0)

@@ -33,7 +33,7 @@ def built(tmp_path_factory):
 
 
 def _initial(scene_dir) -> SceneGraph:
-    from anomalygen.scene.graph import load_scene, scene_graph
+    from anomalygen.world.graph import load_scene, scene_graph
 
     m, d, spec = load_scene(scene_dir)
     return scene_graph(m, d, spec)

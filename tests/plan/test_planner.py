@@ -124,9 +124,9 @@ def test_detected_plans_fix_every_hazard_most_severe_first_with_roles_chosen_fro
 
 
 def test_the_perceived_spec_carries_no_answer_key(tmp_path):
-    from anomalygen.perception import load_perceived_spec
     from anomalygen.runfolder import RunFolder
     from anomalygen.schema import ObjectRole
+    from anomalygen.world.perception import load_perceived_spec
 
     run = RunFolder.create(tmp_path / "r")
     spec = _scene_with_a_drawer_and_two_sharp_things(run, "a")
@@ -139,9 +139,9 @@ def test_the_perceived_spec_carries_no_answer_key(tmp_path):
 def test_a_fix_with_no_container_in_the_scene_fails_with_the_reason(tmp_path):
     from anomalygen.errors import ItemFailed
     from anomalygen.knowledge import load_kb
-    from anomalygen.perception import load_scene_graph
     from anomalygen.plan.bind import bind_fix
     from anomalygen.runfolder import RunFolder
+    from anomalygen.world.perception import load_scene_graph
 
     run = RunFolder.create(tmp_path / "r")
     _scene_with_a_drawer_and_two_sharp_things(run, "a")

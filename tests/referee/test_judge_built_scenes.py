@@ -14,7 +14,7 @@ from tests.scene.conftest import make_task
 
 from anomalygen.config import Settings
 from anomalygen.referee import judge
-from anomalygen.scene.graph import held_objects, load_scene, scene_graph
+from anomalygen.world.graph import held_objects, load_scene, scene_graph
 from support.moves import cavity_center, hold, put
 
 KNIFE = "kitchen_knife_0"
@@ -160,8 +160,9 @@ def test_the_judge_stage_writes_a_verdict_per_run_from_its_saved_final_state(sce
     from anomalygen.cli import main
     from anomalygen.referee import load_verdict
     from anomalygen.runfolder import RunFolder, write_jsonl, write_model
-    from anomalygen.scene.state import FINAL_STATE, save_state
+    from anomalygen.scene_files import FINAL_STATE
     from anomalygen.schema import SkillResult
+    from anomalygen.world.state import save_state
 
     run = RunFolder.create(tmp_path / "run")
     task = make_task("t-knife-store", "store_sharp_objects", "Table", "kitchen_knife", "counter_edge")

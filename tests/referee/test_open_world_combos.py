@@ -134,10 +134,10 @@ def test_a_stored_childs_hazard_goes_where_a_child_cannot_open(tasks, scenes, tm
 def _built_detected_and_resolved(task, scene_dir, tmp_path, hazard_class, category, stored_in=None):
     from anomalygen.detect.stage import detect_scene
     from anomalygen.learn.execute import execute_plan
-    from anomalygen.perception import load_scene_graph
     from anomalygen.referee import judge, load_manifest
-    from anomalygen.scene.graph import load_scene, scene_graph
-    from anomalygen.scene.state import restore_state
+    from anomalygen.world.graph import load_scene, scene_graph
+    from anomalygen.world.perception import load_scene_graph
+    from anomalygen.world.state import restore_state
 
     # the referee's truth: the composed class on the object the line is about
     truth = load_manifest(scene_dir)

@@ -79,8 +79,8 @@ def test_the_truth_lists_every_other_class_that_fires_on_the_object_at_fault():
     from tests.knowledge.test_mechanisms import NEAR, crib
 
     from anomalygen.knowledge import load_kb
-    from anomalygen.referee.truth import hazard_manifest
     from anomalygen.schema import SceneSpec
+    from anomalygen.truth.manifest import hazard_manifest
 
     g = graph(obj("pod_0", "detergent_pod", at="floor", xy=NEAR), crib())
     spec = SceneSpec.model_construct(scene_id="s", task_id="t", bindings={"$hazard": "pod_0", "$crib": "crib_0"})

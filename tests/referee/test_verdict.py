@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from anomalygen.referee.truth import bound_success, class_matches
 from anomalygen.referee.verdict import verdict_on
 from anomalygen.schema import HazardManifest, ManifestHazard, NearMiss, Relation, SceneGraph
+from anomalygen.truth.manifest import bound_success, class_matches
 from detect import detect_graphs as g  # tests/detect/detect_graphs.py: the hand-built scene graphs
 
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 from anomalygen.assets.core import generate
 from anomalygen.knowledge import load_kb
 from anomalygen.scene.asset_choice import wanted_states
-from anomalygen.scene.states import why_cannot_show
 from anomalygen.schema import ObjectRole, TaskProposal
+from anomalygen.world.states import why_cannot_show
 
 
 def test_only_assets_that_can_show_a_state_pass():

@@ -11,8 +11,8 @@ import pytest
 from anomalygen.knowledge import load_kb
 from anomalygen.knowledge.predicates import evaluate
 from anomalygen.runfolder import read_model
-from anomalygen.scene.graph import load_scene, scene_graph
 from anomalygen.schema import SceneGraph, SceneSpec
+from anomalygen.world.graph import load_scene, scene_graph
 
 from .conftest import TASKS
 

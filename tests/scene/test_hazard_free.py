@@ -30,7 +30,7 @@ def test_a_hazard_free_fridge_scene_has_its_door_shut_and_an_empty_answer_key(tm
 
 def test_a_hazard_free_pill_scene_shuts_the_pills_away(tmp_path):
     from anomalygen.knowledge import load_kb
-    from anomalygen.referee.truth import class_matches
+    from anomalygen.truth.manifest import class_matches
 
     spec, graph, truth = _build("floor", tmp_path)  # a button battery, normally on the floor
     battery = next(o for o in graph.objects if o.category == "button_battery")

@@ -8,15 +8,16 @@ import math
 import numpy as np
 
 from anomalygen.config import Settings
+from anomalygen.mjgeom import FLOOR_GEOM
 from anomalygen.rng import item_rng
 from anomalygen.robot.agent import Agent
 from anomalygen.runfolder import read_model
 from anomalygen.scene import build
-from anomalygen.scene.graph import FLOOR_GEOM, load_scene
 from anomalygen.scene.instances import renumber_by_position
 from anomalygen.scene.layout import DOCK_YAW, Layout, Placed
-from anomalygen.scene.sensors import sensor_items
 from anomalygen.schema import ObjectRole, SceneSpec
+from anomalygen.world.graph import load_scene
+from anomalygen.world.sensors import sensor_items
 
 from .conftest import TASKS
 

@@ -13,9 +13,9 @@ import pytest
 from anomalygen.config import Settings
 from anomalygen.errors import ItemFailed
 from anomalygen.runfolder import read_model
-from anomalygen.scene.graph import load_scene, scene_graph
-from anomalygen.scene.states import GLOW_ALPHA, WATER_ALPHA, refresh_glows
 from anomalygen.schema import SceneSpec
+from anomalygen.world.graph import load_scene, scene_graph
+from anomalygen.world.states import GLOW_ALPHA, WATER_ALPHA, refresh_glows
 from support.kb_scenes import state_task as _task
 
 TASKS = {

@@ -32,7 +32,7 @@ def _wall_geoms(model) -> np.ndarray:
 
 
 def _mounted(folder, category):
-    from anomalygen.scene.graph import load_scene
+    from anomalygen.world.graph import load_scene
 
     model, data, spec = load_scene(folder)
     obj = next(o for o in spec.objects if o.asset.category == category)
@@ -60,8 +60,8 @@ def test_windows_and_doors_are_mounted_in_a_wall_at_their_height(room_scenes, ke
 
 
 def test_walls_are_structure_not_items(room_scenes):
-    from anomalygen.perception import load_scene_graph
-    from anomalygen.scene.layout import ROOM_CENTER, ROOM_HALF
+    from anomalygen.world.perception import load_scene_graph
+    from anomalygen.world.room import ROOM_CENTER, ROOM_HALF
 
     # the walls stand where the floor area ended before there were walls: every layout still fits
     assert np.allclose([walls.WALL_X, walls.WALL_Y], ROOM_CENTER + ROOM_HALF + 0.3)
@@ -72,8 +72,9 @@ def test_walls_are_structure_not_items(room_scenes):
 
 
 def test_walls_fill_the_background_behind_the_objects(room_scenes, built_scenes, scene_settings):
-    from anomalygen.scene.graph import FLOOR_GEOM, load_scene
-    from anomalygen.scene.render import SceneRenderer
+    from anomalygen.mjgeom import FLOOR_GEOM
+    from anomalygen.world.graph import load_scene
+    from anomalygen.world.render import SceneRenderer
 
     b = scene_settings.build
     for key, folder in {**room_scenes, **built_scenes}.items():
@@ -90,9 +91,9 @@ def test_walls_fill_the_background_behind_the_objects(room_scenes, built_scenes,
 def test_object_at_fault_is_not_covered_by_the_arm(room_scenes, built_scenes, scene_settings):
     from anomalygen.runfolder import read_model
     from anomalygen.scene.build import at_fault
-    from anomalygen.scene.graph import load_scene
-    from anomalygen.scene.render import SceneRenderer
     from anomalygen.schema import SceneSpec
+    from anomalygen.world.graph import load_scene
+    from anomalygen.world.render import SceneRenderer
 
     b = scene_settings.build
     for key, folder in {**room_scenes, **built_scenes}.items():
@@ -110,8 +111,8 @@ def test_front_view_moves_away_from_a_robot_in_the_way(built_scenes, scene_setti
     """A candidate view looking over the robot's shoulder at the fridge is passed over for the next one."""
     import mujoco
 
-    from anomalygen.scene.graph import load_scene
-    from anomalygen.scene.render import SceneRenderer
+    from anomalygen.world.graph import load_scene
+    from anomalygen.world.render import SceneRenderer
 
     folder = built_scenes["fridge"]
     model, data, spec = load_scene(folder)

@@ -29,8 +29,8 @@ def _judged(built, key, tmp_path):
     from anomalygen.learn.execute import execute_plan
     from anomalygen.referee import judge
     from anomalygen.referee.settle import settled_graph
-    from anomalygen.scene.graph import load_scene
-    from anomalygen.scene.state import restore_state
+    from anomalygen.world.graph import load_scene
+    from anomalygen.world.state import restore_state
 
     scene_dir, spec, plan = built[key]
     res = execute_plan(scene_dir, plan, seed=0, final_state_path=tmp_path / "final.npz")
@@ -47,7 +47,7 @@ def _support(graph: SceneGraph, obj: str) -> str | None:
 @pytest.mark.slow
 @pytest.mark.parametrize("key", ["table", "shelf"])
 def test_the_fragile_object_ends_back_from_every_edge_as_the_referee_measures(built, key, tmp_path):
-    from anomalygen.scene.graph import load_scene, scene_graph
+    from anomalygen.world.graph import load_scene, scene_graph
 
     scene_dir = built[key][0]
     obj, verdict, graph, res = _judged(built, key, tmp_path)
@@ -63,7 +63,7 @@ def test_the_fragile_object_ends_back_from_every_edge_as_the_referee_measures(bu
 
 @pytest.mark.slow
 def test_a_shelf_too_narrow_for_the_margin_sends_the_object_to_another_top(built, tmp_path):
-    from anomalygen.scene.graph import load_scene, scene_graph
+    from anomalygen.world.graph import load_scene, scene_graph
 
     scene_dir = built["shelf"][0]
     obj = built["shelf"][1].bindings["$hazard"]
@@ -78,11 +78,11 @@ def test_a_shelf_too_narrow_for_the_margin_sends_the_object_to_another_top(built
 def test_the_support_to_set_back_on_is_where_the_object_rests_now_not_where_the_spec_put_it(built):
     """A second edge step after the object moved (the loop's recheck of a laptop carried from the
     sink to a table) must work on the table it is on now; it used to read the spec's first support."""
-    from anomalygen.perception import load_perceived_scene
     from anomalygen.rng import item_rng
     from anomalygen.skills import geometry
     from anomalygen.skills.episode import Episode, EpisodeBudget, LearningSettings
     from anomalygen.skills.scripted import relocate
+    from anomalygen.world.perception import load_perceived_scene
 
     scene_dir, spec, plan = built["shelf"]
     obj = spec.bindings["$hazard"]
@@ -100,10 +100,10 @@ def test_the_support_to_set_back_on_is_where_the_object_rests_now_not_where_the_
 def test_an_object_on_no_top_is_set_back_on_the_nearest_safe_one(built):
     """A vase knocked to the floor (no support to re-centre on: the skill used to fail, "stands on no
     support") is set on the nearest safe top, back from its edges."""
-    from anomalygen.perception import load_perceived_scene
     from anomalygen.rng import item_rng
     from anomalygen.skills.episode import Episode, EpisodeBudget, LearningSettings
     from anomalygen.skills.scripted import relocate
+    from anomalygen.world.perception import load_perceived_scene
 
     scene_dir, spec, plan = built["table"]
     obj = spec.bindings["$hazard"]

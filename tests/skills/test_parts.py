@@ -45,8 +45,8 @@ def scenes(tmp_path_factory):
 
 
 def _episode(scenes, key, seed=0):
-    from anomalygen.scene.graph import load_scene
     from anomalygen.skills.episode import Episode
+    from anomalygen.world.graph import load_scene
 
     m, d, spec = load_scene(scenes[key][0])
     return Episode(m, d, spec, rng=np.random.default_rng(seed))

@@ -15,10 +15,10 @@ TASKS = {"spray": kb_task("t-spray-safe", "manage_chemical_risks", "Bottle", "cl
 
 @pytest.fixture(scope="module")
 def opened(tmp_path_factory):
-    from anomalygen.scene.graph import load_scene
     from anomalygen.schema import DOOR
     from anomalygen.skills.episode import Episode
     from anomalygen.skills.scripted.access import open_for_access
+    from anomalygen.world.graph import load_scene
 
     scene_dir, spec, _ = build_with_kb_plans(TASKS, tmp_path_factory.mktemp("safe_scene"), clutter=1)["spray"]
     m, d, spec = load_scene(scene_dir)

@@ -14,11 +14,11 @@ def episode_on_built_task(fixture: Path, out: Path, *, primitives: bool = False)
     loop does (``primitives``: as the primitives benchmark does, the judgement mix off), into ``out``,
     and return an Episode on its perceived scene with an empty plan."""
     from anomalygen.config import Settings
-    from anomalygen.perception import load_perceived_scene
     from anomalygen.rng import item_rng
     from anomalygen.scene.build import build_scene
     from anomalygen.schema import Plan, TaskProposal
     from anomalygen.skills.episode import Episode, EpisodeBudget, LearningSettings
+    from anomalygen.world.perception import load_perceived_scene
 
     task = TaskProposal.model_validate_json(fixture.read_text())
     settings = Settings(build=PRIMITIVES_BUILD) if primitives else Settings()

@@ -32,7 +32,7 @@ def hold(model, data, spec, name: str, below_cup: float = 0.08) -> int:
     The weld is the scene's own (one per loose object); returns its id."""
     import mujoco
 
-    from anomalygen.scene.graph import _index, _subtree_bodies
+    from anomalygen.world.graph import _index, _subtree_bodies
 
     idx = _index(model, spec)
     eq = int(idx.hold_eqs[list(idx.hold_owner).index(idx.names.index(name))])

@@ -29,7 +29,6 @@ import numpy as np
 
 from anomalygen.knowledge.predicates import aabb_gap
 from anomalygen.rng import item_rng
-from anomalygen.scene.graph import NEAR_DIST
 from anomalygen.schema import (
     CHILD_REACH,
     GraphObject,
@@ -38,6 +37,7 @@ from anomalygen.schema import (
     SceneGraph,
     within_child_reach,
 )
+from anomalygen.world.graph import NEAR_DIST
 
 if TYPE_CHECKING:
     from anomalygen.config import NoiseConfig, Settings

@@ -1,6 +1,6 @@
 """Stage 3 entry point: detect the hazards in every built scene and collate the detections.
 
-Per scene (one runner item): read ``scene_graph.json`` through ``anomalygen.perception`` (the only
+Per scene (one runner item): read ``scene_graph.json`` through ``anomalygen.world.perception`` (the only
 input a detector sees; with ``detect.noise`` on, a noisy copy of it, ``detect/noise.py``), run the
 configured detector and write ``detections/<task_id>.json`` (which records the noise it ran under). A detector failure (an LLM that never
 produced a valid reply) is recorded in that scene's ``Detection.error`` and counts as a miss; it
@@ -81,7 +81,7 @@ def detect_scene(task_id: str, graph: SceneGraph, settings: Settings, *, detecto
 
 
 def _item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str, Any]:
-    from anomalygen.perception import load_scene_graph
+    from anomalygen.world.perception import load_scene_graph
 
     run, settings = ctx.run, ctx.settings
     graph = load_scene_graph(run.scene_dir(task_id))
@@ -99,9 +99,9 @@ def _item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str,
 
 
 def _graph_path(run: RunFolder, task_id: str):
-    from anomalygen.perception import GRAPH_FILE
+    from anomalygen.scene_files import SCENE_GRAPH
 
-    return run.scene_dir(task_id) / GRAPH_FILE
+    return run.scene_dir(task_id) / SCENE_GRAPH
 
 
 def _is_done_for(run: RunFolder, settings: Settings):

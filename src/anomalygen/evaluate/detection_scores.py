@@ -12,8 +12,8 @@ from collections.abc import Mapping, Sequence
 
 from anomalygen.referee.ground_truth import GroundTruth, ground_truth, norm_name
 from anomalygen.referee.score import DetectionScores, claim_matches, score_detections
-from anomalygen.referee.truth import load_manifest
 from anomalygen.schema import Detection, HazardManifest, Hypothesis, ManifestHazard
+from anomalygen.truth.manifest import load_manifest
 
 __all__ = [
     "DetectionScores", "GroundTruth", "claims_on", "finds", "ground_truth", "load_manifest", "norm_name", "score",

@@ -38,6 +38,7 @@ from anomalygen.evaluate.scored_sections import (
 from anomalygen.evaluate.verdicts import STATUS_LABELS
 from anomalygen.runfolder import RunFolder, atomic_write_text, now_iso, write_model
 from anomalygen.runner import StageSummary
+from anomalygen.scene_files import VIDEO, render_file
 from anomalygen.schema import Artefact, StageRecord, Strict
 
 if TYPE_CHECKING:
@@ -88,7 +89,7 @@ def collect_gallery(run: RunFolder) -> list[GalleryItem]:
     items = []
     for tid in ids:
         t = by_id.get(tid)
-        render = run.scene_dir(tid) / "render_front.png"
+        render = run.scene_dir(tid) / render_file("front")
         videos = []
         for res in sorted(results.get(tid, []), key=lambda r: r.seed):
             if _find_video(run, tid, res.seed, res.video) is not None:
@@ -120,7 +121,7 @@ def _find_video(run: RunFolder, task_id: str, seed: int, declared: str | None = 
     """The skill's video: the declared path (relative to the seed folder or the run), else any mp4 there."""
     folder = run.skill_dir(task_id, seed)
     candidates = [folder / declared, run.root / declared] if declared else []
-    candidates += [folder / "video.mp4", *sorted(folder.glob("*.mp4"))]
+    candidates += [folder / VIDEO, *sorted(folder.glob("*.mp4"))]
     return next((p for p in candidates if p.is_file()), None)
 
 

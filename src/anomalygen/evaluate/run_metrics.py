@@ -12,6 +12,7 @@ from pathlib import Path
 from anomalygen.evaluate.results import Rate, SuccessSummary, VerdictCounts
 from anomalygen.evaluate.verdicts import RunVerdict, verdict_of
 from anomalygen.runfolder import RunFolder, read_jsonl, try_read_model
+from anomalygen.scene_files import RESULT, SCENE_SPEC, render_file
 from anomalygen.schema import Detection, SceneSpec, SkillResult, TaskProposal
 
 
@@ -104,18 +105,18 @@ def load_verdicts(run: RunFolder, results: Sequence[SkillResult]) -> dict[tuple[
 def load_skill_results(run: RunFolder) -> list[SkillResult]:
     if not run.skills_dir.is_dir():
         return []
-    paths = sorted(run.skills_dir.glob("*/seed*/result.json"))
+    paths = sorted(run.skills_dir.glob(f"*/seed*/{RESULT}"))
     return [r for p in paths if (r := try_read_model(p, SkillResult)) is not None]
 
 
 def built_scenes(run: RunFolder) -> list[SceneSpec]:
     if not run.scenes_dir.is_dir():
         return []
-    return [s for p in sorted(run.scenes_dir.glob("*/scene.json")) if (s := try_read_model(p, SceneSpec))]
+    return [s for p in sorted(run.scenes_dir.glob(f"*/{SCENE_SPEC}")) if (s := try_read_model(p, SceneSpec))]
 
 
 def scene_renders(run: RunFolder) -> list[Path]:
     """One front render per built scene (the paper embeds one image per scene)."""
     if not run.scenes_dir.is_dir():
         return []
-    return sorted(p for p in run.scenes_dir.glob("*/render_front.png") if p.is_file())
+    return sorted(p for p in run.scenes_dir.glob(f"*/{render_file('front')}") if p.is_file())

@@ -31,6 +31,7 @@ from pydantic import BaseModel, Field
 from anomalygen.evaluate.detection_report import TextJudgeDiagnostic
 from anomalygen.evaluate.detection_scores import GroundTruth
 from anomalygen.runfolder import RunFolder, try_read_model
+from anomalygen.scene_files import SCENE_GRAPH, SCENE_SPEC
 from anomalygen.schema import (
     Detection,
     HazardManifest,
@@ -215,8 +216,8 @@ def text_judge_diagnostic(run: RunFolder, detections: Sequence[Detection], tasks
         if d.detector not in judges:
             judges[d.detector] = make_judge(settings, d.detector)
         judge = judges[d.detector]
-        spec = try_read_model(run.scene_dir(d.task_id) / "scene.json", SceneSpec)
-        graph = try_read_model(run.scene_dir(d.task_id) / "scene_graph.json", SceneGraph)
+        spec = try_read_model(run.scene_dir(d.task_id) / SCENE_SPEC, SceneSpec)
+        graph = try_read_model(run.scene_dir(d.task_id) / SCENE_GRAPH, SceneGraph)
         hc = kb.hazard_classes.get(task.hazard_class)
         truth_of_task = ground_truth(task, spec, graph, hazard_variable=hc.hazard_variable if hc else None)
         judgements = judge.judge(d.hypotheses, truth_of_task, graph)

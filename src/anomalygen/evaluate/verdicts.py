@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Literal
 from pydantic import Field
 
 from anomalygen.runfolder import try_read_model
+from anomalygen.scene_files import RESULT
 from anomalygen.schema import FixOutcome, SkillResult, Strict
 
 if TYPE_CHECKING:
@@ -63,7 +64,7 @@ def verdict_of(run: RunFolder, task_id: str, seed: int) -> RunVerdict | None:
                    for h in verdict.hazards]
         return RunVerdict(status=verdict.status, resolved=verdict.resolved, hazards=hazards,
                           new_hazards=list(verdict.new_hazards), interventions_on_safe=list(verdict.interventions_on_safe))
-    result = try_read_model(run.skill_dir(task_id, seed) / "result.json", SkillResult)
+    result = try_read_model(run.skill_dir(task_id, seed) / RESULT, SkillResult)
     if result is None or result.outcome is None:
         return None
     return from_outcome(result.outcome)

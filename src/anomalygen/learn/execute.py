@@ -22,6 +22,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from anomalygen.schema import Plan, PredicateResult, SkillMethod, SkillResult, SubTask, SubTaskResult
+from anomalygen.world.perception import load_perceived_scene
+from anomalygen.world.state import save_state
 
 if TYPE_CHECKING:  # pragma: no cover
     from anomalygen.skills.episode import Episode
@@ -166,7 +168,6 @@ def run_subtasks(ep: Episode, plan: Plan, retries: int = 1) -> list[SubTaskResul
 def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: float | None, sac_steps: int,
                   retries: int = 1, reward_mode: str = "spec", final_graph_path=None, n_envs: int = 1,
                   recheck_fixes: int = 0, final_state_path=None) -> SkillResult:
-    from anomalygen.perception import load_perceived_scene
     from anomalygen.rng import item_rng
     from anomalygen.skills.episode import Episode, EpisodeBudget, LearningSettings
 
@@ -194,7 +195,6 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
 
         write_model(Path(final_graph_path), ep.graph())
     if final_state_path is not None:
-        from anomalygen.scene.state import save_state
 
         save_state(final_state_path, ep.model, ep.data)
     timings["execute_s"] = round(budget.elapsed() - timings["load_s"], 3)

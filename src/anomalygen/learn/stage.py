@@ -18,13 +18,13 @@ from typing import TYPE_CHECKING
 from anomalygen.errors import ItemFailed
 from anomalygen.runfolder import RunFolder, try_read_model, write_model
 from anomalygen.runner import StageContext, StageSummary, check_only, config_section, run_items
+from anomalygen.scene_files import FINAL_GRAPH, FINAL_STATE, RESULT, SCENE_GRAPH, SCENE_SPEC, SCENE_XML, VIDEO
 from anomalygen.schema import Plan, SkillResult
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
 
 STAGE = "learn"
-FINAL_GRAPH = "final_graph.json"  # the scene graph of the final state, as the robot perceives it
 
 
 def _item_id(task_id: str, seed: int) -> str:
@@ -38,7 +38,6 @@ def _split(item_id: str) -> tuple[str, int]:
 
 def learn_item(item_id: str, payload: dict, ctx: StageContext) -> dict:
     from anomalygen.learn.execute import execute_plan
-    from anomalygen.scene.state import FINAL_STATE
 
     run, settings = ctx.run, ctx.settings
     task_id, seed = _split(item_id)
@@ -46,7 +45,7 @@ def learn_item(item_id: str, payload: dict, ctx: StageContext) -> dict:
     if plan is None:
         raise ItemFailed(f"no valid plan for {task_id}")
     out = run.skill_dir(task_id, seed)
-    video = out / "video.mp4" if settings.learn.video else None
+    video = out / VIDEO if settings.learn.video else None
     final_graph = out / FINAL_GRAPH
     result = execute_plan(run.scene_dir(task_id), plan, seed=seed, video_path=video,
                           sac_steps=settings.learn.sac_steps, retries=settings.learn.retries,
@@ -54,15 +53,15 @@ def learn_item(item_id: str, payload: dict, ctx: StageContext) -> dict:
                           final_state_path=out / FINAL_STATE, n_envs=settings.learn.n_envs,
                           recheck_fixes=settings.plan.max_fixes if settings.learn.recheck else 0)
     if result.video:
-        result = result.model_copy(update={"video": "video.mp4"})
-    write_model(out / "result.json", result)
+        result = result.model_copy(update={"video": VIDEO})
+    write_model(out / RESULT, result)
     return {"success": result.success}
 
 
 def _inputs(run: RunFolder, task_id: str) -> list[Path]:
     """What an execution is made from: its plan and the built scene (a re-plan or rebuild redoes it)."""
     scene = run.scene_dir(task_id)
-    return [run.plan_path(task_id), scene / "scene.json", scene / "scene.xml", scene / "scene_graph.json"]
+    return [run.plan_path(task_id), scene / SCENE_SPEC, scene / SCENE_XML, scene / SCENE_GRAPH]
 
 
 def success_table(run: RunFolder, items: list[tuple[str, dict]], classes: dict[str, str]) -> dict[str, dict[str, float]]:
@@ -72,7 +71,7 @@ def success_table(run: RunFolder, items: list[tuple[str, dict]], classes: dict[s
     acc: dict[str, dict[str, int]] = defaultdict(lambda: dict.fromkeys(TABLE_COUNTS, 0))
     for item_id, _payload in items:
         task_id, seed = _split(item_id)
-        res = try_read_model(run.skill_dir(task_id, seed) / "result.json", SkillResult)
+        res = try_read_model(run.skill_dir(task_id, seed) / RESULT, SkillResult)
         row = acc[classes.get(task_id, "unknown")]
         row["n"] += 1
         row["success"] += int(bool(res is not None and res.success))
@@ -104,14 +103,14 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
     for t in tasks:
         if only and t.id not in only:
             continue
-        if not run.plan_path(t.id).is_file() or not (run.scene_dir(t.id) / "scene.json").is_file():
+        if not run.plan_path(t.id).is_file() or not (run.scene_dir(t.id) / SCENE_SPEC).is_file():
             continue
         for seed in range(settings.learn.seeds):
             items.append((_item_id(t.id, seed), {}))
 
     def done(item_id: str) -> bool:
         task_id, seed = _split(item_id)
-        return try_read_model(run.skill_dir(task_id, seed) / "result.json", SkillResult) is not None
+        return try_read_model(run.skill_dir(task_id, seed) / RESULT, SkillResult) is not None
 
     summary = run_items(run, STAGE, items, learn_item, settings=settings, is_done=done, force=force,
                         inputs=lambda item_id: _inputs(run, _split(item_id)[0]),

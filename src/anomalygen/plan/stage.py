@@ -4,7 +4,7 @@ With ``plan.source = detected`` (the default) the robot plans from what it perce
 hypothesis worth acting on (a known class, score at least ``plan.min_score``, one per object, most
 severe first, up to ``plan.max_fixes``) becomes a fix whose roles (container, support, ...) are
 chosen from the perceived scene graph (``plan.bind``); the scene spec it reads has the answer key
-removed (``anomalygen.perception``). A scene where nothing was detected gets an empty plan: acting
+removed (``anomalygen.world.perception``). A scene where nothing was detected gets an empty plan: acting
 there would be an unnecessary intervention. A wrong detection gives a wrong plan, as it should.
 
 With ``plan.source = ground_truth`` the task's class and the builder's bindings are used: the oracle
@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 from anomalygen.errors import ItemFailed, UserError
 from anomalygen.runfolder import RunFolder, read_jsonl, try_read_model, write_model
 from anomalygen.runner import StageContext, StageSummary, check_only, config_section, run_items
+from anomalygen.scene_files import SCENE_GRAPH, SCENE_SPEC
 from anomalygen.schema import Detection, DroppedFix, Plan, SceneSpec, SuccessSpec, TaskProposal
 
 if TYPE_CHECKING:
@@ -45,7 +46,7 @@ def _plan_from_oracle(task_id: str, payload: dict, ctx: StageContext) -> Plan:
     from anomalygen.plan.planner import plan_from_kb
 
     settings = ctx.settings
-    spec = try_read_model(ctx.run.scene_dir(task_id) / "scene.json", SceneSpec)
+    spec = try_read_model(ctx.run.scene_dir(task_id) / SCENE_SPEC, SceneSpec)
     bindings = dict(spec.bindings) if spec is not None else {}
     hazard_class = payload["hazard_class"]
     if spec is not None and not spec.bindings:  # a hazard-free scene: the oracle knows there is nothing to fix
@@ -60,9 +61,9 @@ def _plan_from_oracle(task_id: str, payload: dict, ctx: StageContext) -> Plan:
 def _plan_from_perception(task_id: str, payload: dict, ctx: StageContext) -> Plan:
     """Fix what was detected, most severe first, with every role chosen from the perceived scene."""
     from anomalygen.knowledge import load_kb
-    from anomalygen.perception import load_perceived_spec, load_scene_graph
     from anomalygen.plan.bind import bind_fix
     from anomalygen.plan.planner import merge_plans, plan_from_kb
+    from anomalygen.world.perception import load_perceived_spec, load_scene_graph
 
     settings = ctx.settings
     det = payload.get("detection")
@@ -177,5 +178,5 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
         return plan is not None and plan.source == settings.plan.source and plan.engine == engine
 
     return run_items(run, STAGE, items, plan_item, settings=settings, is_done=done, force=force, workers=1,
-                     inputs=lambda tid: [run.scene_dir(tid) / "scene.json", run.scene_dir(tid) / "scene_graph.json"],
+                     inputs=lambda tid: [run.scene_dir(tid) / SCENE_SPEC, run.scene_dir(tid) / SCENE_GRAPH],
                      config=config_section(settings, "learn", exclude=("seeds",), llm=engine.value == "llm"))

@@ -1,6 +1,6 @@
 """The referee: the answer key and the judgement, on the far side from the robot.
 
-The builder writes each scene's hidden ``truth.json`` through :mod:`anomalygen.referee.truth`; after
+The builder writes each scene's hidden ``truth.json`` through :mod:`anomalygen.truth.manifest`; after
 the robot's items have finished, the judge stage (:mod:`anomalygen.referee.stage`, ``anomalygen
 judge``) scores the detections and judges every run's settled final state. Nothing on the robot's
 side (detect, plan, learn, robot, skills) imports this package; ``tests/test_layout.py``
@@ -21,6 +21,6 @@ from __future__ import annotations
 
 from anomalygen.referee.settle import judge
 from anomalygen.referee.stage import load_verdict
-from anomalygen.referee.truth import TRUTH_FILE, load_manifest
+from anomalygen.truth.manifest import load_manifest
 
-__all__ = ["TRUTH_FILE", "judge", "load_manifest", "load_verdict"]
+__all__ = ["judge", "load_manifest", "load_verdict"]

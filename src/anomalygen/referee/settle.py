@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from anomalygen.scene_files import SCENE_SPEC
 from anomalygen.schema import SceneGraph, SceneSpec, Verdict
 
 SETTLE_S = 1.0  # s of simulated time after the release (a knife dropped from 1 m lands in 0.45 s)
@@ -26,7 +27,7 @@ def copy_state(model, data):
     """A copy of ``model`` and a fresh data for it holding ``data``'s full integration state."""
     import mujoco
 
-    from anomalygen.scene.state import get_state, set_state
+    from anomalygen.world.state import get_state, set_state
 
     m = copy.deepcopy(model)
     d = mujoco.MjData(m)
@@ -38,7 +39,7 @@ def released_and_settled(model, data, spec: SceneSpec) -> tuple[object, object, 
     """(model copy, settled data copy, objects that were held, simulated seconds) for ``data``."""
     import mujoco
 
-    from anomalygen.scene.graph import _index, held_objects, robot_constraints
+    from anomalygen.world.graph import _index, held_objects, robot_constraints
 
     m, d = copy_state(model, data)
     released = held_objects(m, d, spec)
@@ -65,7 +66,7 @@ def _fastest(model, data, spec: SceneSpec) -> float:
 
 def settled_graph(model, data, spec: SceneSpec) -> tuple[SceneGraph, list[str], float]:
     """The scene graph the referee judges: (graph of the released, settled copy, released objects, seconds)."""
-    from anomalygen.scene.graph import scene_graph
+    from anomalygen.world.graph import scene_graph
 
     m, d, released, settled = released_and_settled(model, data, spec)
     return scene_graph(m, d, spec), released, settled
@@ -75,7 +76,7 @@ def initial_graph(model, spec: SceneSpec) -> SceneGraph:
     """The scene graph of the settled scene as built (the model's ``init`` keyframe), by today's rules."""
     import mujoco
 
-    from anomalygen.scene.graph import reset_to_initial, scene_graph
+    from anomalygen.world.graph import reset_to_initial, scene_graph
 
     d = mujoco.MjData(model)
     reset_to_initial(model, d)
@@ -90,15 +91,15 @@ def judge(scene_dir: str | Path, model, data, *, task_id: str | None = None, see
     with the new hazards, the near-misses acted on and the objects that were still held.
     """
     from anomalygen.knowledge import load_kb
-    from anomalygen.referee.truth import load_manifest
     from anomalygen.referee.verdict import verdict_on
     from anomalygen.runfolder import read_model
+    from anomalygen.truth.manifest import load_manifest
 
     scene_dir = Path(scene_dir)
     manifest = load_manifest(scene_dir)
     if manifest is None:
         raise FileNotFoundError(f"no truth.json in {scene_dir}: a scene built before the truth existed cannot be judged")
-    spec = read_model(scene_dir / "scene.json", SceneSpec)
+    spec = read_model(scene_dir / SCENE_SPEC, SceneSpec)
     final, released, settled = settled_graph(model, data, spec)
     return verdict_on(manifest, initial_graph(model, spec), final, load_kb(),
                       task_id=task_id if task_id is not None else manifest.task_id, seed=seed,

@@ -19,21 +19,29 @@ from typing import TYPE_CHECKING, Any
 
 from anomalygen.runfolder import RunFolder, try_read_model, write_model
 from anomalygen.runner import StageContext, StageSummary, check_only, run_items
+from anomalygen.scene_files import (
+    FINAL_GRAPH,
+    FINAL_STATE,
+    JUDGED_GRAPH,
+    RESULT,
+    SCENE_GRAPH,
+    SCENE_SPEC,
+    SCENE_XML,
+    TRUTH,
+    VERDICT,
+)
 from anomalygen.schema import SceneGraph, SceneSpec, SkillResult, TaskProposal, Verdict
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
 
 STAGE = "judge"
-VERDICT_FILE = "verdict.json"
-JUDGED_GRAPH = "judged_graph.json"  # the released, settled final state's scene graph the verdict read
-FINAL_GRAPH = "final_graph.json"  # what an old run's learn item left instead of its final state
 TABLE_COUNTS = ("runs", "robot_done", "judged", "resolved", "hazard_free", "no_action_needed", "acted_on_safe",
                 "new_hazards", "on_safe")
 
 
 def verdict_path(run: RunFolder, task_id: str, seed: int) -> Path:
-    return run.skill_dir(task_id, seed) / VERDICT_FILE
+    return run.skill_dir(task_id, seed) / VERDICT
 
 
 def load_verdict(run: RunFolder | str | Path, task_id: str, seed: int) -> Verdict | None:
@@ -47,18 +55,17 @@ def _seeds(run: RunFolder, task_id: str) -> list[int]:
     root = run.skills_dir / task_id
     if not root.is_dir():
         return []
-    return sorted(int(p.parent.name.removeprefix("seed")) for p in root.glob("seed*/result.json")
+    return sorted(int(p.parent.name.removeprefix("seed")) for p in root.glob(f"seed*/{RESULT}")
                   if p.parent.name.removeprefix("seed").isdigit())
 
 
 def _inputs(run: RunFolder, task_id: str) -> list[Path]:
     """What a task's verdicts are made from: the scene, its truth, and every run's result and end state."""
-    from anomalygen.scene.state import FINAL_STATE
 
     scene = run.scene_dir(task_id)
     runs = [run.skill_dir(task_id, s) / name for s in _seeds(run, task_id)
-            for name in ("result.json", FINAL_STATE, FINAL_GRAPH)]
-    return [scene / "scene.json", scene / "scene.xml", scene / "truth.json", *runs]
+            for name in (RESULT, FINAL_STATE, FINAL_GRAPH)]
+    return [scene / SCENE_SPEC, scene / SCENE_XML, scene / TRUTH, *runs]
 
 
 def judge_run(run: RunFolder, task_id: str, seed: int, spec: SceneSpec, manifest, kb, scene=None) -> Verdict | None:
@@ -67,7 +74,7 @@ def judge_run(run: RunFolder, task_id: str, seed: int, spec: SceneSpec, manifest
     ``scene``: the (model, data) of the task's scene, loaded once per task and reused here."""
     from anomalygen.referee.settle import initial_graph, settled_graph
     from anomalygen.referee.verdict import verdict_on
-    from anomalygen.scene.state import FINAL_STATE, restore_state
+    from anomalygen.world.state import restore_state
 
     folder = run.skill_dir(task_id, seed)
     if (folder / FINAL_STATE).is_file():
@@ -77,7 +84,7 @@ def judge_run(run: RunFolder, task_id: str, seed: int, spec: SceneSpec, manifest
         write_model(folder / JUDGED_GRAPH, final)
         return verdict_on(manifest, initial_graph(model, spec), final, kb, task_id=task_id, seed=seed,
                           released=released, settle_s=settled)
-    initial = try_read_model(run.scene_dir(task_id) / "scene_graph.json", SceneGraph)
+    initial = try_read_model(run.scene_dir(task_id) / SCENE_GRAPH, SceneGraph)
     final = try_read_model(folder / FINAL_GRAPH, SceneGraph)
     if initial is None or final is None:
         return None
@@ -86,12 +93,12 @@ def judge_run(run: RunFolder, task_id: str, seed: int, spec: SceneSpec, manifest
 
 def judge_item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict[str, Any]:
     from anomalygen.knowledge import load_kb
-    from anomalygen.referee.truth import load_manifest
-    from anomalygen.scene.graph import load_scene
+    from anomalygen.truth.manifest import load_manifest
+    from anomalygen.world.graph import load_scene
 
     run = ctx.run
     scene_dir = run.scene_dir(task_id)
-    spec = try_read_model(scene_dir / "scene.json", SceneSpec)
+    spec = try_read_model(scene_dir / SCENE_SPEC, SceneSpec)
     manifest = load_manifest(scene_dir)
     seeds = _seeds(run, task_id)
     out: dict[str, Any] = {"verdicts": {}}
@@ -109,7 +116,7 @@ def judge_item(task_id: str, payload: dict[str, Any], ctx: StageContext) -> dict
 
 def _is_done_for(run: RunFolder):
     def is_done(task_id: str) -> bool:
-        if not (run.scene_dir(task_id) / "truth.json").is_file():
+        if not (run.scene_dir(task_id) / TRUTH).is_file():
             return True
         return all(verdict_path(run, task_id, s).is_file() for s in _seeds(run, task_id))
     return is_done
@@ -124,7 +131,7 @@ def verdict_table(run: RunFolder, tasks: list[TaskProposal]) -> dict[str, dict[s
     for t in tasks:
         for seed in _seeds(run, t.id):
             row = acc[t.hazard_class]
-            res = try_read_model(run.skill_dir(t.id, seed) / "result.json", SkillResult)
+            res = try_read_model(run.skill_dir(t.id, seed) / RESULT, SkillResult)
             row["runs"] += 1
             row["robot_done"] += int(bool(res is not None and res.success))
             v = load_verdict(run, t.id, seed)
@@ -160,7 +167,7 @@ def _print_table(table: dict[str, dict[str, float]]) -> None:
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
     tasks = run.load_tasks()
     check_only(only, [t.id for t in tasks])
-    chosen = [t for t in tasks if (not only or t.id in only) and (run.scene_dir(t.id) / "scene.json").is_file()]
+    chosen = [t for t in tasks if (not only or t.id in only) and (run.scene_dir(t.id) / SCENE_SPEC).is_file()]
     items = [(t.id, {}) for t in chosen]
     summary = run_items(run, STAGE, items, judge_item, settings=settings, is_done=_is_done_for(run), force=force,
                         description="judge", inputs=lambda task_id: _inputs(run, task_id))

@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import math
 
-from anomalygen.referee.truth import class_matches
 from anomalygen.schema import HazardManifest, HazardVerdict, SceneGraph, Verdict
+from anomalygen.truth.manifest import class_matches
 
 MOVED_M = 0.05  # a near-miss object displaced further than this was acted on
 TURNED = 0.1  # a near-miss joint (rad or m) moved further than this was acted on

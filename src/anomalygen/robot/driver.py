@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from anomalygen.mjgeom import FLOOR_GEOM, geom_world_aabbs
 from anomalygen.robot.agent import Agent
 
 REACH = Agent.REACH
@@ -27,8 +28,6 @@ class Driver:
     def __init__(self, model, data, *, frameskip: int = 5, dp: float = 0.012, on_step=None,
                  rng: np.random.Generator | None = None, planned_motion: bool = True):
         import mujoco
-
-        from anomalygen.scene.graph import FLOOR_GEOM
 
         self.model, self.data = model, data
         self.frameskip, self.dp, self.on_step = int(frameskip), float(dp), on_step
@@ -119,7 +118,6 @@ class Driver:
 
     def aabb(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """World AABB of all geoms of body ``name`` and its descendants (collision geoms first)."""
-        from anomalygen.scene.graph import geom_world_aabbs
 
         mask = self.agent.subtree_geoms(self.body_id(name))
         lo, hi = geom_world_aabbs(self.model, self.data)
@@ -142,7 +140,6 @@ class Driver:
         return False
 
     def _in_body(self, geom: int, name: str) -> bool:
-
         return bool(self.agent.subtree_geoms(self.body_id(name))[geom])
 
     @property

@@ -36,7 +36,7 @@ class Chosen:
     role: ObjectRole
     asset: object  # anomalygen.assets.model.Asset
     joint_values: dict[str, float] = field(default_factory=dict)  # unprefixed joint -> value
-    states: list[str] = field(default_factory=list)  # instance states the builder sets (scene/states.py)
+    states: list[str] = field(default_factory=list)  # instance states the builder sets (world/states.py)
 
     @property
     def size(self) -> float:
@@ -214,7 +214,7 @@ def plausibility_problem(
         if part.initial_state in ("open", "closed", "on", "off") and not joints_with_label(asset, part.part):
             return f"{catalogue} candidate has no '{part.part}' joint"
     if states:
-        from anomalygen.scene.states import why_cannot_show
+        from anomalygen.world.states import why_cannot_show
 
         for state in sorted(states):
             why = why_cannot_show(asset, state)

@@ -37,13 +37,13 @@ from anomalygen.robot.agent import Agent
 from anomalygen.runfolder import atomic_write_bytes, atomic_write_text, write_model
 from anomalygen.scene import viewpoint
 from anomalygen.scene.casting import bind_roles, select_objects, set_initial_joints
-from anomalygen.scene.cavities import placed_cavities
 from anomalygen.scene.compose import compose_scene, hold_gravity_hinges, latch_switched_on, set_joints
 from anomalygen.scene.instances import renumber_by_position
 from anomalygen.scene.judgement import check_hazard_free
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.placement import place
 from anomalygen.scene.set_states import arrange_states
+from anomalygen.scene_files import SCENE_GRAPH, SCENE_SPEC, SCENE_XML, TRUTH, render_file
 from anomalygen.schema import (
     AssetRef,
     AssetSource,
@@ -55,6 +55,7 @@ from anomalygen.schema import (
     ValidationReport,
     part_labels,
 )
+from anomalygen.world.cavities import placed_cavities
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
@@ -73,7 +74,7 @@ class Built:
     data: object
     report: ValidationReport
     graph: object
-    intents: dict = field(default_factory=dict)  # instance -> referee.truth.Intent of the judgement mix
+    intents: dict = field(default_factory=dict)  # instance -> truth.manifest.Intent of the judgement mix
     views: list = field(default_factory=list)  # the front camera's candidate views (viewpoint.front_views)
 
 
@@ -99,7 +100,7 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
     import mujoco
 
     from anomalygen.scene import validate as val
-    from anomalygen.scene.graph import scene_graph
+    from anomalygen.world.graph import scene_graph
 
     rng = item_rng(seed, task.id, attempt)
     hints = hints.model_copy(deep=True) if hints is not None else None  # each attempt records its own
@@ -259,8 +260,8 @@ def build_scene(task: TaskProposal, *, seed: int, settings: Settings, out_dir: P
 
 
 def _vlm_check(task, built: Built, settings: Settings) -> None:
-    from anomalygen.scene.render import SceneRenderer, png_bytes
     from anomalygen.scene.verify import verify_with_vlm
+    from anomalygen.world.render import SceneRenderer, png_bytes
 
     with SceneRenderer(built.model, settings.build.render_width, settings.build.render_height) as r:
         png = png_bytes(r.render(built.data, "front"))
@@ -274,8 +275,8 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_cla
     """scene.xml, renders, scene_graph.json, the hidden truth.json, scene.json last.
 
     ``hazard_class`` is the hazard the builder set up (None for a hazard-free scene)."""
-    from anomalygen.referee.truth import TRUTH_FILE, hazard_manifest
-    from anomalygen.scene.render import SceneRenderer, png_bytes
+    from anomalygen.truth.manifest import hazard_manifest
+    from anomalygen.world.render import SceneRenderer, png_bytes
 
     out_dir.mkdir(parents=True, exist_ok=True)
     model, data, mjspec = built.model, built.data, built.mjspec
@@ -286,7 +287,7 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_cla
     if model.nmocap:
         key.mpos = data.mocap_pos.flatten().copy()
         key.mquat = data.mocap_quat.flatten().copy()
-    files = {"xml": "scene.xml", "spec": "scene.json", "graph": "scene_graph.json"}
+    files = {"xml": SCENE_XML, "spec": SCENE_SPEC, "graph": SCENE_GRAPH}
     with SceneRenderer(model, settings.build.render_width, settings.build.render_height) as r:
         if built.views:
             view, worst = viewpoint.choose_front_view(r, model, data, mjspec, [o.name for o in built.spec.objects],
@@ -299,12 +300,12 @@ def write_outputs(built: Built, settings: Settings, out_dir: Path, *, hazard_cla
             built.report.checks.extend(viewpoint.fault_coverage(r, model, data, fault))
         _write_xml(mjspec, out_dir)  # after the front view is chosen
         for cam in CAMERAS:
-            atomic_write_bytes(out_dir / f"render_{cam}.png", png_bytes(r.render(data, cam)))
-            files[f"render_{cam}"] = f"render_{cam}.png"
+            atomic_write_bytes(out_dir / render_file(cam), png_bytes(r.render(data, cam)))
+            files[f"render_{cam}"] = render_file(cam)
     spec = built.spec.model_copy(update={"validation": built.report, "files": files})
-    write_model(out_dir / "scene_graph.json", built.graph)
-    write_model(out_dir / TRUTH_FILE, hazard_manifest(spec, hazard_class, built.graph, load_kb(), built.intents))
-    write_model(out_dir / "scene.json", spec)  # last: its presence marks the scene done
+    write_model(out_dir / SCENE_GRAPH, built.graph)
+    write_model(out_dir / TRUTH, hazard_manifest(spec, hazard_class, built.graph, load_kb(), built.intents))
+    write_model(out_dir / SCENE_SPEC, spec)  # last: its presence marks the scene done
     return spec
 
 
@@ -332,4 +333,4 @@ def _write_xml(mjspec, out_dir: Path) -> None:
     if 'meshdir="assets/franka"' not in xml:  # pragma: no cover - MuJoCo changed its XML writer
         raise RuntimeError("could not relocate the robot mesh folder in scene.xml")
     xml = relocate_meshes(xml, out_dir, "assets/franka")  # real models' meshes, under assets/real
-    atomic_write_text(out_dir / "scene.xml", xml)
+    atomic_write_text(out_dir / SCENE_XML, xml)

@@ -7,7 +7,7 @@ in the same change, and the brainstorm engine draws it from then on without bein
 
 from __future__ import annotations
 
-from anomalygen.scene.states import KNOWN_STATES
+from anomalygen.world.states import KNOWN_STATES
 
 #: Placement kinds ``scene/placement.py`` implements (``inside``/``on``/``near`` take ``:<name>``).
 PLACEMENT_KINDS: tuple[str, ...] = (
@@ -15,7 +15,7 @@ PLACEMENT_KINDS: tuple[str, ...] = (
     "inside", "on", "near",
 )
 #: Instance states the builder puts into a scene when a task or its class asks for them
-#: (``scene/set_states.py``; the words live in ``scene/states.py``). States an asset always shows come
+#: (``scene/set_states.py``; the words live in ``world/states.py``). States an asset always shows come
 #: from the knowledge base (``ObjectInfo.states``).
 BUILT_STATES: tuple[str, ...] = KNOWN_STATES
 

@@ -11,13 +11,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from anomalygen.mjgeom import FLOOR_GEOM
 from anomalygen.robot.agent import Agent
-from anomalygen.scene import furniture, layout, viewpoint, walls
-from anomalygen.scene.graph import FLOOR_GEOM
+from anomalygen.scene import furniture, viewpoint, walls
 from anomalygen.scene.layout import Layout, Placed
-from anomalygen.scene.sensors import add_observation_sensors
-from anomalygen.scene.states import geoms_below, show_states
 from anomalygen.scene.viewpoint import CAMERA_FOVY, FRAME_TOP
+from anomalygen.world.room import ROOM_CENTER
+from anomalygen.world.sensors import add_observation_sensors
+from anomalygen.world.states import geoms_below, show_states
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
@@ -75,7 +76,7 @@ def compose_scene(lay: Layout, placed: dict[str, Placed], settings: Settings, rn
     )
     spec.worldbody.add_light(
         name="sun",
-        pos=[layout.ROOM_CENTER[0], layout.ROOM_CENTER[1], 3.5],
+        pos=[ROOM_CENTER[0], ROOM_CENTER[1], 3.5],
         dir=[0.2, 0.1, -1],
         type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
         diffuse=[0.6, 0.6, 0.6],
@@ -135,7 +136,7 @@ def add_room_cameras(spec, objects: list[Placed], aspect: float) -> list:
     front camera looks in from the room's open corner at the walls (at +x and +y), just far enough
     back for the box to fit its view (``aspect``: width / height); the top camera looks straight down
     from just high enough."""
-    boxes = [p.footprint() for p in objects] or [(np.r_[layout.ROOM_CENTER - 1.0, 0.0], np.r_[layout.ROOM_CENTER + 1.0, 1.0])]
+    boxes = [p.footprint() for p in objects] or [(np.r_[ROOM_CENTER - 1.0, 0.0], np.r_[ROOM_CENTER + 1.0, 1.0])]
     views = viewpoint.front_views(boxes, aspect)
     eye, xyaxes = views[0]
     spec.worldbody.add_camera(name="front", pos=eye.tolist(), xyaxes=xyaxes, fovy=CAMERA_FOVY)

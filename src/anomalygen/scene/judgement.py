@@ -2,7 +2,7 @@
 
 Near-misses go on a table top, well clear of its edges or on the borderline of the edge rule; a state
 near-miss stands on a table with its part safe (a switch off, a lid ajar two degrees); a second
-hazard goes on the floor with its bin. Each carries its intent (``referee.truth.Intent``) to the truth
+hazard goes on the floor with its bin. Each carries its intent (``truth.manifest.Intent``) to the truth
 manifest. A hazard-free scene puts the task's object where it is no hazard and, once settled, checks
 that it really is none.
 """
@@ -14,7 +14,6 @@ import math
 from anomalygen.errors import ItemFailed
 from anomalygen.knowledge import load_kb
 from anomalygen.knowledge.predicates import ROOM_FIXTURES
-from anomalygen.referee.truth import Intent
 from anomalygen.scene import asset_choice, mix
 from anomalygen.scene.asset_choice import container_room
 from anomalygen.scene.casting import CONTAINER_REDRAWS, Selection
@@ -28,6 +27,7 @@ from anomalygen.scene.instances import (
 )
 from anomalygen.scene.layout import Layout, Placed, overlaps
 from anomalygen.schema import ObjectRole, ValidationCheck, ValidationReport, part_labels
+from anomalygen.truth.manifest import Intent
 
 CAVITY_TRIES = 8  # jittered spots tried for a second object shut in the hazard's container
 
@@ -249,7 +249,7 @@ def _latching_container(sel: Selection, hazard) -> asset_choice.Chosen | None:
 
 def check_hazard_free(report: ValidationReport, graph, hazard_class: str) -> ValidationReport:
     """A hazard-free variant must not show the task's hazard anywhere once settled."""
-    from anomalygen.referee.truth import class_matches
+    from anomalygen.truth.manifest import class_matches
 
     still = sorted(obj for cls, obj, _ in class_matches(graph, load_kb()) if cls == hazard_class)
     check = ValidationCheck(name="hazard_free", passed=not still,

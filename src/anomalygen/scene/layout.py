@@ -22,11 +22,10 @@ from anomalygen.robot.agent import Agent
 from anomalygen.scene.furniture import Support
 from anomalygen.scene.walls import WALL_GAP, WALL_X, WALL_Y, mount_height
 from anomalygen.schema import ObjectRole, ValidationCheck
+from anomalygen.world.room import ROOM_CENTER, ROOM_HALF
 
 REGION_ORIGIN = np.array([0.8, -0.6, 0.0])  # world position of the cube corner (0, 0, 0)
 REGION_SIZE = np.array([1.1, 1.2, 1.0])
-ROOM_HALF = np.array([1.9, 2.0])  # floor area used, around ROOM_CENTER
-ROOM_CENTER = np.array([1.0, 0.0])
 DROP_GAP = 0.002  # objects start this far above their support and settle onto it
 EDGE_BAND = (0.015, 0.07)  # metres from the edge for *_edge placements (KB threshold: 0.12)
 WALKWAY_CLEAR = 0.42  # > the KB's 0.3 m walkway clearance, with margin
@@ -53,7 +52,7 @@ class Placed:
     asset: object | None = None
     support_geom: Support | None = None
     joint_values: dict[str, float] = field(default_factory=dict)
-    states: list[str] = field(default_factory=list)  # instance states the builder set up (scene/states.py)
+    states: list[str] = field(default_factory=list)  # instance states the builder set up (world/states.py)
     front: np.ndarray | None = None  # local xy unit vector of the side doors/drawers open to
     pos: np.ndarray = field(default_factory=lambda: np.zeros(3))
     yaw: float = 0.0
@@ -64,7 +63,7 @@ class Placed:
     # (a counter 2 cm in front of a cabinet's doors keeps them shut); unlike ``sweep`` the base may
     # stand in it, and it does not push the base back from the front
     swing: float = 0.0
-    intent: object = None  # what the judgement mix meant it to be (a referee.truth.Intent), for truth.json
+    intent: object = None  # what the judgement mix meant it to be (a truth.manifest.Intent), for truth.json
 
     def world_half(self) -> np.ndarray:
         c, s = abs(math.cos(self.yaw)), abs(math.sin(self.yaw))

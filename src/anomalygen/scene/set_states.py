@@ -11,7 +11,8 @@ import math
 import numpy as np
 
 from anomalygen.scene.layout import DROP_GAP
-from anomalygen.scene.states import (
+from anomalygen.schema import part_labels
+from anomalygen.world.states import (
     ALWAYS_WET,
     BUILT_STATES,
     CONTAINS_WATER,
@@ -27,7 +28,6 @@ from anomalygen.scene.states import (
     _is_on,
     handle_tip_x,
 )
-from anomalygen.schema import part_labels
 
 BURNER, BURNER_CONTROL = "burner_", "knob_"  # surface "burner_k" is heated by the control body "knob_k"
 HANDLE_OVERHANG = (0.04, 0.08)  # m the handle's tip reaches past the edge for "handle_out"

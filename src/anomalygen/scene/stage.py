@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 from anomalygen.runfolder import RunFolder, atomic_write_bytes, try_read_model, write_model
 from anomalygen.runner import StageContext, StageSummary, check_only, config_section, run_items
+from anomalygen.scene_files import CONTACT_SHEET, LLM_LAYOUT, SCENE_SPEC
 from anomalygen.schema import Engine, SceneSpec, TaskProposal
 
 if TYPE_CHECKING:
@@ -23,7 +24,7 @@ SHEET_N = 10
 
 
 def scene_ok(scene_dir: Path) -> bool:
-    spec = try_read_model(Path(scene_dir) / "scene.json", SceneSpec)
+    spec = try_read_model(Path(scene_dir) / SCENE_SPEC, SceneSpec)
     return spec is not None and spec.validation is not None and spec.validation.ok
 
 
@@ -44,7 +45,7 @@ def build_item(item_id: str, payload: str, ctx: StageContext) -> str:
         spec = build_scene(task, seed=settings.seed, settings=settings, out_dir=out_dir, hints=hints,
                            hazard_free=is_hazard_free(task.id, settings, source=task.source))
     if hints is not None:
-        write_model(out_dir / "llm_layout.json", hints)  # what the LLM said, before the builder's corrections
+        write_model(out_dir / LLM_LAYOUT, hints)  # what the LLM said, before the builder's corrections
     return spec.scene_id
 
 
@@ -117,7 +118,7 @@ def write_contact_sheet(run: RunFolder, *, seed: int = 0, n: int = SHEET_N) -> P
 
     buf = io.BytesIO()
     sheet.save(buf, format="PNG")
-    out = run.scenes_dir / "contact_sheet.png"
+    out = run.scenes_dir / CONTACT_SHEET
     atomic_write_bytes(out, buf.getvalue())
     return out
 
@@ -127,8 +128,8 @@ def revalidate_run(run: RunFolder, settings: Settings | None = None) -> dict[str
     rebuild the scene graph and evaluate the hazard class's preconditions (and penetration) again.
     Returns task id -> None when valid, else the reason. Used by tests and the acceptance run."""
     from anomalygen.knowledge import load_kb
-    from anomalygen.scene.graph import load_scene, scene_graph
     from anomalygen.scene.validate import validate
+    from anomalygen.world.graph import load_scene, scene_graph
 
     kb = load_kb()
     out: dict[str, str | None] = {}

@@ -31,7 +31,7 @@ TAP = "tap"
 FAUCET = "faucet"
 GATE = "gate"  # a safety gate: bars a way, holding nothing behind it
 #: Not a joint label: the geom name of a pan's or pot's long handle, which the builder turns out over
-#: the edge (scene/states.py) and the rotate-inward skill turns back (skills/scripted/relocate.py).
+#: the edge (world/states.py) and the rotate-inward skill turns back (skills/scripted/relocate.py).
 HANDLE_GEOM = "handle"
 
 # Labels of parts that move but that no rule of the code turns on (a blade, a wheel, a seat). They

@@ -19,6 +19,7 @@ import numpy as np
 from anomalygen.robot.driver import Driver
 from anomalygen.robot.motion import restart_seed_sequence
 from anomalygen.schema import Plan, SceneSpec
+from anomalygen.world.graph import scene_graph
 
 
 @dataclass
@@ -135,6 +136,5 @@ class Episode:
 
     def graph(self):
         """The scene graph of the current state, as the robot perceives it."""
-        from anomalygen.scene.graph import scene_graph
 
         return scene_graph(self.model, self.data, self.spec)

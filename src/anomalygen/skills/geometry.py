@@ -11,7 +11,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from anomalygen.mjgeom import geom_world_aabbs
 from anomalygen.robot.frames import subtree_geoms
+from anomalygen.world.tops import on_fixed_frame
 
 if TYPE_CHECKING:
     from anomalygen.skills.episode import Episode
@@ -36,7 +38,6 @@ def grasp_points(ep: Episode, obj: str, n: int = 3) -> list[np.ndarray]:
     """Up to ``n`` points to put the cup on, best first: the tops of the object's highest, widest
     collision geoms, then the centre of its box's top. A pair of pliers or glasses has nothing
     under the centre of its box, so the box alone sends the cup into a gap."""
-    from anomalygen.scene.graph import geom_world_aabbs
 
     drv = ep.driver
     m = drv.model
@@ -116,7 +117,6 @@ def floor_below(ep: Episode, point: np.ndarray, obj: str) -> float | None:
     """Height of the first surface under ``point`` (the held object and the robot ignored)."""
     import mujoco
 
-
     drv = ep.driver
     m, d = drv.model, drv.data
     skip = subtree_geoms(m, drv.body_id(obj)) | np.isin(np.arange(m.ngeom), list(drv._robot_geoms))
@@ -139,8 +139,6 @@ def top_rect(ep: Episode, support: str) -> tuple[np.ndarray, np.ndarray]:
     Only solid geoms of the support's fixed frame count: the top edge of a cabinet door swung open
     reaches the same height, and counting it moved the middle of the "top" out over the doorway (a
     dumbbell taken down onto the Franka Kitchen cabinet was set on its front edge)."""
-    from anomalygen.scene.graph import geom_world_aabbs
-    from anomalygen.scene.tops import on_fixed_frame
 
     drv = ep.driver
     m = drv.model
@@ -382,7 +380,6 @@ def part_point_local(ep: Episode, joint: str) -> tuple[int, np.ndarray]:
 
 def static_box(ep: Episode, obj: str) -> tuple[np.ndarray, np.ndarray]:
     """World AABB of the object's carcass: its collision geoms that no hinge or slide moves."""
-    from anomalygen.scene.graph import geom_world_aabbs
 
     drv = ep.driver
     m = drv.model

@@ -28,13 +28,13 @@ def built(tmp_path_factory):
 
 
 def _held_start(scene_dir, plan, k: int = 0):
-    from anomalygen.perception import perceived_spec
-    from anomalygen.scene.graph import load_scene
     from anomalygen.skills.episode import Episode
     from anomalygen.skills.learned.part_env import PartStart
     from anomalygen.skills.learned.part_skill import grasp_part
     from anomalygen.skills.learned.part_subtask import far_value
     from anomalygen.skills.learned.sac_subtask import snapshot
+    from anomalygen.world.graph import load_scene
+    from anomalygen.world.perception import perceived_spec
 
     model, data, spec = load_scene(scene_dir)
     spec = perceived_spec(spec)

@@ -225,9 +225,9 @@ def test_a_closing_reward_about_an_already_closed_part_moves_to_the_open_one(tmp
     from anomalygen.config import Settings
     from anomalygen.plan.planner import plan_from_kb
     from anomalygen.scene.build import build_scene
-    from anomalygen.scene.graph import load_scene
     from anomalygen.skills.episode import Episode
     from anomalygen.skills.learned.sac_subtask import retarget_joints
+    from anomalygen.world.graph import load_scene
     from support.kb_scenes import kb_task
 
     task = kb_task("t-fridge", "close_open_refrigerator", "Refrigerator", "Refrigerator", "floor",

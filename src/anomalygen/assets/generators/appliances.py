@@ -175,7 +175,7 @@ def kitchen_pot(rng):
         for s in (-1, 1):
             r.box((0.02, 0.03, 0.006), (s * (rad + 0.02), 0, h * 0.85), DARK, 1100)
     else:
-        r.box((0.08, 0.012, 0.008), (rad + 0.08, 0, h * 0.85), DARK, 1100, name=HANDLE_GEOM)  # turned by scene/states.py
+        r.box((0.08, 0.012, 0.008), (rad + 0.08, 0, h * 0.85), DARK, 1100, name=HANDLE_GEOM)  # turned by world/states.py
     lid = r.child("lid", (0, 0, h + 0.001))
     lid.slide("lid_lift", (0, 0, 1), (0, 0.12), LID, 0.0)
     lid.cyl(rad + 0.004, 0.003, (0, 0, 0.003), GLASS if rng.random() < 0.5 else c, 2500)

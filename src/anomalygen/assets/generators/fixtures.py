@@ -33,7 +33,7 @@ from anomalygen.assets.parts import Part, axis_angle
 from anomalygen.assets.registry import register
 from anomalygen.schema import GATE
 
-WATER = (0.25, 0.5, 0.9, 0.0)  # hidden until the builder fills the basin (``scene/states.py``)
+WATER = (0.25, 0.5, 0.9, 0.0)  # hidden until the builder fills the basin (``world/states.py``)
 WATER_FILL = 0.7  # of a basin's depth
 SHELL = 120.0  # kg/m3: a hollow cabinet or staircase modelled as a solid box
 TUBE = 1500.0  # kg/m3: a thin-walled metal tube modelled as a solid rod

@@ -310,7 +310,7 @@ def frying_pan(rng):
     c = colour(rng, [DARK, METAL[2]])
     r.cyl(rad, 0.003, (0, 0, 0.003), c, D_METAL)
     r.ring(rad, 0.006, 0.045, 0.003, 14, c, D_METAL)
-    r.box((hl / 2, 0.012, 0.008), (rad + hl / 2, 0, 0.03), DARK, 1100, name=HANDLE_GEOM)  # turned by scene/states.py
+    r.box((hl / 2, 0.012, 0.008), (rad + hl / 2, 0, 0.03), DARK, 1100, name=HANDLE_GEOM)  # turned by world/states.py
     return Draft(
         r,
         {"radius": rad},

@@ -133,7 +133,7 @@ def top_lid(parent: Part, name: str, hx, hy, z, rgba, density, thick=0.01, open_
 
 
 # A geom named ``<control body>_glow`` is drawn only while that control is on (a burner's flame, a
-# heater's element, a candle's flame); the scene builder shows it (``scene/states.py``). Its rgba
+# heater's element, a candle's flame); the scene builder shows it (``world/states.py``). Its rgba
 # here has alpha 0, so the asset on its own, and a scene with the control off, show nothing.
 GLOW = (1.0, 0.35, 0.05, 0.0)
 

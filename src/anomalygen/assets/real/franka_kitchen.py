@@ -170,7 +170,7 @@ KNOB_FRICTION = 0.1  # N m
 
 def _glow(control: str, burner_pos: str) -> ET.Element:
     """A hidden disc just over a burner, named after the knob that lights it: the builder shows it
-    while that knob is on (``scene/states.py``), as the procedural stove's burners glow."""
+    while that knob is on (``world/states.py``), as the procedural stove's burners glow."""
     x, y, z = (float(v) for v in burner_pos.split())
     return ET.Element("geom", {
         "name": f"{control}_glow", "type": "cylinder", "size": f"{_GLOW_RADIUS} {_GLOW_HALF_HEIGHT}",

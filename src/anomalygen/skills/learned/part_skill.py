@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from anomalygen.mjgeom import geom_world_aabbs
 from anomalygen.schema import CLOSED_TOL
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -51,7 +52,6 @@ def part_geometry(model, data, joint: str) -> dict:
     import mujoco
 
     from anomalygen.robot.frames import subtree_geoms
-    from anomalygen.scene.graph import geom_world_aabbs
 
     j = model.joint(joint).id
     body = int(model.jnt_bodyid[j])

@@ -36,10 +36,12 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from anomalygen.mjgeom import geom_world_aabbs
 from anomalygen.robot.agent import Agent
 from anomalygen.robot.frames import subtree_geoms
 from anomalygen.schema import CLOSED_TOL, RewardSpec, SceneSpec, SubTask
 from anomalygen.skills.learned.reward import evaluate_spec
+from anomalygen.world.graph import scene_graph
 
 SUBTASK_ENV_ID = "anomalygen/SubTask-v0"
 HORIZON = 100  # control steps per episode: the registered TimeLimit
@@ -166,7 +168,6 @@ class SubTaskReadout:
     # ------------------------------------------------------------------ readout
     def state(self, model, data, action=None) -> dict:
         """The reward.py state dict (call after mj_forward / mj_step)."""
-        from anomalygen.scene.graph import geom_world_aabbs
 
         glo, ghi = geom_world_aabbs(model, data)
         quat = np.zeros(4)
@@ -216,7 +217,6 @@ class SubTaskReadout:
         """(success, why): the SuccessSpec on the scene graph, else the reward's goal terms."""
         if self.has_predicates():
             from anomalygen.knowledge.predicates import evaluate_all
-            from anomalygen.scene.graph import scene_graph
 
             res = evaluate_all(list(self.sub_task.success.predicates), scene_graph(model, data, self.spec), self.bindings)
             return all(r.holds for r in res), "; ".join(f"{r.call.name}: {'yes' if r.holds else 'no'}" for r in res)

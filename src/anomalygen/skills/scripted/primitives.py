@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from anomalygen.mjgeom import geom_world_aabbs
 from anomalygen.robot.agent import Agent
 from anomalygen.robot.frames import subtree_geoms
 from anomalygen.skills.episode import Episode
@@ -134,7 +135,6 @@ def side_grasp(ep: Episode, obj: str, *, lift: float = 0.12) -> SkillOutcome:
     import mujoco
 
     from anomalygen.robot.ik import quat_z_to
-    from anomalygen.scene.graph import geom_world_aabbs
 
     drv = ep.driver
     s0 = drv.steps
@@ -172,7 +172,6 @@ def side_grasp(ep: Episode, obj: str, *, lift: float = 0.12) -> SkillOutcome:
 
 
 def release(ep: Episode) -> SkillOutcome:
-
     drv = ep.driver
     s0 = drv.steps
     held = drv.held

@@ -22,18 +22,18 @@ from anomalygen.skills.geometry import floor_below, static_box
 from anomalygen.skills.registry import SkillOutcome
 from anomalygen.skills.scripted.primitives import grasp, release
 from anomalygen.skills.scripted.setdown import lower_until_contact
+from anomalygen.world.room import ROOM_CENTER, ROOM_HALF
 
 SIDE_GAP = 0.08  # m between the furniture's footprint and the object (well under the walkway's 0.3 m)
 CLEARANCE = 0.025  # m the object's bottom is kept above the floor while it is moved
 KEEP_OFF = 0.04  # m kept from other things' footprints at the chosen spot
-ROOM_MARGIN = 0.15  # m the object stays inside the furnished floor area (scene/layout.py ROOM_HALF)
+ROOM_MARGIN = 0.15  # m the object stays inside the furnished floor area (world/room.py ROOM_HALF)
 FLOOR_TOL = 0.02  # m: a ray that hits lower than this hit the floor itself
 SPOTS_PER_SIDE = 9
 
 
 def floor_spot_beside(ep: Episode, obj: str, anchor: str) -> np.ndarray | None:
     """Centre (x, y) of a free floor spot for ``obj`` beside ``anchor``, or None when there is none."""
-    from anomalygen.scene.layout import ROOM_CENTER, ROOM_HALF
 
     drv = ep.driver
     alo, ahi = static_box(ep, anchor)

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from anomalygen.mjgeom import geom_world_aabbs
 from anomalygen.schema.part_labels import HANDLE_GEOM
 from anomalygen.skills.geometry import NEAR_EDGE, box_gap, rated_spot, top_rect
 from anomalygen.skills.registry import SkillOutcome
@@ -182,7 +183,6 @@ def _handle(ep: Episode, obj: str) -> tuple[np.ndarray, np.ndarray] | None:
     import mujoco
 
     from anomalygen.robot.frames import subtree_geoms
-    from anomalygen.scene.graph import geom_world_aabbs
 
     drv = ep.driver
     m, d = drv.model, drv.data

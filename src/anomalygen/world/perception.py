@@ -17,11 +17,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from anomalygen.runfolder import try_read_model
+from anomalygen.scene_files import SCENE_GRAPH, SCENE_SPEC
 from anomalygen.schema import ObjectRole, SceneGraph, SceneSpec
 
 UNKNOWN_ROLE = ObjectRole.AUXILIARY  # every object looks alike to the robot: none is labelled "hazard"
-GRAPH_FILE = "scene_graph.json"
-SPEC_FILE = "scene.json"
 
 
 def perceived_spec(spec: SceneSpec) -> SceneSpec:
@@ -31,17 +30,17 @@ def perceived_spec(spec: SceneSpec) -> SceneSpec:
 
 
 def load_perceived_spec(scene_dir: str | Path) -> SceneSpec | None:
-    spec = try_read_model(Path(scene_dir) / SPEC_FILE, SceneSpec)
+    spec = try_read_model(Path(scene_dir) / SCENE_SPEC, SceneSpec)
     return perceived_spec(spec) if spec is not None else None
 
 
 def load_scene_graph(scene_dir: str | Path) -> SceneGraph | None:
-    return try_read_model(Path(scene_dir) / GRAPH_FILE, SceneGraph)
+    return try_read_model(Path(scene_dir) / SCENE_GRAPH, SceneGraph)
 
 
 def load_perceived_scene(scene_dir: str | Path):
     """The simulator at the settled initial state and the perceived spec: (model, data, spec)."""
-    from anomalygen.scene.graph import load_scene
+    from anomalygen.world.graph import load_scene
 
     model, data, spec = load_scene(scene_dir)
     return model, data, perceived_spec(spec)

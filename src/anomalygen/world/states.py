@@ -120,7 +120,7 @@ def _named_geom(model, name: str) -> int:
 
 
 def object_states(model, data, obj, joints: list[JointState], support_box=None) -> list[str]:
-    """The perceived states of one object (``scene/graph.py``): the builder's recorded states, the
+    """The perceived states of one object (``world/graph.py``): the builder's recorded states, the
     on/off reading of its controls, and the pose-based ones. ``support_box`` is the world (lo, hi)
     of the surface geom it rests on, if any."""
     out = list(obj.states)

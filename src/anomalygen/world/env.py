@@ -18,7 +18,7 @@ names nor their order say which object matters): ``object_pos`` (3 per object, i
 ``object_quat`` (4 per object), ``object_joints`` (the value of every articulated joint, object by
 object, in the asset's joint order), and last ``suction`` (1.0 while something is held).
 
-The env perceives only (``anomalygen.perception``): ``env.scene`` is the scene spec with no bindings,
+The env perceives only (``anomalygen.world.perception``): ``env.scene`` is the scene spec with no bindings,
 roles, validation report or task id, and ``info`` carries no task words. ``info["is_success"]`` is
 there only when a ``success_fn`` is given (the caller's own check, as the skills pass theirs): the env
 itself cannot know success without the answer key. The referee's verdict comes from outside.
@@ -72,7 +72,7 @@ class SceneEnv(gym.Env):
     ):
         import mujoco
 
-        from anomalygen.perception import load_perceived_scene
+        from anomalygen.world.perception import load_perceived_scene
 
         self._mj = mujoco
         self.scene_dir = Path(scene_dir)
@@ -121,8 +121,8 @@ class SceneEnv(gym.Env):
             self.obs_layout[key] = slice(start, start + n)
             start += n
         self._obs = np.zeros(start)
-        # Fast path: the scene compiled observation sensors (scene/sensors.py), read in one copy.
-        from anomalygen.scene.sensors import GROUPS, sensor_items, sensor_layout
+        # Fast path: the scene compiled observation sensors (world/sensors.py), read in one copy.
+        from anomalygen.world.sensors import GROUPS, sensor_items, sensor_layout
 
         layout = sensor_layout(m)
         self._use_sensors = (
@@ -143,7 +143,7 @@ class SceneEnv(gym.Env):
 
     # ------------------------------------------------------------------ gym API
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        from anomalygen.scene.graph import reset_to_initial
+        from anomalygen.world.graph import reset_to_initial
 
         super().reset(seed=seed)
         mj, m, d = self._mj, self.model, self.data
@@ -182,7 +182,7 @@ class SceneEnv(gym.Env):
         if self.render_mode != "rgb_array":
             return None
         if self._renderer is None:
-            from anomalygen.scene.render import SceneRenderer
+            from anomalygen.world.render import SceneRenderer
 
             self._renderer = SceneRenderer(self.model, self.width, self.height)
         return self._renderer.render(self.data, self.camera)
@@ -230,7 +230,7 @@ class SceneEnv(gym.Env):
 
     def graph(self):
         """The SceneGraph of the current state (for success predicates)."""
-        from anomalygen.scene.graph import scene_graph
+        from anomalygen.world.graph import scene_graph
 
         self._mj.mj_forward(self.model, self.data)
         return scene_graph(self.model, self.data, self.scene)
@@ -244,7 +244,7 @@ def make_env(scene_dir, frameskip: int = 2, horizon: int = HORIZON, **kwargs) ->
 def register() -> None:
     """Register ``anomalygen/Scene-v0`` with Gymnasium (idempotent): ``gym.make(ENV_ID, scene_dir=...)``."""
     if ENV_ID not in gym.registry:
-        gym.register(id=ENV_ID, entry_point="anomalygen.scene.env:SceneEnv", max_episode_steps=HORIZON)
+        gym.register(id=ENV_ID, entry_point="anomalygen.world.env:SceneEnv", max_episode_steps=HORIZON)
 
 
 register()

@@ -5,8 +5,8 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from anomalygen.scene.graph import geom_world_aabbs
-from anomalygen.scene.tops import top_surface
+from anomalygen.mjgeom import geom_world_aabbs
+from anomalygen.world.tops import top_surface
 
 # A cabinet whose top is two level boards side by side, a door on a hinge whose top edge is level
 # with them, and a separate board 30 cm away at the same height (another piece of furniture would be

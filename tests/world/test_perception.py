@@ -14,9 +14,14 @@ import anomalygen
 from anomalygen.config import Settings
 from anomalygen.knowledge import load_kb
 from anomalygen.knowledge.models import PROPERTIES, ROOMS, SUPPORT_HEIGHTS
-from anomalygen.perception import UNKNOWN_ROLE, load_perceived_scene, load_perceived_spec, load_scene_graph
 from anomalygen.runfolder import read_model
 from anomalygen.schema import Relation, SceneSpec
+from anomalygen.world.perception import (
+    UNKNOWN_ROLE,
+    load_perceived_scene,
+    load_perceived_spec,
+    load_scene_graph,
+)
 from support.ids import task_text, words
 
 OBS_KEYS = {"robot_qpos", "robot_qvel", "ee_pos", "ee_quat", "object_pos", "object_quat", "object_joints", "suction"}

@@ -13,7 +13,6 @@ from pathlib import Path
 
 import numpy as np
 
-FINAL_STATE = "final_state.npz"  # skills/<task>/seed<k>/: the state after the robot's last action
 _WHICH = "mjSTATE_INTEGRATION"
 
 

@@ -1,14 +1,14 @@
 """The Gymnasium env: Gymnasium's own checker, TimeLimit from the registry, determinism under a seed,
 suction carries an object, success reaches ``info["is_success"]`` only from the caller's own check,
-every object observed alike. (What it must not show the robot: tests/test_perception.py.)"""
+every object observed alike. (What it must not show the robot: tests/world/test_perception.py.)"""
 
 import gymnasium as gym
 import mujoco
 import numpy as np
 
 from anomalygen.runfolder import read_model
-from anomalygen.scene.env import ENV_ID, HORIZON, make_env
 from anomalygen.schema import SceneSpec
+from anomalygen.world.env import ENV_ID, HORIZON, make_env
 
 
 def test_spaces_and_step(built_scenes):

@@ -24,6 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
+from anomalygen.scene_files import TRUTH
 from anomalygen.schema import (
     HazardManifest,
     ManifestHazard,
@@ -33,7 +34,6 @@ from anomalygen.schema import (
     SceneSpec,
 )
 
-TRUTH_FILE = "truth.json"
 CHOSEN_BY_THE_FIX = ("container", "support")  # predicate arguments the fix may fill with any object
 
 
@@ -43,7 +43,7 @@ def load_manifest(scene_dir) -> HazardManifest | None:
 
     from anomalygen.runfolder import try_read_model
 
-    return try_read_model(Path(scene_dir) / TRUTH_FILE, HazardManifest)
+    return try_read_model(Path(scene_dir) / TRUTH, HazardManifest)
 
 
 def bound_success(hc, fault_variable: str, fault_object: str, bindings: dict[str, str]) -> list[PredicateCall]:

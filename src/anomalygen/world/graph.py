@@ -20,8 +20,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from anomalygen.scene.states import object_states
-from anomalygen.scene.tops import top_surface
+from anomalygen.mjgeom import FLOOR_GEOM, geom_world_aabbs
+from anomalygen.scene_files import SCENE_SPEC, SCENE_XML
 from anomalygen.schema import (
     LATCHING_PROPERTY,
     GraphObject,
@@ -32,11 +32,12 @@ from anomalygen.schema import (
     shut_by,
     within_child_reach,
 )
+from anomalygen.world.states import object_states
+from anomalygen.world.tops import top_surface
 
 if TYPE_CHECKING:  # pragma: no cover
     import mujoco
 
-FLOOR_GEOM = "floor"
 ON_FLOOR_TOL = 0.01  # m: bottom this close to z=0 counts as on the floor
 NEAR_DIST = 0.15  # m: bounding-box gap below which two objects are "near"
 CAVITY_TOL = 0.01  # m: an object's centre this far outside a cavity's box still counts as inside it
@@ -120,7 +121,7 @@ def _index(model, spec: SceneSpec) -> _Index:
 def _cavity_tables(model, spec: SceneSpec):
     """Every declared cavity of the scene as arrays, and the joints that must be shut to close each
     (``cavity_closers``)."""
-    from anomalygen.scene.cavities import cavities_of
+    from anomalygen.world.cavities import cavities_of
 
     owners, bodies, centers, halves, closers = [], [], [], [], []
     for i, obj in enumerate(spec.objects):
@@ -208,26 +209,6 @@ def _held(idx: _Index, data) -> set[int]:
         return set()
     on = np.asarray(data.eq_active)[idx.hold_eqs] > 0
     return {int(o) for o in idx.hold_owner[on] if idx.loose[o]}
-
-
-def geom_world_aabbs(model, data) -> tuple[np.ndarray, np.ndarray]:
-    """World-frame (min, max) corners of every geom's bounding box, shape (ngeom, 3) each."""
-    import mujoco
-
-    center_local = model.geom_aabb[:, :3]
-    half_local = model.geom_aabb[:, 3:]
-    mats = data.geom_xmat.reshape(-1, 3, 3)
-    center = data.geom_xpos + np.einsum("gij,gj->gi", mats, center_local)
-    half = np.einsum("gij,gj->gi", np.abs(mats), half_local)
-    # Balls and ellipsoids get their exact box: the turned local box of a ball rolling in a basket
-    # grew by up to 40 % (its bottom 3 cm under the floor) and the ball was no longer 'inside'.
-    # (Capsules and cylinders keep the turned box: cable links and knobs are measured as before.)
-    size, kind = model.geom_size, model.geom_type
-    sph = kind == mujoco.mjtGeom.mjGEOM_SPHERE
-    half[sph] = size[sph, :1]
-    ell = kind == mujoco.mjtGeom.mjGEOM_ELLIPSOID
-    half[ell] = np.sqrt(np.einsum("gij,gj->gi", mats[ell] ** 2, size[ell] ** 2))
-    return center - half, center + half
 
 
 def object_aabbs(model, data, owner: np.ndarray, n: int, geom_boxes=None) -> tuple[np.ndarray, np.ndarray]:
@@ -442,8 +423,8 @@ def load_scene(scene_dir: str | Path):
     from anomalygen.runfolder import read_model
 
     scene_dir = Path(scene_dir)
-    spec = read_model(scene_dir / "scene.json", SceneSpec)
-    model = mujoco.MjModel.from_xml_path(str(scene_dir / spec.files.get("xml", "scene.xml")))
+    spec = read_model(scene_dir / SCENE_SPEC, SceneSpec)
+    model = mujoco.MjModel.from_xml_path(str(scene_dir / spec.files.get("xml", SCENE_XML)))
     data = mujoco.MjData(model)
     reset_to_initial(model, data)
     return model, data, spec

@@ -1,5 +1,5 @@
 """The top an object rests on, as one surface: the edge a thing stands near is the edge of the whole
-top, not of one board of it (``scene/graph.py`` measures ``distance_to_edge`` against it)."""
+top, not of one board of it (``world/graph.py`` measures ``distance_to_edge`` against it)."""
 
 from __future__ import annotations
 
