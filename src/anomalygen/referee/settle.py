@@ -39,14 +39,13 @@ def released_and_settled(model, data, spec: SceneSpec) -> tuple[object, object, 
     """(model copy, settled data copy, objects that were held, simulated seconds) for ``data``."""
     import mujoco
 
-    from anomalygen.world.graph import _index, held_objects, robot_constraints
+    from anomalygen.world.graph import geom_owners, held_objects, robot_constraints
 
     m, d = copy_state(model, data)
     released = held_objects(m, d, spec)
     for eq in robot_constraints(m, d, spec):
         d.eq_active[eq] = 0
-    idx = _index(m, spec)
-    robot = (idx.geom_owner < 0) & (m.geom_bodyid != 0)  # owned by no object and not the room
+    robot = (geom_owners(m, spec) < 0) & (m.geom_bodyid != 0)  # owned by no object and not the room
     m.geom_contype[robot] = 0
     m.geom_conaffinity[robot] = 0
     steps = max(1, int(round(SETTLE_S / m.opt.timestep)))

@@ -21,9 +21,9 @@ INITIAL_OVERLAP = 0.004  # m: deeper than this before settling means the layout 
 def _owners(model, spec: SceneSpec) -> np.ndarray:
     """Geom -> object index (robot = -2, room = -1)."""
     from anomalygen.robot.agent import Agent
-    from anomalygen.world.graph import _index
+    from anomalygen.world.graph import geom_owners
 
-    owner = _index(model, spec).geom_owner.copy()
+    owner = geom_owners(model, spec)
     owner[Agent.geom_ids(model)] = -2
     return owner
 

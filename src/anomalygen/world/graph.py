@@ -184,6 +184,12 @@ def _holding_welds(model, body_owner: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return np.asarray(eqs, int), np.asarray(owners, int), np.asarray(robot_only, int)
 
 
+def geom_owners(model, spec: SceneSpec) -> np.ndarray:
+    """Geom id -> index of the object it belongs to in ``spec.objects`` (-1: the robot or the room).
+    A copy: the lookup table itself is shared by every caller of the same (model, spec)."""
+    return _index(model, spec).geom_owner.copy()
+
+
 def held_objects(model, data, spec: SceneSpec) -> list[str]:
     """Objects the robot's suction cup holds right now (an active object-to-robot weld, loose objects only)."""
     idx = _index(model, spec)
