@@ -24,8 +24,8 @@ from anomalygen.world.states import (
     ON,
     SWITCHED_STATES,
     WET,
-    _add,
-    _is_on,
+    add_state,
+    control_is_on,
     handle_tip_x,
 )
 
@@ -73,15 +73,15 @@ def set_initial_states(sel) -> None:
 
     for ch in sel.by_catalogue.values():
         if ch.catalogue in ALWAYS_WET:
-            _add(ch.states, WET)
+            add_state(ch.states, WET)
     for ch, state in wanted_states(sel):
         if state in SWITCHED_STATES:
             controls = switch_joints(ch.asset)
             if sel.hazard_free:
                 continue
             if not controls:
-                _add(ch.states, state)
-            elif not any(_is_on(ch.joint_values, j) for j in controls):
+                add_state(ch.states, state)
+            elif not any(control_is_on(ch.joint_values, j) for j in controls):
                 from anomalygen.scene.asset_choice import open_value
 
                 joint = controls[int(sel.rng.integers(len(controls)))]
@@ -89,7 +89,7 @@ def set_initial_states(sel) -> None:
         elif state in BUILT_STATES:
             if state == CONTAINS_WATER and ch.catalogue not in HOLDS_WATER:
                 raise ItemFailed(f"{ch.catalogue} cannot hold water; what can: {', '.join(sorted(HOLDS_WATER))}")
-            _add(ch.states, state)
+            add_state(ch.states, state)
         elif state == FACE_DOWN and ch.catalogue not in FACE_DOWN_CATEGORIES:
             raise ItemFailed(f"face_down is an iron lying on its soleplate; {ch.catalogue} is not an iron")
 
@@ -111,7 +111,7 @@ def _light_burner_under(holder, placed: dict) -> None:
     from anomalygen.scene.layout import surface_world
 
     knobs = {j.body: j for j in holder.asset.joints}
-    on = [j for j in knobs.values() if _is_on(holder.joint_values, j)]
+    on = [j for j in knobs.values() if control_is_on(holder.joint_values, j)]
     items = sorted((p for p in placed.values() if p.support.split(":")[0] == holder.name),
                    key=lambda p: p.role.value != "hazard")
     if not on or not items:
@@ -121,7 +121,7 @@ def _light_burner_under(holder, placed: dict) -> None:
     near = min(burners, key=lambda s: float(np.linalg.norm(
         (lambda w: (w[0] + w[1]) / 2)(surface_world(holder, s.center, s.half_size)) - where)))
     joint = knobs.get(near.name.replace(BURNER, BURNER_CONTROL, 1))
-    if joint is None or _is_on(holder.joint_values, joint):
+    if joint is None or control_is_on(holder.joint_values, joint):
         return
     holder.joint_values[joint.name] = holder.joint_values.pop(on[0].name)
 

@@ -41,11 +41,13 @@ GLOW_ALPHA = 0.95
 UPRIGHT_COS = 0.7  # cos of the most an object's up axis may lean and still count as upright (45 deg)
 
 
-def _is_on(values: dict[str, float], joint) -> bool:
+def control_is_on(values: dict[str, float], joint) -> bool:
+    """Whether a control joint stands away from its off value in ``values`` (joint name -> value)."""
     return abs(values.get(joint.name, joint.closed_value) - joint.closed_value) > 1e-9
 
 
-def _add(states: list[str], state: str) -> None:
+def add_state(states: list[str], state: str) -> None:
+    """Append ``state`` once: a state list never names one state twice."""
     if state not in states:
         states.append(state)
 
@@ -78,7 +80,7 @@ def why_cannot_show(asset, state: str) -> str | None:
 def show_states(root, placed) -> None:
     """Draw a placed object's states on its attached body (``compose.py``): water in a filled basin,
     the glow of each control that starts on. The asset hides both (alpha 0)."""
-    on_bodies = {j.body for j in placed.asset.joints if _is_on(placed.joint_values, j)}
+    on_bodies = {j.body for j in placed.asset.joints if control_is_on(placed.joint_values, j)}
     prefix = f"{placed.name}/"
     for geom in geoms_below(root):
         name = geom.name.removeprefix(prefix)
@@ -127,16 +129,16 @@ def object_states(model, data, obj, joints: list[JointState], support_box=None) 
     controls = [j for j in joints if part_labels.is_switch(j.label)]
     if controls:
         on = [j for j in controls if not j.is_closed()]
-        _add(out, ON if on else OFF)
+        add_state(out, ON if on else OFF)
         if on and obj.asset.category in LIT_WHEN_ON:
-            _add(out, LIT)
+            add_state(out, LIT)
         if any(part_labels.canonical(j.label) == part_labels.TAP for j in on):
-            _add(out, RUNNING)
+            add_state(out, RUNNING)
     body = model.body(obj.name)
     if obj.asset.category in FACE_DOWN_CATEGORIES and data.xmat[body.id][8] > UPRIGHT_COS:
-        _add(out, FACE_DOWN)  # its local up (the side away from the soleplate) points up
+        add_state(out, FACE_DOWN)  # its local up (the side away from the soleplate) points up
     if support_box is not None and _handle_beyond(model, data, obj.name, support_box):
-        _add(out, HANDLE_OUT)
+        add_state(out, HANDLE_OUT)
     return out
 
 
