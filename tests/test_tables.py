@@ -54,13 +54,14 @@ def test_group_table_keeps_every_class_whole_at_80_columns(classes_by_category):
 
 
 def test_detection_table_lists_each_class_under_its_own_category(classes_by_category):
-    from anomalygen.evaluate.detection_report import DetectionReport, Found, print_report
+    from anomalygen.evaluate.detection_report import DetectionReport, print_report
     from anomalygen.evaluate.detection_scores import DetectionScores
+    from anomalygen.evaluate.rate import Rate
 
     scores = DetectionScores(scenes=30, hazards=40, found=38, claims=45, true_claims=38, recall=0.95,
                              precision=0.84, f1=0.89, single_hazard_scenes=20, hit_at_k={1: 0.9, 2: 1.0})
     report = DetectionReport(detector="rules", k=2, scenes=30, overall=scores,
-                             per_category={c: {cls: Found(hazards=3, found=2) for cls in members}
+                             per_category={c: {cls: Rate(n=3, successes=2) for cls in members}
                                            for c, members in classes_by_category.items()})
     console = Console(width=WIDTH, record=True, color_system=None)
     print_report(report, console=console)
@@ -68,7 +69,8 @@ def test_detection_table_lists_each_class_under_its_own_category(classes_by_cate
 
 
 def test_the_referees_table_groups_classes_and_labels_the_robots_check(classes_by_category):
-    from anomalygen.evaluate.results import Rate, SuccessSummary, VerdictCounts
+    from anomalygen.evaluate.rate import Rate
+    from anomalygen.evaluate.results import SuccessSummary, VerdictCounts
     from anomalygen.evaluate.verdict_table import COLUMNS, verdict_table
 
     counts = VerdictCounts(runs=4, resolved=2, unresolved=1, no_action_needed=1)

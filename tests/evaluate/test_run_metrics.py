@@ -32,9 +32,9 @@ def test_detection_is_scored_against_the_truth(synthetic_run):
 
 
 def rm_found(hazards, found):
-    from anomalygen.evaluate.detection_report import Found
+    from anomalygen.evaluate.rate import Rate
 
-    return Found(hazards=hazards, found=found)
+    return Rate(n=hazards, successes=found)
 
 
 def test_headlines_are_the_referees_verdicts_with_the_robots_own_beside(synthetic_run):

@@ -18,6 +18,8 @@ from anomalygen.schema import (
     AuxiliaryItem,
     BrainstormMode,
     Engine,
+    GroundingMatch,
+    HazardCategory,
     Provenance,
     Scenario,
     TaskProposal,
@@ -142,14 +144,51 @@ def auxiliary_items(idea: Idea, kb: KnowledgeBase) -> list[AuxiliaryItem]:
 def to_proposal(
     idea: Idea, texts: Texts, index: int, kb: KnowledgeBase, *, engine: Engine, mode: BrainstormMode, seed: int | None, model: str | None = None
 ) -> TaskProposal:
+    """A knowledge-base idea as a proposal: its class gives the category, the states, the parts and the
+    auxiliary objects."""
     hc = kb.hazard_classes[idea.class_id]
-    return TaskProposal(
+    return build_proposal(
+        idea,
+        texts,
         id=task_id(index, texts.name),
+        category=hc.category,
+        states=scene_states(idea, kb),
+        auxiliary_items=auxiliary_items(idea, kb),
+        articulations=articulations_for(idea, kb),
+        engine=engine,
+        mode=mode,
+        seed=seed,
+        model=model,
+    )
+
+
+def build_proposal(
+    idea: Idea,
+    texts: Texts,
+    *,
+    id: str,
+    category: HazardCategory,
+    auxiliary_items: list[AuxiliaryItem],
+    articulations: list[ArticulationUse],
+    engine: Engine,
+    mode: BrainstormMode,
+    seed: int | None,
+    model: str | None = None,
+    states: dict[str, list[str]] | None = None,
+    hazard_other: str | None = None,
+    grounding: list[GroundingMatch] | None = None,
+) -> TaskProposal:
+    """The one place a TaskProposal is put together from an idea, its texts and what the engine worked
+    out around them (category, states, parts, auxiliary objects; for the LLM engine also the grounding
+    of the model's names). Raises pydantic's ValidationError when a piece does not fit the schema."""
+    return TaskProposal(
+        id=id,
         name=texts.name,
         explanation=texts.explanation,
         description=texts.description,
-        category=hc.category,
-        hazard_class=hc.id,
+        category=category,
+        hazard_class=idea.class_id,
+        hazard_other=hazard_other,
         target_asset=idea.target,
         scenario=Scenario(
             hazard_object=idea.hazard,
@@ -158,10 +197,10 @@ def to_proposal(
             person_at_risk=idea.person,
             container=idea.container,
             co_objects=list(idea.co_objects),
-            states=scene_states(idea, kb),
+            states=states or {},
         ),
-        auxiliary_items=auxiliary_items(idea, kb),
-        articulations=articulations_for(idea, kb),
+        auxiliary_items=auxiliary_items,
+        articulations=articulations,
         solution=texts.solution,
         success_condition=texts.success_condition,
         provenance=Provenance(
@@ -174,4 +213,5 @@ def to_proposal(
             seed=seed,
             model=model,
         ),
+        grounding=grounding or [],
     )

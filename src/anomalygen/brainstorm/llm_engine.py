@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pydantic import ValidationError
 
 from anomalygen.brainstorm.ground_names import ground_llm_names
-from anomalygen.brainstorm.idea import ASPECTS, task_id
+from anomalygen.brainstorm.idea import ASPECTS, Idea, Texts, build_proposal, task_id
 from anomalygen.brainstorm.knowledge_engine import agent_roles, split_quota
 from anomalygen.brainstorm.llm_reply import LLMProposal
 from anomalygen.brainstorm.validate import proposal_problems
@@ -33,8 +33,6 @@ from anomalygen.schema import (
     AuxiliaryItem,
     BrainstormMode,
     Engine,
-    Provenance,
-    Scenario,
     TaskProposal,
     format_validation_error,
 )
@@ -265,38 +263,40 @@ class LLMEngine:
             + [(c, "part of the setting") for c in g.co_objects]
             if n and n != g.target_asset
         ]
+        idea = Idea(
+            class_id=g.hazard_class,
+            target=g.target_asset,
+            hazard=g.hazard_object,
+            placement=g.placement,
+            room=g.room,
+            person=raw.person_at_risk,
+            container=g.container,
+            co_objects=tuple(g.co_objects),
+            agent=role,
+            round=r,
+            builds_on=tuple(b for b in raw.builds_on if b in shown_ids),
+            borrowed=tuple(b for b in raw.borrowed if b in ASPECTS),
+        )
+        texts = Texts(
+            name=raw.name.strip() or "untitled",
+            explanation=raw.explanation,
+            description=raw.description,
+            solution=raw.solution,
+            success_condition=raw.success_condition,
+        )
         try:
-            proposal = TaskProposal(
+            proposal = build_proposal(
+                idea,
+                texts,
                 id="pending",
-                name=raw.name.strip() or "untitled",
-                explanation=raw.explanation,
-                description=raw.description,
                 category=category,
-                hazard_class=g.hazard_class,
                 hazard_other=g.hazard_other,
-                target_asset=g.target_asset,
-                scenario=Scenario(
-                    hazard_object=g.hazard_object,
-                    room=g.room,
-                    placement=g.placement,
-                    person_at_risk=raw.person_at_risk,
-                    container=g.container,
-                    co_objects=g.co_objects,
-                ),
                 auxiliary_items=aux,
                 articulations=articulations,
-                solution=raw.solution,
-                success_condition=raw.success_condition,
-                provenance=Provenance(
-                    engine=Engine.LLM,
-                    mode=BrainstormMode(self.mode),
-                    agent_role=role,
-                    round=r,
-                    builds_on=[b for b in raw.builds_on if b in shown_ids],
-                    borrowed=[b for b in raw.borrowed if b in ASPECTS],
-                    seed=self.seed,
-                    model=getattr(self.client, "model", None),
-                ),
+                engine=Engine.LLM,
+                mode=BrainstormMode(self.mode),
+                seed=self.seed,
+                model=getattr(self.client, "model", None),
                 grounding=g.matches,
             )
         except ValidationError as exc:

@@ -18,6 +18,7 @@ from collections.abc import Mapping, Sequence
 from pydantic import Field
 
 from anomalygen.evaluate.detection_scores import DetectionScores, claims_on, finds, score
+from anomalygen.evaluate.rate import Rate
 from anomalygen.runfolder import RunFolder
 from anomalygen.schema import Artefact, Detection, HazardManifest, Strict, TaskProposal
 from anomalygen.tables import group_table
@@ -28,17 +29,6 @@ SUMMARY_FILE = "detections_summary.json"
 
 def summary_path(run: RunFolder):
     return run.root / SUMMARY_FILE
-
-
-class Found(Strict):
-    """Recall within one group of truth hazards."""
-
-    hazards: int = 0
-    found: int = 0
-
-    @property
-    def recall(self) -> float:
-        return self.found / self.hazards if self.hazards else 0.0
 
 
 class MissedHazard(Strict):
@@ -66,8 +56,8 @@ class DetectionReport(Artefact):
     errors: int = 0
     overall: DetectionScores | None = Field(None, description="against the scenes' truth.json; None without any")
     per_detector: dict[str, DetectionScores] = Field(default_factory=dict)
-    per_category: dict[str, dict[str, Found]] = Field(
-        default_factory=dict, description="category -> hazard class -> truth hazards found")
+    per_category: dict[str, dict[str, Rate]] = Field(
+        default_factory=dict, description="category -> hazard class -> truth hazards (n) and those found (successes)")
     confusion: dict[str, dict[str, int]] = Field(
         default_factory=dict, description="truth class -> class first claimed on its object ('none') -> count")
     misses: list[MissedHazard] = Field(default_factory=list)
@@ -75,10 +65,10 @@ class DetectionReport(Artefact):
     unjudged_scenes: list[str] = Field(default_factory=list, description="detections whose scene has no truth.json")
     text_judge: TextJudgeDiagnostic | None = None
 
-    def per_category_found(self) -> dict[str, Found]:
-        out: dict[str, Found] = {}
+    def per_category_found(self) -> dict[str, Rate]:
+        out: dict[str, Rate] = {}
         for cat, classes in self.per_category.items():
-            out[cat] = Found(hazards=sum(f.hazards for f in classes.values()), found=sum(f.found for f in classes.values()))
+            out[cat] = Rate(n=sum(f.n for f in classes.values()), successes=sum(f.successes for f in classes.values()))
         return out
 
 
@@ -100,17 +90,17 @@ def summarise(detections: Sequence[Detection], tasks: Sequence[TaskProposal], ma
     dets = [d for d in detections if d.task_id in by_task] if by_task else list(detections)
     k = max([k, *(len(d.hypotheses) for d in dets)])
     judged = [d for d in dets if d.task_id in manifests]
-    per_cat: dict[str, dict[str, Found]] = defaultdict(dict)
+    per_cat: dict[str, dict[str, Rate]] = defaultdict(dict)
     confusion: dict[str, Counter] = defaultdict(Counter)
     misses: list[MissedHazard] = []
     for d in judged:
         hyps = sorted(d.hypotheses, key=lambda h: h.rank)
         for z in manifests[d.task_id].hazards:
             cat = (category_of or {}).get(z.hazard_class, "unknown")
-            cell = per_cat[cat].setdefault(z.hazard_class, Found())
-            cell.hazards += 1
+            cell = per_cat[cat].setdefault(z.hazard_class, Rate())
+            cell.n += 1
             hit = finds(hyps, z)
-            cell.found += int(hit)
+            cell.successes += int(hit)
             on_object = claims_on(hyps, z)
             confusion[z.hazard_class][(on_object[0].hazard_class or "free_text") if on_object else "none"] += 1
             if not hit:
@@ -156,9 +146,9 @@ def print_report(report: DetectionReport, *, console=None, max_misses: int = 20)
         console.print(f"[bold]{title}[/bold]\n  recall {sc.recall:.3f} ({sc.found}/{sc.hazards} hazards), precision "
                       f"{sc.precision:.3f} ({sc.true_claims}/{sc.claims} claims), F1 {sc.f1:.3f}; false alarms {alarms}\n"
                       f"  on the {sc.single_hazard_scenes} single-hazard scenes: {hits}", highlight=False)
-        rows = {cat: [(cls, [str(f.hazards), str(f.found), f"{f.recall:.2f}"]) for cls, f in classes.items()]
+        rows = {cat: [(cls, [str(f.n), str(f.successes), f"{f.rate:.2f}"]) for cls, f in classes.items()]
                 for cat, classes in report.per_category.items()}
-        totals = {cat: [str(f.hazards), str(f.found), f"{f.recall:.2f}"] for cat, f in report.per_category_found().items()}
+        totals = {cat: [str(f.n), str(f.successes), f"{f.rate:.2f}"] for cat, f in report.per_category_found().items()}
         console.print(group_table("recall by category and class (truth hazards)", ["hazards", "found", "recall"],
                                   rows, totals))
         off = [(t, p, n) for t, row in report.confusion.items() for p, n in row.items() if p != t]

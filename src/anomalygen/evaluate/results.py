@@ -12,6 +12,7 @@ from pydantic import Field
 
 from anomalygen.evaluate.detection_report import DetectionReport
 from anomalygen.evaluate.hazard_table import HazardTable
+from anomalygen.evaluate.rate import Rate
 from anomalygen.schema import Artefact, LLMUsage, StageRecord, Strict
 
 
@@ -27,15 +28,6 @@ class DiversityRow(Strict):
     image: float | None = None
     clip: float | None = None
     image_embedder: str | None = None
-
-
-class Rate(Strict):
-    n: int = 0
-    successes: int = 0
-
-    @property
-    def rate(self) -> float:
-        return self.successes / self.n if self.n else 0.0
 
 
 class VerdictCounts(Strict):

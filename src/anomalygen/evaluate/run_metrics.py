@@ -9,7 +9,8 @@ from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
-from anomalygen.evaluate.results import Rate, SuccessSummary, VerdictCounts
+from anomalygen.evaluate.rate import Rate
+from anomalygen.evaluate.results import SuccessSummary, VerdictCounts
 from anomalygen.evaluate.verdicts import RunVerdict, verdict_of
 from anomalygen.runfolder import RunFolder, read_jsonl, try_read_model
 from anomalygen.scene_files import RESULT, SCENE_SPEC, render_file

@@ -117,8 +117,8 @@ def _recall_rows(d: DetectionReport) -> list[list]:
     totals = d.per_category_found()
     for cat, classes in d.per_category.items():
         t = totals[cat]
-        rows.append([cat, t.hazards, t.found, fmt(t.recall, 2)])
-        rows.extend([f"\u2003{cls}", f.hazards, f.found, fmt(f.recall, 2)] for cls, f in classes.items())
+        rows.append([cat, t.n, t.successes, fmt(t.rate, 2)])
+        rows.extend([f"\u2003{cls}", f.n, f.successes, fmt(f.rate, 2)] for cls, f in classes.items())
     return rows
 
 

@@ -7,7 +7,8 @@ column, labelled as such.
 
 from __future__ import annotations
 
-from anomalygen.evaluate.results import Rate, SuccessSummary, VerdictCounts
+from anomalygen.evaluate.rate import Rate
+from anomalygen.evaluate.results import SuccessSummary, VerdictCounts
 from anomalygen.tables import group_table
 
 COLUMNS = ("resolved", "no action / on safe", "new hazard", "robot's own check")
