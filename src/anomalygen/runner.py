@@ -5,9 +5,10 @@ Every stage uses this one code path, locally (inline or a process pool) or on Ra
 (picklable) and write their own outputs atomically through :mod:`anomalygen.runfolder`.
 
 Resume notices change: each item's fingerprint (its payload, the input files it reads and the
-stage's config section, :func:`anomalygen.runfolder.fingerprint`) is recorded when the item
-succeeds, and an item counts as done only when its outputs are valid *and* the recorded fingerprint
-is the current one. A re-planned task re-runs its skill; a rebuilt scene is detected again.
+settings it reads, :func:`config_section`; :func:`anomalygen.runfolder.fingerprint`) is recorded
+when the item succeeds, and an item counts as done only when its outputs are valid *and* the
+recorded fingerprint is the current one. A re-planned task re-runs its skill; a rebuilt scene is
+detected again; a setting no item of the stage reads redoes nothing.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import sys
 import tempfile
 import time
 import traceback
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -221,13 +222,23 @@ def _run_ray(todo, fn, ctx, settings: Settings, advance) -> dict[str, tuple[bool
             ray.shutdown()
 
 
-def config_section(settings: Settings, section: str, *, exclude: Sequence[str] = (), llm: bool = False) -> dict:
-    """A stage's config section for its fingerprint, less the keys that change no item's output
-    (``exclude``: e.g. how many seeds to run); with ``llm``, the model that answers and how."""
-    out: dict[str, Any] = {section: getattr(settings, section).model_dump(mode="json", exclude=set(exclude)),
-                           "seed": settings.seed}
+def config_section(settings: Settings, section: str, *, exclude: Sequence[str] = (),
+                   also: Mapping[str, Sequence[str]] | None = None, seed: bool = True, llm: bool = False) -> dict:
+    """What a stage's items read of the settings, for their fingerprint: the stage's own section less
+    the keys that change no item's output (``exclude``: e.g. how many seeds to run); ``also``: the keys
+    it reads of other sections (``{"plan": ("max_fixes",)}``); ``seed``: the run's master seed; with
+    ``llm``, the model that answers and how (``LLM_IDENTITY``, with any ``also["llm"]`` keys).
+
+    Each stage declares its call in one function, ``reads(settings)``, next to its ``run_stage``, so
+    resume redoes an item when a setting it reads changes, and only then."""
+    out: dict[str, Any] = {section: getattr(settings, section).model_dump(mode="json", exclude=set(exclude))}
+    if seed:
+        out["seed"] = settings.seed
+    others = {name: set(keys) for name, keys in (also or {}).items()}
     if llm:
-        out["llm"] = settings.llm.model_dump(mode="json", include=set(LLM_IDENTITY))
+        others["llm"] = others.get("llm", set()) | set(LLM_IDENTITY)
+    for name, keys in others.items():
+        out[name] = getattr(settings, name).model_dump(mode="json", include=keys)
     return out
 
 

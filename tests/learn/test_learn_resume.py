@@ -1,5 +1,6 @@
-"""Resume notices change: a changed detection re-plans, a changed plan re-runs its skill; a mistyped
-``--only`` id is an error in every per-item stage."""
+"""Resume notices change: a changed detection re-plans, a changed plan re-runs its skill, a changed
+setting the skill reads re-runs it (and no other setting does); a mistyped ``--only`` id is an error
+in every per-item stage."""
 
 from __future__ import annotations
 
@@ -12,6 +13,9 @@ from anomalygen.config import Settings
 from anomalygen.errors import UserError
 from anomalygen.runfolder import RunFolder, read_jsonl, read_model, write_jsonl, write_model
 from anomalygen.schema import Detection, Plan, PredicateCall, SkillResult, SuccessSpec
+from support.resume import assert_resume, stage_reads
+from support.resume import cases as resume_cases
+from support.resume import settings as resume_settings
 
 
 def _settings() -> Settings:
@@ -81,3 +85,21 @@ def test_an_unknown_only_id_is_an_error_in_every_stage(tmp_path, stage):
     with pytest.raises(UserError, match=r"unknown task id in --only: 't0002-pill' \(closest: 't0002-pills'\); "
                                         r"the run has 2 task ids"):
         registered(stage).run(run, _settings(), only=["t0002-pill"])
+
+
+LEARN_BASES = {"recheck": {}, "no_recheck": {"learn": {"recheck": False}}}
+
+
+@pytest.mark.parametrize(("base", "key", "redo"), resume_cases("learn", LEARN_BASES))
+def test_runs_are_redone_exactly_when_a_setting_they_read_changes(request, base, key, redo):
+    """With a cheap double of the item: ``[learn]`` less ``seeds`` and, with the look-again on,
+    ``plan.max_fixes`` redo every run; any other key (the master seed, ``[plan]``'s other keys) none."""
+    assert_resume("learn", request, base, key, redo=redo)
+
+
+def test_the_learn_stage_reads_max_fixes_only_for_its_look_again():
+    read = stage_reads("learn", resume_settings())
+    assert {"learn.sac_steps", "learn.recheck", "plan.max_fixes"} <= set(read)
+    assert "learn.seeds" not in read and "seed" not in read
+    assert [k for k in read if not k.startswith("learn.")] == ["plan.max_fixes"]
+    assert "plan.max_fixes" not in stage_reads("learn", resume_settings(**LEARN_BASES["no_recheck"]))

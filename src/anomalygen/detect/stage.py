@@ -112,6 +112,14 @@ def _is_done_for(run: RunFolder, settings: Settings):
     return is_done
 
 
+def reads(settings: Settings) -> dict:
+    """What a detect item reads of the settings (its fingerprint's config part): all of ``[detect]``;
+    the master seed when ``detect.noise`` is on (the noise is drawn from it); the LLM's identity for the
+    llm and hybrid detectors (they ask it with a fixed seed of their own)."""
+    return config_section(settings, "detect", seed=settings.detect.noise.enabled,
+                          llm=settings.detect.detector != "rules")
+
+
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
     tasks = run.load_tasks()
     check_only(only, [t.id for t in tasks])
@@ -127,7 +135,7 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
                         is_done=_is_done_for(run, settings), force=force,
                         description=f"detect ({settings.detect.detector})",
                         inputs=lambda tid: [_graph_path(run, tid)],
-                        config=config_section(settings, "detect", llm=settings.detect.detector != "rules"))
+                        config=reads(settings))
     _record_llm_usage(run, summary)
 
     detections = [d for t in tasks if (d := try_read_model(detection_path(run, t.id), Detection)) is not None]

@@ -96,6 +96,14 @@ def _print_table(table: dict[str, dict[str, float]]) -> None:
     print_with_total(t, table, TABLE_COUNTS, cells)
 
 
+def reads(settings: Settings) -> dict:
+    """What a learn item reads of the settings (its fingerprint's config part): ``[learn]`` less
+    ``seeds`` (adding seeds runs only the new ones) and, with ``learn.recheck``, ``plan.max_fixes`` (how
+    many hazards the look-again fixes). Not the master seed: an item's seed is its own."""
+    return config_section(settings, "learn", exclude=("seeds",), seed=False,
+                          also={"plan": ("max_fixes",)} if settings.learn.recheck else None)
+
+
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
     items: list[tuple[str, dict]] = []
     tasks = run.load_tasks()
@@ -114,7 +122,7 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
 
     summary = run_items(run, STAGE, items, learn_item, settings=settings, is_done=done, force=force,
                         inputs=lambda item_id: _inputs(run, _split(item_id)[0]),
-                        config=config_section(settings, "learn", exclude=("seeds",)))
+                        config=reads(settings))
     table = success_table(run, items, {t.id: t.hazard_class for t in tasks})
     summary.results["by_class"] = table
     if not settings.quiet and table:

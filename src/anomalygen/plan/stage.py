@@ -23,7 +23,7 @@ from anomalygen.errors import ItemFailed, UserError
 from anomalygen.runfolder import RunFolder, read_jsonl, try_read_model, write_model
 from anomalygen.runner import StageContext, StageSummary, check_only, config_section, run_items
 from anomalygen.scene_files import SCENE_GRAPH, SCENE_SPEC
-from anomalygen.schema import Detection, DroppedFix, Plan, SceneSpec, SuccessSpec, TaskProposal
+from anomalygen.schema import Detection, DroppedFix, Engine, Plan, SceneSpec, SuccessSpec, TaskProposal
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
@@ -151,6 +151,14 @@ def _plan_with_llm(task_id: str, payload: dict, ctx: StageContext, hazard_class:
             record_usage(ctx.run, usage)
 
 
+def reads(settings: Settings) -> dict:
+    """What a plan item reads of the settings (its fingerprint's config part): all of ``[plan]``; with
+    the llm engine (``plan.engine``, or a configured LLM while it is unset), the model that answers and
+    the seed it is asked with. Not ``[learn]``: the plan stage reads none of it."""
+    llm = settings.engine_for("plan") == Engine.LLM
+    return config_section(settings, "plan", seed=llm, llm=llm)
+
+
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
     engine = settings.engine_for("plan")
     if engine.value == "llm" and not settings.llm.configured:
@@ -179,4 +187,4 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
 
     return run_items(run, STAGE, items, plan_item, settings=settings, is_done=done, force=force, workers=1,
                      inputs=lambda tid: [run.scene_dir(tid) / SCENE_SPEC, run.scene_dir(tid) / SCENE_GRAPH],
-                     config=config_section(settings, "learn", exclude=("seeds",), llm=engine.value == "llm"))
+                     config=reads(settings))

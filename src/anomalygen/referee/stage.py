@@ -7,8 +7,10 @@ in ``judged_graph.json``. Runs from before the state was saved are judged on the
 ``final_graph.json`` as it was (``judged_from = "graph"``).
 
 An item is done when every run has a verdict and its fingerprint (the scene, its truth, each run's
-result and final state) is unchanged, so re-running learn or rebuilding the scene redoes the judging. After the items: the fixes table by hazard class — the referee's verdict, with
-the robot's own check beside it. (Detections are scored against the truth on the evaluate side.)
+result and final state) is unchanged, so re-running learn or rebuilding the scene redoes the judging;
+no setting does, as the judge reads none (``reads``). After the items: the fixes table by hazard
+class — the referee's verdict, with the robot's own check beside it. (Detections are scored against
+the truth on the evaluate side.)
 """
 
 from __future__ import annotations
@@ -164,13 +166,20 @@ def _print_table(table: dict[str, dict[str, float]]) -> None:
     print_with_total(t, table, TABLE_COUNTS, cells)
 
 
+def reads(settings: Settings) -> None:
+    """What a judge item reads of the settings (its fingerprint's config part): nothing. The referee
+    judges from the files alone (the scene, its truth, each run's end state) with its own fixed
+    settle, so no setting redoes a verdict; a changed input file does."""
+    return None
+
+
 def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None) -> StageSummary:
     tasks = run.load_tasks()
     check_only(only, [t.id for t in tasks])
     chosen = [t for t in tasks if (not only or t.id in only) and (run.scene_dir(t.id) / SCENE_SPEC).is_file()]
     items = [(t.id, {}) for t in chosen]
     summary = run_items(run, STAGE, items, judge_item, settings=settings, is_done=_is_done_for(run), force=force,
-                        description="judge", inputs=lambda task_id: _inputs(run, task_id))
+                        description="judge", inputs=lambda task_id: _inputs(run, task_id), config=reads(settings))
     table = verdict_table(run, chosen)
     summary.results["by_class"] = table
     if not settings.quiet and table:

@@ -66,8 +66,18 @@ class _one_torch_thread:
         torch.set_num_threads(self.before)
 
 
+def reads(settings: Settings) -> dict:
+    """What a build item reads of the settings (its fingerprint's config part): all of ``[build]`` and
+    the master seed; the LLM's identity when it lays the scene out (``build.engine = llm``) or checks
+    the render (a configured LLM with ``llm.vision``, ``scene/verify.py``; then ``llm.vision`` too).
+    A configured LLM that does neither is not read: its settings redo no scene."""
+    vlm = settings.llm.configured and settings.llm.vision
+    return config_section(settings, "build", also={"llm": ("vision",)} if vlm else None,
+                          llm=settings.build.engine == Engine.LLM or vlm)
+
+
 def run_stage(
-    run: RunFolder, settings, *, force: bool = False, only: list[str] | None = None
+    run: RunFolder, settings: Settings, *, force: bool = False, only: list[str] | None = None
 ) -> StageSummary:
     tasks = run.load_tasks()
     check_only(only, [t.id for t in tasks])
@@ -84,7 +94,7 @@ def run_stage(
         is_done=lambda task_id: scene_ok(run.scene_dir(task_id)),
         force=force,
         description="build scenes",
-        config=config_section(settings, "build", llm=settings.build.engine == Engine.LLM),
+        config=reads(settings),
     )
     try:
         write_contact_sheet(run, seed=settings.seed)
