@@ -5,7 +5,7 @@ planned by the knowledge planner because the KB marks the recipe step ``"method"
 LLM-planned SAC step that drives a knob or switch to off: the skill claims those too, when rewards are
 specs):
 
-1. :func:`~anomalygen.skills.learned.part_skill.grasp_part` puts the cup on the part's face and holds it (the
+1. :func:`~anomalygen.skills.part_motion.grasp_part` puts the cup on the part's face and holds it (the
    approach is motion-planned, as RoboGen pre-positions before an RL sub-task).
 2. The warm start (``anomalygen/data/policies/switch_off.zip``, trained over many built scenes by
    ``benchmarks/train_warm_start.py``) is evaluated on a snapshot of this scene
@@ -75,14 +75,8 @@ def run_part_subtask(ep: Episode, st: SubTask, plan: Plan, *, steps: int, seed: 
                      warm_start: Path | None | str = "shipped", log=None) -> SkillOutcome:
     """Grasp the part, fine-tune the family policy on this scene (if needed), execute it on the Driver."""
     from anomalygen.skills.learned.part_env import HORIZON, PartStart, make_part_env
-    from anomalygen.skills.learned.part_skill import (
-        PartReadout,
-        grasp_part,
-        lead_held_part,
-        let_go,
-        pulled_to_off,
-    )
     from anomalygen.skills.learned.sac import train_sac
+    from anomalygen.skills.part_motion import PartReadout, grasp_part, lead_held_part, let_go, pulled_to_off
 
     drv = ep.driver
     joint = str(st.params.get("joint", ""))

@@ -1,7 +1,7 @@
 """Switching a control off by script: hold the knob, switch or snuffer by suction and lead it to off.
 
 The learned switch-off skill (:mod:`~anomalygen.skills.learned.part_subtask`) and this primitive share
-the family's grasp (:func:`~anomalygen.skills.learned.part_skill.grasp_part`: the cup on the part's face,
+the family's grasp (:func:`~anomalygen.skills.part_motion.grasp_part`: the cup on the part's face,
 off the axis for a knob, on top for a push switch), its observation (``PartReadout``) and its control
 loop (``lead_held_part``); here the actions come from the family's scripted reference
 (``reference_action``) instead of a policy. It is what a ``push`` or ``switch_off`` step on a control
@@ -17,6 +17,16 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from anomalygen.schema import CLOSED_TOL, part_labels
+from anomalygen.skills.part_motion import (
+    POS_SCALE,
+    REFERENCE_MOVE,
+    PartReadout,
+    grasp_part,
+    lead_held_part,
+    let_go,
+    pulled_to_off,
+    reference_action,
+)
 from anomalygen.skills.registry import SkillOutcome
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -37,7 +47,6 @@ def paced(readout):
     axis is more than a radian, the cup runs off the dial's circle and the weld hauls the appliance
     after it (a 3 kg fan heater tipped over)."""
     from anomalygen.robot.agent import Agent
-    from anomalygen.skills.learned.part_skill import POS_SCALE, REFERENCE_MOVE, reference_action
 
     def act(obs: np.ndarray) -> np.ndarray:
         lever = float(np.linalg.norm(obs[6:9])) / POS_SCALE if readout.hinge else 1.0
@@ -50,14 +59,6 @@ def paced(readout):
 
 def switch_off_control(ep: Episode, joint: str, closed: float, far: float) -> SkillOutcome:
     """Hold the control ``joint`` (off at ``closed``, fully on at ``far``) and lead it to off."""
-    from anomalygen.skills.learned.part_skill import (
-        PartReadout,
-        grasp_part,
-        lead_held_part,
-        let_go,
-        pulled_to_off,
-    )
-
     drv = ep.driver
     s0 = drv.steps
     readout = PartReadout(drv.model, joint, closed, far)

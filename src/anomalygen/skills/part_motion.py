@@ -1,4 +1,9 @@
-"""The switch-off family as a learnable sub-task: hold a knob or switch by suction and turn it to off.
+"""Moving a part held by suction, for the switch-off family: grasp a knob or switch, read it, lead it, let go.
+
+Below both kinds of skill: the scripted primitive (:mod:`~anomalygen.skills.scripted.controls`, the
+family's reference paced) and the learned skill (:mod:`~anomalygen.skills.learned.part_subtask`, its
+env :mod:`~anomalygen.skills.learned.part_env`, a policy) hold, read, lead and let go of a part through
+this module, so neither imports the other for it (``tests/test_layout.py``).
 
 Why a family-level observation: appliances differ (an oven has 2-5 front knobs turning about a
 horizontal axis, a toaster one side knob, a coffee machine a push button on top, a kettle a switch
@@ -40,6 +45,9 @@ if TYPE_CHECKING:  # pragma: no cover
     from anomalygen.skills.episode import Episode
 
 POS_SCALE = 10.0  # positions in dm (~unit scale for the networks)
+# Physics steps per 7-D action while a part is led, here and in the family's env (skills/learned/part_env.py),
+# so a policy is replayed at the rate it learned at (the shipped warm start: 2, as every SAC env here).
+FRAMESKIP = 2
 OBS_DIM = 17
 OFF_AXIS = 0.6  # grasp this fraction of the knob radius away from its axis: a lever for the hold
 PRE_CONTACT = 0.04  # m in front of the face before the final approach
@@ -150,8 +158,6 @@ def lead_held_part(ep: Episode, readout: PartReadout, act, *, horizon: int,
     stays tipped. With ``past_ok`` a part led beyond off (into its stop) is off too: a button pulled out
     past its stop by the weld sprang back in when let go. Returns (off, control steps taken, why it
     stopped early or "")."""
-    from anomalygen.skills.learned.subtask_env import FRAMESKIP
-
     drv = ep.driver
     m, d = drv.model, drv.data
     holder = int(m.body_parentid[readout.body])
@@ -219,8 +225,8 @@ def let_go(ep: Episode, joint: str, *, pulled: bool = False) -> None:
 class PartReadout:
     """The family's observation and success for one joint, on any (model, data) of the scene.
 
-    Used both by :class:`~anomalygen.skills.learned.subtask_env.SubTaskEnv` (via ``obs_mode="part"``) and by the
-    replay on the Driver's data, so training and execution read the same numbers.
+    Used both by :class:`~anomalygen.skills.learned.part_env.PartTurnEnv` and by the lead on the Driver's
+    data (a policy's replay, the scripted reference), so training and execution read the same numbers.
     """
 
     def __init__(self, model, joint: str, closed: float, far: float):
