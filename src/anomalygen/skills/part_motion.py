@@ -34,6 +34,7 @@ axis (or out along a button's axis) without losing the hold, dragging the applia
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -42,6 +43,8 @@ from anomalygen.mjgeom import geom_world_aabbs
 from anomalygen.schema import CLOSED_TOL
 
 if TYPE_CHECKING:  # pragma: no cover
+    from collections.abc import Callable
+
     from anomalygen.skills.episode import Episode
 
 POS_SCALE = 10.0  # positions in dm (~unit scale for the networks)
@@ -220,6 +223,38 @@ def let_go(ep: Episode, joint: str, *, pulled: bool = False) -> None:
     finally:
         drv.dp = dp
     drv.straighten_wrist(lift=0.1, lift_steps=30)
+
+
+@dataclass
+class Lead:
+    """What one hold of a part and its lead towards off came to (:func:`hold_and_lead`)."""
+
+    held: bool  # the cup took hold of the part
+    why: str  # grasp_part's word: what the cup holds, or why it did not take hold
+    off: bool = False  # the lead brought the part to off (before letting go)
+    steps: int = 0  # control steps the lead took
+    stopped: str = ""  # why the lead stopped early ("" when it did not)
+    led_to: float = 0.0  # the joint's value where the lead left it, before letting go
+
+
+def hold_and_lead(ep: Episode, readout: PartReadout, policy: Callable[[], Callable[[np.ndarray], np.ndarray]], *,
+                  horizon: int, tol: float = CLOSED_TOL) -> Lead:
+    """The family's one sequence, for the scripted primitive and the learned skill alike: hold the part
+    by suction (:func:`grasp_part`), lead it towards off (:func:`lead_held_part`) with the actions of
+    ``policy()``, asked once the part is held (the learned skill fine-tunes there, on a snapshot of the
+    hold, and puts the state back), and let go (:func:`let_go`). A part that comes out towards the cup to
+    go off (:func:`pulled_to_off`) counts as off led past it and is let go where it is. Nothing is led
+    or let go when the cup does not take hold."""
+    held, why = grasp_part(ep, readout.joint)
+    if not held:
+        return Lead(False, why)
+    act = policy()
+    drv = ep.driver
+    pulled = pulled_to_off(drv.model, drv.data, readout)
+    off, t, stopped = lead_held_part(ep, readout, act, horizon=horizon, tol=tol, past_ok=pulled)
+    led_to = float(drv.data.joint(readout.joint).qpos[0])
+    let_go(ep, readout.joint, pulled=pulled)
+    return Lead(True, why, off, t, stopped, led_to)
 
 
 class PartReadout:
