@@ -1,10 +1,10 @@
 """Train the switch-off family's warm start over built scenes and measure it on held-out scenes.
 
 The learn stage loads ``anomalygen/data/policies/switch_off.zip`` for every switch-off sub-task
-(``rl/part_subtask.py``) and fine-tunes it only where it does not already succeed. This script makes
+(``skills/learned/part_subtask.py``) and fine-tunes it only where it does not already succeed. This script makes
 that file: it collects, for each built scene of the class ``switch_off_appliance`` in the training
 run folder, one start per knob or switch that is on (the cup holding the part after
-``part_skill.grasp_part``), trains one SAC policy on all of them at once (``PartTurnEnv`` picks a
+``part_motion.grasp_part``), trains one SAC policy on all of them at once (``PartTurnEnv`` picks a
 start per episode; ``--n-envs`` vectorised envs), evaluates during training on the held-out run
 folder's scenes, and finally measures the saved policy on every held-out start over ``--eval-seeds``
 seeded episodes (different start noise). Scenes come from the real pipeline (knowledge brainstorm
@@ -56,8 +56,8 @@ def starts_of(run: Path, log=lambda m: print(m, file=sys.stderr)) -> list:
     from anomalygen.schema import SceneSpec
     from anomalygen.skills.episode import Episode
     from anomalygen.skills.learned.part_env import PartStart
-    from anomalygen.skills.learned.part_skill import grasp_part
     from anomalygen.skills.learned.part_subtask import far_value
+    from anomalygen.skills.part_motion import grasp_part
     from anomalygen.world.graph import load_scene
     from anomalygen.world.perception import perceived_spec
 
@@ -87,11 +87,11 @@ def starts_of(run: Path, log=lambda m: print(m, file=sys.stderr)) -> list:
 
 
 def demonstrations(starts, episodes: int, seed: int) -> dict:
-    """Transitions of the scripted reference (``part_skill.reference_action``) on the training starts."""
+    """Transitions of the scripted reference (``part_motion.reference_action``) on the training starts."""
     import numpy as np
 
     from anomalygen.skills.learned.part_env import make_part_env
-    from anomalygen.skills.learned.part_skill import reference_action
+    from anomalygen.skills.part_motion import reference_action
 
     env = make_part_env(starts)
     cols = {k: [] for k in ("obs", "next_obs", "action", "reward", "done")}

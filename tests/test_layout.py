@@ -197,6 +197,35 @@ def test_the_reach_check_follows_imports_through_shared_modules():
              "anomalygen.world.graph": set()}
     assert _forbidden_paths(edges, ROBOT_SIDE, FORBIDDEN) == [
         ["anomalygen.plan.x", "anomalygen.shared", "anomalygen.truth.manifest"]]
+
+
+SCRIPTED_SKILLS = ("anomalygen.skills.scripted",)
+LEARNED_SKILLS = ("anomalygen.skills.learned",)
+
+
+def test_scripted_skills_reach_no_learned_skill():
+    """What scripted and learned skills both need (grasping a part, its readout, leading it, letting go,
+    the reference action) lives below both, in ``skills/part_motion.py``: no module under
+    ``skills/scripted`` imports one under ``skills/learned``, not inside a function either, nor through
+    a module in between."""
+    edges = _module_graph()
+    # the switch-off primitive holds and leads a control through the shared module
+    assert "anomalygen.skills.part_motion" in edges["anomalygen.skills.scripted.controls"]
+    # and the learned skill does too (an import inside run_part_subtask, counted as any other)
+    assert "anomalygen.skills.part_motion" in edges["anomalygen.skills.learned.part_subtask"]
+    paths = _forbidden_paths(edges, SCRIPTED_SKILLS, LEARNED_SKILLS)
+    assert paths == [], "scripted skills reach learned ones: " + "; ".join(" -> ".join(p) for p in paths)
+
+
+def test_the_scripted_check_sees_an_import_of_a_learned_skill_direct_or_through_a_shared_module():
+    edges = {"anomalygen.skills.scripted.a": {"anomalygen.skills.learned.x"},
+             "anomalygen.skills.scripted.b": {"anomalygen.skills.shared"},
+             "anomalygen.skills.shared": {"anomalygen.skills.learned.x"}, "anomalygen.skills.learned.x": set()}
+    assert _forbidden_paths(edges, SCRIPTED_SKILLS, LEARNED_SKILLS) == [
+        ["anomalygen.skills.scripted.a", "anomalygen.skills.learned.x"],
+        ["anomalygen.skills.scripted.b", "anomalygen.skills.shared", "anomalygen.skills.learned.x"]]
+
+
 def _string_constants(tree: ast.AST) -> list[str]:
     """Every string literal of a module, f-string pieces included."""
     return [n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)]

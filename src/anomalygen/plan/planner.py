@@ -151,7 +151,7 @@ def switch_off_subtasks(index: int, args: dict[str, str], bindings: dict[str, st
                         final_success: list[PredicateCall], method: SkillMethod) -> list[SubTask]:
     """A switch_off step -> one sub-task per knob or switch of the appliance that is on, most on first.
 
-    The learned skill turns one part (``skills/learned/part_skill.py``), and an oven has up to five knobs on; the
+    The learned skill turns one part (``skills/learned/part_subtask.py``), and an oven has up to five knobs on; the
     scene spec (perceived joint values) says which. Each sub-task's reward is the part's travel to off
     as a fraction (the joint term scaled by 1 / travel, so a 4.7 rad knob and a 4 mm button weigh the
     same) plus the cup near the part; the class's predicates check the last one, earlier ones are

@@ -30,9 +30,9 @@ def built(tmp_path_factory):
 def _held_start(scene_dir, plan, k: int = 0):
     from anomalygen.skills.episode import Episode
     from anomalygen.skills.learned.part_env import PartStart
-    from anomalygen.skills.learned.part_skill import grasp_part
     from anomalygen.skills.learned.part_subtask import far_value
     from anomalygen.skills.learned.sac_subtask import snapshot
+    from anomalygen.skills.part_motion import grasp_part
     from anomalygen.world.graph import load_scene
     from anomalygen.world.perception import perceived_spec
 
@@ -60,7 +60,7 @@ def test_part_env_contract_and_the_reference_turns_a_held_knob_off(built):
     from gymnasium.utils.env_checker import check_env
 
     from anomalygen.skills.learned.part_env import HORIZON, PartTurnEnv, make_part_env
-    from anomalygen.skills.learned.part_skill import OBS_DIM, reference_action
+    from anomalygen.skills.part_motion import OBS_DIM, reference_action
 
     scene_dir, spec, plan = built["toaster"]
     _, start = _held_start(scene_dir, plan)

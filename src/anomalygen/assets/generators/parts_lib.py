@@ -150,7 +150,7 @@ def push_switch(parent: Part, name: str, pos, half, rgba, travel: float = PUSH_S
     """A latching on/off push switch on a top face (label "switch"): off pressed down at 0 (its box
     centred at ``pos``), on standing ``travel`` proud. Joint friction is the latch, so a switch left on
     stays on; pressing it down from above puts it off, which is how a suction cup meets a top face
-    (the switch-off family's buttons, ``skills/learned/part_skill.py``)."""
+    (the switch-off family's buttons, ``skills/part_motion.py``)."""
     s = parent.child(name, pos)
     s.slide(f"{name}_press", (0, 0, 1), (0, travel), SWITCH, 0.0, hold=True)
     s.box(half, (0, 0, 0), rgba, D_METAL)  # as heavy as its latch: a 3 g cap rang against the cup's hold

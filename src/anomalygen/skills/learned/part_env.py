@@ -1,20 +1,20 @@
 """Gymnasium env for the switch-off family: turn a held knob or switch to off, on one or many scenes.
 
 One env may hold several *starts* (a built scene's model, a physics snapshot taken right after
-:func:`~anomalygen.skills.learned.part_skill.grasp_part`, the sub-task and its joint); every ``reset`` picks one
+:func:`~anomalygen.skills.part_motion.grasp_part`, the sub-task and its joint); every ``reset`` picks one
 with the env's seeded ``np_random``. With one start it is the learn stage's fine-tuning env; with the
 starts of many built scenes it is the warm start's training env (``benchmarks/train_warm_start.py``),
 which is how one policy learns knobs of ovens, toasters, microwaves and washing machines and the push
-buttons of coffee machines at once. The observation is :class:`~anomalygen.skills.learned.part_skill.PartReadout`'s
+buttons of coffee machines at once. The observation is :class:`~anomalygen.skills.part_motion.PartReadout`'s
 (17 numbers, relative to cup and part); the reward is the sub-task's RewardSpec through
 :class:`~anomalygen.skills.learned.subtask_env.SubTaskReadout`; success (``info["is_success"]``, which also ends the
 episode) is the joint within ``CLOSED_TOL`` of its travel from off, as ``joint_closed`` counts it.
 
 Settings as every SAC env here (:mod:`~anomalygen.skills.learned.subtask_env`): 7-D action through
-``Agent.apply_action`` (the agent's 3 cm, 0.1 rad per step, suction flag), frameskip 2; episodes of
-60 steps (the scripted reference turns a knob from 90 % on to off in 15-26 steps), set by the
-registration's ``max_episode_steps`` (``PART_ENV_ID``, :func:`make_part_env`), +-5 mm noise on the
-cup target at reset.
+``Agent.apply_action`` (the agent's 3 cm, 0.1 rad per step, suction flag), frameskip 2 (the lead's,
+``part_motion.FRAMESKIP``); episodes of 60 steps (the scripted reference turns a knob from 90 % on to
+off in 15-26 steps), set by the registration's ``max_episode_steps`` (``PART_ENV_ID``,
+:func:`make_part_env`), +-5 mm noise on the cup target at reset.
 """
 
 from __future__ import annotations
@@ -27,8 +27,8 @@ import numpy as np
 from gymnasium import spaces
 
 from anomalygen.schema import SceneSpec, SubTask
-from anomalygen.skills.learned.part_skill import OBS_DIM, PartReadout
-from anomalygen.skills.learned.subtask_env import FRAMESKIP, SubTaskReadout, registered_horizon
+from anomalygen.skills.learned.subtask_env import SubTaskReadout, registered_horizon
+from anomalygen.skills.part_motion import FRAMESKIP, OBS_DIM, PartReadout
 
 PART_ENV_ID = "anomalygen/PartTurn-v0"
 HORIZON = 60  # control steps per episode: the registered TimeLimit

@@ -5,7 +5,10 @@ planned by the knowledge planner because the KB marks the recipe step ``"method"
 LLM-planned SAC step that drives a knob or switch to off: the skill claims those too, when rewards are
 specs):
 
-1. :func:`~anomalygen.skills.learned.part_skill.grasp_part` puts the cup on the part's face and holds it (the
+The sequence is the family's one (:func:`~anomalygen.skills.part_motion.hold_and_lead`, the scripted
+primitive's too); what this skill adds is the policy, made once the part is held:
+
+1. :func:`~anomalygen.skills.part_motion.grasp_part` puts the cup on the part's face and holds it (the
    approach is motion-planned, as RoboGen pre-positions before an RL sub-task).
 2. The warm start (``anomalygen/data/policies/switch_off.zip``, trained over many built scenes by
    ``benchmarks/train_warm_start.py``) is evaluated on a snapshot of this scene
@@ -13,8 +16,8 @@ specs):
    90 % it is fine-tuned with SAC for at most ``steps`` (capped at ``FINETUNE_MAX``) transitions, ``n_envs`` envs at once,
    keeping the best checkpoint by success.
 3. The policy is replayed once, deterministically, on the Driver's own data from the snapshot
-   (through the env's own :func:`~anomalygen.skills.learned.part_env.part_control_step`), so the video shows it.
-   The cup then lets go and backs off.
+   (:func:`~anomalygen.skills.part_motion.lead_held_part`, at the env's frameskip), so the video shows it.
+   The cup then lets go and backs off (:func:`~anomalygen.skills.part_motion.let_go`).
 
 Without a shipped policy it trains from scratch within ``steps``. The caller (``learn/execute.py``)
 falls back to the primitive when the replay fails, and records why.
@@ -75,14 +78,8 @@ def run_part_subtask(ep: Episode, st: SubTask, plan: Plan, *, steps: int, seed: 
                      warm_start: Path | None | str = "shipped", log=None) -> SkillOutcome:
     """Grasp the part, fine-tune the family policy on this scene (if needed), execute it on the Driver."""
     from anomalygen.skills.learned.part_env import HORIZON, PartStart, make_part_env
-    from anomalygen.skills.learned.part_skill import (
-        PartReadout,
-        grasp_part,
-        lead_held_part,
-        let_go,
-        pulled_to_off,
-    )
     from anomalygen.skills.learned.sac import train_sac
+    from anomalygen.skills.part_motion import PartReadout, hold_and_lead
 
     drv = ep.driver
     joint = str(st.params.get("joint", ""))
@@ -92,45 +89,47 @@ def run_part_subtask(ep: Episode, st: SubTask, plan: Plan, *, steps: int, seed: 
     closed, far = float(js.closed_value), far_value(js)
     s0 = drv.steps
     now = float(drv.data.joint(joint).qpos[0])
-    if js.open_fraction_at(now) <= 0.05:
+    if js.is_off(value=now):
         return SkillOutcome(True, 0, f"{joint} already off ({now:.3f})")
     warm = warm_start_path() if warm_start == "shipped" else (Path(warm_start) if warm_start else None)
     if warm is None and steps <= 0:
         return SkillOutcome(False, 0, "not executed: no warm start shipped and sac_steps is 0")
-    held, why = grasp_part(ep, joint)
-    if not held:
-        return SkillOutcome(False, drv.steps - s0, f"not executed: {why}")
-    import mujoco
+    tuned = ""
 
-    kind = mujoco.mjtState.mjSTATE_INTEGRATION
-    snap = np.empty(mujoco.mj_stateSize(drv.model, kind))
-    mujoco.mj_getState(drv.model, drv.data, snap, kind)
-    start = PartStart(drv.model, snap, ep.spec, st, plan.bindings, joint, closed, far)
+    def tune_on_the_hold():
+        """Fine-tune on a snapshot of the hold, put the Driver back on it, and act by the best policy."""
+        nonlocal tuned
+        import mujoco
 
-    def make_env():
-        return make_part_env([start])
+        kind = mujoco.mjtState.mjSTATE_INTEGRATION
+        snap = np.empty(mujoco.mj_stateSize(drv.model, kind))
+        mujoco.mj_getState(drv.model, drv.data, snap, kind)
+        start = PartStart(drv.model, snap, ep.spec, st, plan.bindings, joint, closed, far)
 
-    steps = min(steps, FINETUNE_MAX)
-    eval_every = max(1, min(steps, 500)) if steps > 0 else 1
-    policy, res = train_sac(make_env, max(0, steps), seed=seed, eval_every=eval_every, eval_episodes=EVAL_EPISODES,
-                            learning_starts=200, threads=threads, stop_at=0.9, log=log, n_envs=n_envs,
-                            net_arch=(64, 64), init_model=None if warm is None else str(warm))
-    tuned = ("warm start" if warm is not None else "from scratch") + (
-        f" already at {res.curve[0]['success']:.2f} on this scene, not fine-tuned" if res.steps == 0 and warm is not None
-        else f", {res.steps} SAC steps: best eval success {res.best_success:.2f} at {res.best_step} steps")
+        def make_env():
+            return make_part_env([start])
 
-    mujoco.mj_setState(drv.model, drv.data, snap, kind)
-    mujoco.mj_forward(drv.model, drv.data)
-    readout = PartReadout(drv.model, joint, closed, far)
-    pulled = pulled_to_off(drv.model, drv.data, readout)
-    ok, t, stopped = lead_held_part(ep, readout, lambda obs: policy.predict(obs, deterministic=True)[0], horizon=HORIZON,
-                                    past_ok=pulled)
-    q = float(drv.data.joint(joint).qpos[0])
-    let_go(ep, joint, pulled=pulled)
+        budget = min(steps, FINETUNE_MAX)
+        eval_every = max(1, min(budget, 500)) if budget > 0 else 1
+        policy, res = train_sac(make_env, max(0, budget), seed=seed, eval_every=eval_every, eval_episodes=EVAL_EPISODES,
+                                learning_starts=200, threads=threads, stop_at=0.9, log=log, n_envs=n_envs,
+                                net_arch=(64, 64), init_model=None if warm is None else str(warm))
+        tuned = ("warm start" if warm is not None else "from scratch") + (
+            f" already at {res.curve[0]['success']:.2f} on this scene, not fine-tuned" if res.steps == 0 and warm is not None
+            else f", {res.steps} SAC steps: best eval success {res.best_success:.2f} at {res.best_step} steps")
+        mujoco.mj_setState(drv.model, drv.data, snap, kind)
+        mujoco.mj_forward(drv.model, drv.data)
+        return lambda obs: policy.predict(obs, deterministic=True)[0]
+
+    lead = hold_and_lead(ep, PartReadout(drv.model, joint, closed, far), tune_on_the_hold, horizon=HORIZON)
+    if not lead.held:
+        return SkillOutcome(False, drv.steps - s0, f"not executed: {lead.why}")
+    q, t = lead.led_to, lead.steps
     after = float(drv.data.joint(joint).qpos[0])
-    ok = ok and js.open_fraction_at(after) <= 0.05
-    detail = (f"{why}; {tuned}; rollout {'turned' if ok else 'did not turn'} {joint} to off in {t} steps "
-              f"({q:.3f}, off {closed:.3f}, on {far:.3f})" + (f" ({stopped})" if stopped else "") + (f"; {after:.3f} after letting go" if abs(after - q) > 1e-3 else ""))
+    ok = lead.off and js.is_off(value=after)
+    detail = (f"{lead.why}; {tuned}; rollout {'turned' if ok else 'did not turn'} {joint} to off in {t} steps "
+              f"({q:.3f}, off {closed:.3f}, on {far:.3f})" + (f" ({lead.stopped})" if lead.stopped else "")
+              + (f"; {after:.3f} after letting go" if abs(after - q) > 1e-3 else ""))
     return SkillOutcome(ok, drv.steps - s0, detail)
 
 

@@ -1,13 +1,13 @@
 """Switching a control off by script: hold the knob, switch or snuffer by suction and lead it to off.
 
-The learned switch-off skill (:mod:`~anomalygen.skills.learned.part_subtask`) and this primitive share
-the family's grasp (:func:`~anomalygen.skills.learned.part_skill.grasp_part`: the cup on the part's face,
-off the axis for a knob, on top for a push switch), its observation (``PartReadout``) and its control
-loop (``lead_held_part``); here the actions come from the family's scripted reference
-(``reference_action``) instead of a policy. It is what a ``push`` or ``switch_off`` step on a control
-runs, so also what a failed SAC switch-off falls back to: the panel grasp of
-:mod:`~anomalygen.skills.scripted.parts` (doors, lids) holds a knob by its rim, where leading it round
-drags a light appliance off its table.
+The learned switch-off skill (:mod:`~anomalygen.skills.learned.part_subtask`) and this primitive run
+the family's one sequence (:func:`~anomalygen.skills.part_motion.hold_and_lead`): its grasp (the cup
+on the part's face, off the axis for a knob, on top for a push switch), its observation
+(``PartReadout``), its control loop (``lead_held_part``) and letting go; here the actions come from
+the family's scripted reference (``reference_action``) instead of a policy, and a hold that slips is
+tried again. It is what a ``push`` or ``switch_off`` step on a control runs, so also what a failed SAC
+switch-off falls back to: the panel grasp of :mod:`~anomalygen.skills.scripted.parts` (doors, lids)
+holds a knob by its rim, where leading it round drags a light appliance off its table.
 """
 
 from __future__ import annotations
@@ -16,7 +16,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from anomalygen.schema import CLOSED_TOL, part_labels
+from anomalygen.schema import part_labels
+from anomalygen.skills.part_motion import (
+    POS_SCALE,
+    REFERENCE_MOVE,
+    PartReadout,
+    hold_and_lead,
+    reference_action,
+)
 from anomalygen.skills.registry import SkillOutcome
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -37,7 +44,6 @@ def paced(readout):
     axis is more than a radian, the cup runs off the dial's circle and the weld hauls the appliance
     after it (a 3 kg fan heater tipped over)."""
     from anomalygen.robot.agent import Agent
-    from anomalygen.skills.learned.part_skill import POS_SCALE, REFERENCE_MOVE, reference_action
 
     def act(obs: np.ndarray) -> np.ndarray:
         lever = float(np.linalg.norm(obs[6:9])) / POS_SCALE if readout.hinge else 1.0
@@ -50,14 +56,6 @@ def paced(readout):
 
 def switch_off_control(ep: Episode, joint: str, closed: float, far: float) -> SkillOutcome:
     """Hold the control ``joint`` (off at ``closed``, fully on at ``far``) and lead it to off."""
-    from anomalygen.skills.learned.part_skill import (
-        PartReadout,
-        grasp_part,
-        lead_held_part,
-        let_go,
-        pulled_to_off,
-    )
-
     drv = ep.driver
     s0 = drv.steps
     readout = PartReadout(drv.model, joint, closed, far)
@@ -65,16 +63,14 @@ def switch_off_control(ep: Episode, joint: str, closed: float, far: float) -> Sk
         return SkillOutcome(True, 0, f"{joint} already off ({drv.data.joint(joint).qpos[0]:.3f})")
     notes = []
     for attempt in range(1, ATTEMPTS + 1):
-        held, why = grasp_part(ep, joint)
-        if not held:
-            notes.append(f"hold {attempt}: {why}")
+        lead = hold_and_lead(ep, readout, lambda: paced(readout), horizon=HORIZON, tol=OFF_TOL)
+        if not lead.held:
+            notes.append(f"hold {attempt}: {lead.why}")
             continue
-        pulled = pulled_to_off(drv.model, drv.data, readout)
-        ok, t, stopped = lead_held_part(ep, readout, paced(readout), horizon=HORIZON, tol=OFF_TOL, past_ok=pulled)
-        let_go(ep, joint, pulled=pulled)
-        notes.append(f"hold {attempt}: led {'to off' if ok else 'towards off'} in {t} steps" + (f" ({stopped})" if stopped else ""))
-        if abs(readout.fraction(drv.data)) <= CLOSED_TOL:
+        notes.append(f"hold {attempt}: led {'to off' if lead.off else 'towards off'} in {lead.steps} steps"
+                     + (f" ({lead.stopped})" if lead.stopped else ""))
+        if readout.at_off(drv.data):
             break
     q = float(drv.data.joint(joint).qpos[0])
-    ok = abs(readout.fraction(drv.data)) <= CLOSED_TOL
+    ok = readout.at_off(drv.data)
     return SkillOutcome(ok, drv.steps - s0, f"{joint} = {q:.3f} (off {closed:.3f}, on {far:.3f}); {'; '.join(notes)}")

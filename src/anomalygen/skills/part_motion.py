@@ -1,4 +1,9 @@
-"""The switch-off family as a learnable sub-task: hold a knob or switch by suction and turn it to off.
+"""Moving a part held by suction, for the switch-off family: grasp a knob or switch, read it, lead it, let go.
+
+Below both kinds of skill: the scripted primitive (:mod:`~anomalygen.skills.scripted.controls`, the
+family's reference paced) and the learned skill (:mod:`~anomalygen.skills.learned.part_subtask`, its
+env :mod:`~anomalygen.skills.learned.part_env`, a policy) hold, read, lead and let go of a part through
+this module, so neither imports the other for it (``tests/test_layout.py``).
 
 Why a family-level observation: appliances differ (an oven has 2-5 front knobs turning about a
 horizontal axis, a toaster one side knob, a coffee machine a push button on top, a kettle a switch
@@ -29,6 +34,7 @@ axis (or out along a button's axis) without losing the hold, dragging the applia
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -37,9 +43,14 @@ from anomalygen.mjgeom import geom_world_aabbs
 from anomalygen.schema import CLOSED_TOL
 
 if TYPE_CHECKING:  # pragma: no cover
+    from collections.abc import Callable
+
     from anomalygen.skills.episode import Episode
 
 POS_SCALE = 10.0  # positions in dm (~unit scale for the networks)
+# Physics steps per 7-D action while a part is led, here and in the family's env (skills/learned/part_env.py),
+# so a policy is replayed at the rate it learned at (the shipped warm start: 2, as every SAC env here).
+FRAMESKIP = 2
 OBS_DIM = 17
 OFF_AXIS = 0.6  # grasp this fraction of the knob radius away from its axis: a lever for the hold
 PRE_CONTACT = 0.04  # m in front of the face before the final approach
@@ -150,8 +161,6 @@ def lead_held_part(ep: Episode, readout: PartReadout, act, *, horizon: int,
     stays tipped. With ``past_ok`` a part led beyond off (into its stop) is off too: a button pulled out
     past its stop by the weld sprang back in when let go. Returns (off, control steps taken, why it
     stopped early or "")."""
-    from anomalygen.skills.learned.subtask_env import FRAMESKIP
-
     drv = ep.driver
     m, d = drv.model, drv.data
     holder = int(m.body_parentid[readout.body])
@@ -216,11 +225,43 @@ def let_go(ep: Episode, joint: str, *, pulled: bool = False) -> None:
     drv.straighten_wrist(lift=0.1, lift_steps=30)
 
 
+@dataclass
+class Lead:
+    """What one hold of a part and its lead towards off came to (:func:`hold_and_lead`)."""
+
+    held: bool  # the cup took hold of the part
+    why: str  # grasp_part's word: what the cup holds, or why it did not take hold
+    off: bool = False  # the lead brought the part to off (before letting go)
+    steps: int = 0  # control steps the lead took
+    stopped: str = ""  # why the lead stopped early ("" when it did not)
+    led_to: float = 0.0  # the joint's value where the lead left it, before letting go
+
+
+def hold_and_lead(ep: Episode, readout: PartReadout, policy: Callable[[], Callable[[np.ndarray], np.ndarray]], *,
+                  horizon: int, tol: float = CLOSED_TOL) -> Lead:
+    """The family's one sequence, for the scripted primitive and the learned skill alike: hold the part
+    by suction (:func:`grasp_part`), lead it towards off (:func:`lead_held_part`) with the actions of
+    ``policy()``, asked once the part is held (the learned skill fine-tunes there, on a snapshot of the
+    hold, and puts the state back), and let go (:func:`let_go`). A part that comes out towards the cup to
+    go off (:func:`pulled_to_off`) counts as off led past it and is let go where it is. Nothing is led
+    or let go when the cup does not take hold."""
+    held, why = grasp_part(ep, readout.joint)
+    if not held:
+        return Lead(False, why)
+    act = policy()
+    drv = ep.driver
+    pulled = pulled_to_off(drv.model, drv.data, readout)
+    off, t, stopped = lead_held_part(ep, readout, act, horizon=horizon, tol=tol, past_ok=pulled)
+    led_to = float(drv.data.joint(readout.joint).qpos[0])
+    let_go(ep, readout.joint, pulled=pulled)
+    return Lead(True, why, off, t, stopped, led_to)
+
+
 class PartReadout:
     """The family's observation and success for one joint, on any (model, data) of the scene.
 
-    Used both by :class:`~anomalygen.skills.learned.subtask_env.SubTaskEnv` (via ``obs_mode="part"``) and by the
-    replay on the Driver's data, so training and execution read the same numbers.
+    Used both by :class:`~anomalygen.skills.learned.part_env.PartTurnEnv` and by the lead on the Driver's
+    data (a policy's replay, the scripted reference), so training and execution read the same numbers.
     """
 
     def __init__(self, model, joint: str, closed: float, far: float):
