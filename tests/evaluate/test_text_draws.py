@@ -11,8 +11,17 @@ import numpy as np
 import pytest
 
 from anomalygen.embedding import embed, mean_pairwise_similarity
+from anomalygen.evaluate.baselines import PAPER_DIVERSITY, baseline_records, baseline_texts
+from anomalygen.evaluate.diversity import (
+    DIVERSITY_HEADERS,
+    PAPER_ENGINE_ROW,
+    PUBLISHED_HEADER,
+    baseline_rows,
+    diversity_cells,
+    text_row,
+)
 from anomalygen.evaluate.selfbleu import self_bleu
-from anomalygen.evaluate.text_draws import Spread, drawn_text_metrics
+from anomalygen.evaluate.text_draws import TEXT_FIELD, Spread, drawn_text_metrics, set_texts
 
 EIGHT = [
     "A knife lies on the kitchen counter next to the bread.",
@@ -73,3 +82,60 @@ def test_spread():
     assert s.mean == pytest.approx(0.2) and s.std == pytest.approx(0.1)
     assert (s.low, s.high) == (pytest.approx(0.105), pytest.approx(0.295))
     assert Spread.of([0.4]) == Spread(0.4, 0.0, 0.4, 0.4)
+
+
+def test_every_set_is_its_full_descriptions():
+    from anomalygen.schema import TaskProposal
+
+    assert TEXT_FIELD == "description"
+    records = baseline_records("rlbench")
+    assert baseline_texts("rlbench") == [r["description"] for r in records]
+    assert baseline_texts("rlbench")[0] == "put the ball in the hoop"
+    task = TaskProposal(id="t1", name="Knife at the edge", explanation="e", description=" A knife at the edge. ",
+                        category="household_hazard", hazard_class="store_sharp_objects", target_asset="Knife",
+                        scenario=dict(hazard_object="Knife", room="kitchen", placement="counter_edge"),
+                        provenance=dict(engine="knowledge", mode="brainstorm"))
+    assert set_texts([task, {"description": "b"}]) == ["A knife at the edge.", "b"]
+
+
+def test_rows_carry_draws_and_the_published_figures_in_their_own_column():
+    row = text_row("tiny", "run", EIGHT, seed=0, key="run", draw_size=4, draws=3, wmd_pairs=2)
+    assert (row.draws, row.draw_size, row.small_set, row.text_field) == (3, 4, False, "description")
+    assert row.self_bleu_std is not None and row.wmd is not None and row.published is None
+    assert row == text_row("tiny", "run", EIGHT, seed=0, key="run", draw_size=4, draws=3, wmd_pairs=2)
+
+    paper = baseline_rows(seed=0, measure=False)
+    assert [r.name for r in paper][:2] == [PAPER_ENGINE_ROW, "RoboGen"]
+    assert all(r.kind == "paper" and r.self_bleu is None and r.published is not None for r in paper)
+    assert paper[0].published == PAPER_DIVERSITY["AnomalyGen"]
+
+    assert DIVERSITY_HEADERS[-1] == PUBLISHED_HEADER == "as published; not reproducible from public code"
+    small = text_row("small", "baseline", EIGHT[:3], seed=0, key="s", draw_size=50)
+    cells = diversity_cells([row, small, paper[0]])
+    assert cells[0][3] == "4 × 3 draws" and "±" in cells[0][4] and cells[0][-1] == "—"
+    assert cells[1][3] == "all 3 (flagged: fewer than 50)" and "±" not in cells[1][4]
+    assert cells[2][2:7] == ["—"] * 5 and cells[2][-1].startswith("Self-BLEU 0.227 · SBERT 0.245")
+
+
+def test_evaluate_and_report_show_the_drawn_table_and_no_target_for_the_offline_engine(synthetic_run):
+    from anomalygen.config import Settings
+    from anomalygen.evaluate.report import run_stage as report_stage
+    from anomalygen.evaluate.stage import evaluate_run, load_evaluation, run_stage
+
+    s = Settings(quiet=True)
+    s.evaluate.baselines = False
+    s.evaluate.image_metrics = False
+    s.evaluate.wmd_pairs = 5
+    ev = evaluate_run(synthetic_run, s)
+    run = ev.diversity[0]
+    assert (run.kind, run.tasks, run.small_set, run.draws, run.published) == ("run", 5, True, 1, None)
+    tasks = synthetic_run.load_tasks()
+    assert run.self_bleu == self_bleu([t.description for t in tasks])
+    assert [r.name for r in ev.diversity if r.published == PAPER_DIVERSITY["AnomalyGen"]] == [PAPER_ENGINE_ROW]
+    run_stage(synthetic_run, s)
+    assert load_evaluation(synthetic_run).diversity == ev.diversity
+    report_stage(synthetic_run, s)
+    html = (synthetic_run.report_dir / "index.html").read_text()
+    diversity = html.split('id="diversity"')[1].split("</section>")[0]
+    assert f"<th>{PUBLISHED_HEADER}</th>" in diversity and "all 5 (flagged: fewer than 50)" in diversity
+    assert "target" not in diversity.replace("not a target for the offline engine", "")
