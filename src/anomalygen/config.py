@@ -155,6 +155,11 @@ class EvaluateConfig(Section):
     vit_weights: str | None = Field(None, description="optional path to ViT/CLIP weights for image similarity")
     wmd_pairs: int = Field(300, ge=1, description="pairs sampled per text set for mean Word Mover's Distance")
     baselines: bool = Field(True, description="recompute the six benchmark baselines in the diversity table")
+    # 50 texts per draw (issue 39): MetaWorld's whole list; RoboGen's public 46 and ManiSkill2's 20 fall short.
+    draw_size: int = Field(50, ge=2, description="texts per draw for Self-BLEU and SBERT (a smaller set is measured "
+                           "whole and flagged)")
+    # 100 draws: the standard error of the mean is a tenth of the spread the table shows.
+    draws: int = Field(100, ge=1, description="draws per text set; the table shows their mean and spread")
     text_judge_llm: bool = Field(
         False, description="text judge diagnostic: when an LLM is configured, ask it about hypotheses exact+SBERT "
         "judged a miss (detection itself is scored against the truth, not by this judge)")

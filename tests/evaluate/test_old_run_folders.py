@@ -48,3 +48,36 @@ def test_rate_reads_either_name_and_writes_n_and_successes():
     assert Rate.model_validate({"hazards": 4, "found": 3}) == Rate(n=4, successes=3)
     assert Rate.model_validate_json('{"n": 4, "successes": 3}').rate == 0.75
     assert Rate(n=4, successes=3).model_dump() == {"n": 4, "successes": 3}
+
+
+# The diversity table as evaluate wrote it before issue 39: whole-set figures, the paper's in rows of their own.
+OLD_DIVERSITY = [
+    {"name": "synth", "kind": "run", "tasks": 5, "self_bleu": 0.481, "sbert": 0.283, "wmd": 0.55, "image": 0.716,
+     "clip": None, "image_embedder": "efficientnet-lite0"},
+    {"name": "RoboGen", "kind": "baseline", "tasks": 46, "self_bleu": 0.41, "sbert": 0.44, "wmd": 0.5, "image": None,
+     "clip": None, "image_embedder": None},
+    {"name": "RoboGen (paper)", "kind": "paper", "tasks": 106, "self_bleu": 0.287, "sbert": 0.394, "wmd": None,
+     "image": 0.353, "clip": 0.824, "image_embedder": "ViT / CLIP"},
+]
+
+
+def test_old_diversity_table_loads_and_renders(synthetic_run):
+    from anomalygen.evaluate.baselines import PAPER_DIVERSITY
+    from anomalygen.evaluate.diversity import PUBLISHED_HEADER, diversity_cells
+    from anomalygen.evaluate.report import Report, render_html, render_markdown
+
+    old_eval = json.loads(Evaluation(run="synth", tasks=5).model_dump_json())
+    old_eval["diversity"] = OLD_DIVERSITY
+    evaluation_path(synthetic_run).write_text(json.dumps(old_eval, indent=2))
+
+    loaded = load_evaluation(synthetic_run)
+    run, baseline, paper = loaded.diversity
+    assert (run.self_bleu, run.wmd, run.image, run.draw_size, run.draws, run.published) == (0.481, 0.55, 0.716, None, None, None)
+    assert paper.published == PAPER_DIVERSITY["RoboGen"] and paper.self_bleu is None and paper.image_embedder is None
+    cells = diversity_cells(loaded.diversity)
+    assert cells[0][3] == "all 5 (older file: whole set)" and cells[0][4] == "0.481" and cells[0][6] == "0.716"
+    assert cells[2][-1].startswith("Self-BLEU 0.287 · SBERT 0.394 · ViT 0.353 · CLIP 0.824")
+    report = Report(generated="then", evaluation=loaded)
+    assert PUBLISHED_HEADER in render_html(report, synthetic_run) and PUBLISHED_HEADER in render_markdown(report)
+    # written again and read back, the row is the same
+    assert Evaluation.model_validate_json(loaded.model_dump_json()) == loaded

@@ -19,6 +19,7 @@ from pydantic import Field
 from anomalygen.evaluate import plots
 from anomalygen.evaluate import run_metrics as rm
 from anomalygen.evaluate.baselines import PAPER_ABLATION
+from anomalygen.evaluate.diversity import DIVERSITY_HEADERS, diversity_cells, table_note
 from anomalygen.evaluate.html_parts import NOT_RUN
 from anomalygen.evaluate.html_parts import esc as _e
 from anomalygen.evaluate.html_parts import fmt as _f
@@ -191,17 +192,15 @@ def render_html(report: Report, run: RunFolder) -> str:
 
     # diversity
     if ev.diversity:
-        rows = [[r.name, r.kind, r.tasks, _f(r.self_bleu), _f(r.sbert), _f(r.wmd), _f(r.image), _f(r.clip)] for r in ev.diversity]
-        table = _table(["set", "source", "tasks", "Self-BLEU ↓", "SBERT sim ↓", "WMD ↑", "image sim ↓", "CLIP sim ↓"],
-                       rows, [r.kind if r.kind != "baseline" else "" for r in ev.diversity])
-        embedders = sorted({r.image_embedder for r in ev.diversity if r.kind == "run" and r.image_embedder})
-        note = ("<p>Text = task name + description. Baselines are recomputed from the packaged public task lists; "
-                "“paper” rows are the published figures (ViT/CLIP image columns). Our image column uses "
-                f"{_e(', '.join(embedders) or 'no image embedder')}; WMD uses MiniLM word-piece vectors.</p>")
+        table = _table(DIVERSITY_HEADERS, diversity_cells(ev.diversity),
+                       [r.kind if r.kind != "baseline" else "" for r in ev.diversity])
+        note = f"<p>{_e(table_note(ev.diversity))}</p>"
         headers, rows, classes = ablation_rows(ev)
         ablation = _table(headers, rows, classes) + ("<p>Measured rows are this run's proposals grouped by engine and "
-                                                      "mode; the paper's are published. The paper reads its WMD as lower "
-                                                      "is better; ours is a distance, so higher means more diverse.</p>")
+                                                      "mode (Self-BLEU and SBERT: mean over the draws, as above; WMD: "
+                                                      "the whole group); the paper's are published. The paper reads its "
+                                                      "WMD as lower is better; ours is a distance, so higher means more "
+                                                      "diverse.</p>")
         parts.append(_section("diversity", "Diversity", table + note + "<h3>Brainstorming ablation</h3>" + ablation))
     else:
         parts.append(_section("diversity", "Diversity", _not_run("evaluate")))
@@ -299,9 +298,7 @@ def render_markdown(report: Report) -> str:
         lines.append(f"- {NOT_RUN}: {', '.join(ev.not_run)}")
     lines += ["", "## Diversity", ""]
     if ev.diversity:
-        lines += ["| set | source | tasks | Self-BLEU | SBERT sim | WMD | image sim | CLIP sim |", "|---|---|---:|---:|---:|---:|---:|---:|"]
-        lines += [f"| {r.name} | {r.kind} | {r.tasks} | {_f(r.self_bleu)} | {_f(r.sbert)} | {_f(r.wmd)} | {_f(r.image)} | {_f(r.clip)} |"
-                  for r in ev.diversity]
+        lines += [*_md_table(DIVERSITY_HEADERS, diversity_cells(ev.diversity)), "", table_note(ev.diversity)]
     else:
         lines.append(NOT_RUN)
     if ev.diversity:

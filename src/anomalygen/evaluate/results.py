@@ -8,8 +8,9 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import Field
+from pydantic import Field, model_validator
 
+from anomalygen.evaluate.baselines import PaperRow
 from anomalygen.evaluate.detection_report import DetectionReport
 from anomalygen.evaluate.hazard_table import HazardTable
 from anomalygen.evaluate.rate import Rate
@@ -17,17 +18,46 @@ from anomalygen.schema import Artefact, LLMUsage, StageRecord, Strict
 
 
 class DiversityRow(Strict):
-    """One line of the diversity table. ``None`` = not measured for this row."""
+    """One line of the diversity table. ``None`` = not measured for this row.
+
+    Measured rows (``run``, ``baseline``) carry Self-BLEU and SBERT similarity of the set's full task
+    descriptions as the mean over repeated draws of ``draw_size`` texts (``evaluate/text_draws.py``),
+    with their spread; ``published`` holds the paper's figures for the same set, which public code
+    cannot reproduce. A ``paper`` row has only ``published``: the paper's own LLM-engine row, or a
+    baseline not measured in this run. Files written before the draws existed still load: their
+    ``paper`` rows' figures move into ``published`` and their measured rows read as whole-set figures.
+    """
 
     name: str
     kind: Literal["run", "baseline", "paper"]
-    tasks: int
-    self_bleu: float | None = None
-    sbert: float | None = None
-    wmd: float | None = None
+    tasks: int = Field(description="texts in the set (a paper row: the paper's task count)")
+    self_bleu: float | None = Field(None, description="mean over the draws (whole set in older files)")
+    sbert: float | None = Field(None, description="mean pairwise SBERT cosine, mean over the draws")
+    self_bleu_std: float | None = Field(None, description="sample standard deviation over the draws")
+    sbert_std: float | None = None
+    self_bleu_95: tuple[float, float] | None = Field(None, description="2.5 and 97.5 percentiles over the draws")
+    sbert_95: tuple[float, float] | None = None
+    draw_size: int | None = Field(None, description="texts asked for per draw (k); None: older whole-set figures")
+    draws: int | None = Field(None, description="draws measured; 1 when the set has no more than draw_size texts")
+    small_set: bool = Field(False, description="fewer texts than draw_size: measured whole, flagged")
+    text_field: str | None = Field(None, description="the task field measured (the full description)")
+    wmd: float | None = Field(None, description="run rows only, whole set: the brainstorming ablation's WMD")
     image: float | None = None
     clip: float | None = None
     image_embedder: str | None = None
+    published: PaperRow | None = Field(None, description="as published; not reproducible from public code")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _published_from_old_paper_row(cls, data):
+        """Older files kept the paper's figures in a ``paper`` row's measured fields."""
+        if isinstance(data, dict) and data.get("kind") == "paper" and data.get("published") is None:
+            figures = {"self_bleu": data.get("self_bleu"), "sbert": data.get("sbert"), "vit": data.get("image"),
+                       "clip": data.get("clip")}
+            if all(v is not None for v in figures.values()):
+                data = {k: v for k, v in data.items() if k not in ("self_bleu", "sbert", "image", "clip", "image_embedder")}
+                data["published"] = {"tasks": data.get("tasks"), **figures}
+        return data
 
 
 class VerdictCounts(Strict):

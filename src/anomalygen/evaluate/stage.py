@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 from anomalygen.evaluate import run_metrics as rm
 from anomalygen.evaluate.diversity import diversity_table, rich_table
 from anomalygen.evaluate.results import AblationRow, DiversityRow, Evaluation
-from anomalygen.evaluate.text_metrics import task_text
+from anomalygen.evaluate.text_draws import set_texts
 from anomalygen.runfolder import RunFolder, now_iso, read_model, write_model
 from anomalygen.runner import StageSummary
 from anomalygen.schema import StageRecord
@@ -53,13 +53,15 @@ def evaluate_run(run: RunFolder, settings: Settings) -> Evaluation:
         engine, mode = str(t.provenance.engine), str(t.provenance.mode)
         label = f"mode={mode}" if len(engines) == 1 else f"engine={engine} mode={mode}"
         group_of[label] = (engine, mode)
-        by_mode.setdefault(label, []).append(task_text(t.name, t.description))
+        by_mode.setdefault(label, []).extend(set_texts([t]))
     rows = diversity_table(
         run.root.name,
-        [task_text(t.name, t.description) for t in tasks],
+        set_texts(tasks),
         renders,
         seed=settings.seed,
         wmd_pairs=cfg.wmd_pairs,
+        draw_size=cfg.draw_size,
+        draws=cfg.draws,
         baselines=cfg.baselines,
         image_metrics=cfg.image_metrics,
         vit_weights=cfg.vit_weights,

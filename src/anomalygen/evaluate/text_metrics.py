@@ -1,7 +1,9 @@
 """Semantic text diversity: mean pairwise SBERT similarity and Word Mover's Distance.
 
-Both take the same task texts as Self-BLEU (``task_text``: name + description). Lower SBERT
-similarity and higher WMD mean more diverse tasks.
+Both take the same texts as Self-BLEU: the full description of each task (``text_draws.TEXT_FIELD``).
+Lower SBERT similarity and higher WMD mean more diverse tasks. The diversity table measures SBERT and
+Self-BLEU over repeated draws of equal size (``text_draws.py``); WMD is kept for the brainstorming
+ablation, on the run's whole sets.
 
 Word vectors for WMD: nothing like word2vec/GloVe can be fetched offline here, so WMD uses the
 input word-piece embedding matrix of the bundled all-MiniLM-L6-v2 (the same model behind SBERT,
@@ -19,16 +21,6 @@ from collections import Counter
 from collections.abc import Sequence
 
 import numpy as np
-
-
-def task_text(name: str, description: str) -> str:
-    """The text of one task for every text metric: readable name, then description (paper: concatenated)."""
-    readable = name.replace("_", " ").replace("-", " ").strip()
-    desc = description.strip()
-    # Behavior-100 has no descriptions (its "description" is the name again): do not count it twice.
-    if not desc or desc.lower() == readable.lower():
-        return readable
-    return f"{readable}. {desc}"
 
 
 def sbert_similarity(texts: Sequence[str]) -> float:
