@@ -31,6 +31,7 @@ from pydantic import BaseModel, ValidationError
 
 from anomalygen.errors import UserError
 from anomalygen.schema import ItemError, RunManifest, StageRecord, format_validation_error
+from anomalygen.textfile import read_lines
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
@@ -99,21 +100,31 @@ def write_jsonl(path: Path, models: Iterable[BaseModel]) -> None:
     atomic_write_text(path, "".join(m.model_dump_json() + "\n" for m in models))
 
 
-def read_jsonl(path: Path, cls: type[M], *, strict: bool = True) -> list[M]:
+def read_jsonl(path: Path, cls: type[M], *, strict: bool = True, what: str = "JSONL file") -> list[M]:
     """Read a JSONL file of artefacts. With ``strict`` every bad line is reported, by line number."""
+    return [item for _, item in read_jsonl_numbered(path, cls, strict=strict, what=what)]
+
+
+def read_jsonl_numbered(path: Path, cls: type[M], *, strict: bool = True,
+                        what: str = "JSONL file") -> list[tuple[int, M]]:
+    """``read_jsonl`` with each artefact's line number. The file is read as text by
+    ``anomalygen.textfile`` (``what`` names it there): a folder, a binary file or text that is not
+    UTF-8 is one ``UserError`` line, strict or not. One bad line is reported on one line."""
     path = Path(path)
-    if not path.is_file():
-        raise UserError(f"missing file: {path}")
-    items: list[M] = []
+    items: list[tuple[int, M]] = []
     problems: list[str] = []
-    for lineno, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
+    for lineno, line in enumerate(read_lines(path, what=what), start=1):
         if not line.strip():
             continue
         try:
-            items.append(cls.model_validate_json(line))
+            items.append((lineno, cls.model_validate_json(line)))
         except ValidationError as exc:
             problems.append(f"line {lineno}: {format_validation_error(exc, limit=3)}")
     if problems and strict:
+        if len(problems) == 1:
+            line, reason = problems[0].split(": ", 1)
+            raise UserError(f"{path}, {line}: not a valid {cls.__name__}: {reason}; each line holds one "
+                            f"{cls.__name__} as JSON (see 'anomalygen schema {cls.__name__}')")
         shown = "\n  ".join(problems[:20])
         raise UserError(f"{path}: {len(problems)} invalid {cls.__name__} line(s):\n  {shown}")
     return items
