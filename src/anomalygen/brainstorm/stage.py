@@ -51,6 +51,21 @@ def load_user_tasks(path: str | Path) -> list[TaskProposal]:
     return [task for _, task in numbered]
 
 
+def check_inputs(settings: Settings) -> None:
+    """Read the user's own file (``--tasks`` or ``--tasks-text``), if one is set, before anything is
+    written: the CLI calls this before it creates the run folder, so a file that is missing, a folder,
+    binary, not UTF-8, over-long in a line or empty ends the command with one line and leaves the run
+    folder as it was (no folder, no manifest, no tasks.jsonl). ``run_stage`` reads the file again
+    (small, cheap) rather than carrying it through the stage interface."""
+    from anomalygen.brainstorm.free_text import read_task_lines
+
+    cfg = settings.brainstorm
+    if cfg.tasks_file:
+        load_user_tasks(cfg.tasks_file)
+    elif cfg.tasks_text:
+        read_task_lines(cfg.tasks_text)
+
+
 def generate(settings: Settings, run: RunFolder | None = None) -> tuple[list[TaskProposal], dict[str, str]]:
     """Proposals from the configured engine, and per-item errors (LLM engine only)."""
     cfg = settings.brainstorm
