@@ -93,3 +93,13 @@ def test_a_bad_tasks_text_named_in_the_config_or_the_environment_leaves_no_run_f
     line = one_error_line(run_cli("brainstorm", "--run", run, "--quiet", env={"ANOMALYGEN_BRAINSTORM__TASKS_TEXT": str(folder)}))
     assert f"{folder}: a folder, not a --tasks-text file" in line
     assert snapshot(run) == {} and not run.exists()
+
+
+def test_a_file_given_as_the_run_folder_is_one_line(tmp_path):
+    path = tmp_path / "notes.txt"
+    path.write_text("mine\n")
+    for command in ("brainstorm", "detect"):
+        line = one_error_line(run_cli(command, "--run", path, "--quiet"))
+        assert f"{path}: a file, not a run folder" in line
+    assert "cannot create the run folder: not a directory" in one_error_line(run_cli("brainstorm", "--run", path / "r"))
+    assert path.read_text() == "mine\n"

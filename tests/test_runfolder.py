@@ -91,6 +91,16 @@ def test_jsonl_that_is_not_text_or_one_bad_line_is_one_line(tmp_path):
     assert "\n" not in str(info.value) and f"{path}, line 1: not a valid Hypothesis" in str(info.value)
 
 
+def test_a_file_given_as_the_run_folder_is_a_user_error(tmp_path):
+    path = tmp_path / "notes.txt"
+    path.write_text("x")
+    for opening in (RunFolder.open, RunFolder.create):
+        with pytest.raises(UserError, match="a file, not a run folder"):
+            opening(path)
+    with pytest.raises(UserError, match="cannot create the run folder: not a directory"):
+        RunFolder.create(path / "run")
+
+
 def test_open_missing_run_folder_is_a_user_error(tmp_path):
     with pytest.raises(UserError, match="run folder not found"):
         RunFolder.open(tmp_path / "missing")

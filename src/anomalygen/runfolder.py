@@ -170,7 +170,11 @@ class RunFolder:
     @classmethod
     def create(cls, root: str | Path, *, settings: Settings | None = None) -> RunFolder:
         run = cls(root)
-        run.root.mkdir(parents=True, exist_ok=True)
+        run._refuse_a_file()
+        try:
+            run.root.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:  # a file on the way, no permission, a read-only disk
+            raise UserError(f"{run.root}: cannot create the run folder: {(exc.strerror or str(exc)).lower()}") from None
         run.sweep_temp_files()
         if not run.manifest_path.exists():
             run.save_manifest(run._new_manifest(settings))
@@ -185,10 +189,15 @@ class RunFolder:
     @classmethod
     def open(cls, root: str | Path) -> RunFolder:
         run = cls(root)
+        run._refuse_a_file()
         if not run.root.is_dir():
             raise UserError(f"run folder not found: {run.root} (create one with 'anomalygen brainstorm --out {run.root}')")
         run.sweep_temp_files()
         return run
+
+    def _refuse_a_file(self) -> None:
+        if self.root.exists() and not self.root.is_dir():
+            raise UserError(f"{self.root}: a file, not a run folder; give --run a folder's path (a new one is created)")
 
     def sweep_temp_files(self) -> int:
         """Delete temp files left by a process killed mid-write; they were never visible as outputs."""
