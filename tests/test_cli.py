@@ -103,3 +103,10 @@ def test_a_file_given_as_the_run_folder_is_one_line(tmp_path):
         assert f"{path}: a file, not a run folder" in line
     assert "cannot create the run folder: not a directory" in one_error_line(run_cli("brainstorm", "--run", path / "r"))
     assert path.read_text() == "mine\n"
+
+
+def test_a_folder_as_the_png_to_write_is_one_line_before_any_rendering(tmp_path):
+    for args in (["assets", "render", "Mug"], ["assets", "gallery"]):
+        line = one_error_line(run_cli(*args, "--out", tmp_path))
+        assert f"{tmp_path}: a folder; give --out the PNG file's path" in line
+    assert list(tmp_path.iterdir()) == []
