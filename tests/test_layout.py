@@ -18,6 +18,7 @@ CATALOGUES = {"assets/generators/household.py", "assets/generators/furniture.py"
 # floor, never one on its own floor or above: the packages of one floor know nothing of each other.
 FLOORS = (
     ("version", "errors", "rng", "tables", "procs", "embedding", "scene_files", "mjgeom", "schema"),
+    ("textfile",),  # the one reader of user text files, below config and runfolder, which read them
     ("config", "knowledge", "robot"),
     ("llm", "runfolder"),
     ("assets", "runner", "truth"),  # truth: the answer key, which the builder writes and the referee reads
@@ -175,9 +176,12 @@ def test_no_package_imports_one_on_its_own_floor_or_above():
 def test_the_floor_check_sees_an_upward_import_and_one_between_neighbours():
     edges = {"anomalygen.world.graph": {"anomalygen.scene.build"}, "anomalygen.skills.x": {"anomalygen.referee.y"},
              "anomalygen.scene.build": {"anomalygen.world.graph"}, "anomalygen.referee.y": set()}
+    floor = _floor_of()  # the numbers move when a floor is added below
+    world, scene = floor["world"], floor["scene"]
+    assert floor["skills"] == floor["referee"] == scene == world + 1
     assert _upward_imports(edges) == [
-        "anomalygen.skills.x -> anomalygen.referee.y (floor 5 imports floor 5)",
-        "anomalygen.world.graph -> anomalygen.scene.build (floor 4 imports floor 5)"]
+        f"anomalygen.skills.x -> anomalygen.referee.y (floor {scene} imports floor {scene})",
+        f"anomalygen.world.graph -> anomalygen.scene.build (floor {world} imports floor {scene})"]
 
 
 def test_the_robot_side_reaches_neither_the_builder_nor_the_answer_key_nor_the_referee():

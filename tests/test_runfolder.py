@@ -73,6 +73,34 @@ def test_jsonl_round_trip_and_line_numbered_errors(tmp_path):
     assert len(read_jsonl(path, Hypothesis, strict=False)) == 3
 
 
+def test_jsonl_keeps_a_record_whole_across_a_unicode_line_separator(tmp_path):
+    path = tmp_path / "h.jsonl"
+    write_jsonl(path, [Hypothesis(rank=1, problem="a\u2028b", solution="s", target_object="o")])
+    [back] = read_jsonl(path, Hypothesis)  # pydantic writes U+2028 raw; str.splitlines would cut there
+    assert back.problem == "a\u2028b"
+
+
+def test_jsonl_that_is_not_text_or_one_bad_line_is_one_line(tmp_path):
+    path = tmp_path / "h.jsonl"
+    path.write_bytes('{"problem": "caf\u00e9"}\n'.encode("latin-1"))
+    with pytest.raises(UserError, match=r"line 1: not UTF-8 text .*save the JSONL file as UTF-8"):
+        read_jsonl(path, Hypothesis, strict=False)
+    path.write_text("# a comment\n")
+    with pytest.raises(UserError) as info:
+        read_jsonl(path, Hypothesis)
+    assert "\n" not in str(info.value) and f"{path}, line 1: not a valid Hypothesis" in str(info.value)
+
+
+def test_a_file_given_as_the_run_folder_is_a_user_error(tmp_path):
+    path = tmp_path / "notes.txt"
+    path.write_text("x")
+    for opening in (RunFolder.open, RunFolder.create):
+        with pytest.raises(UserError, match="a file, not a run folder"):
+            opening(path)
+    with pytest.raises(UserError, match="cannot create the run folder: not a directory"):
+        RunFolder.create(path / "run")
+
+
 def test_open_missing_run_folder_is_a_user_error(tmp_path):
     with pytest.raises(UserError, match="run folder not found"):
         RunFolder.open(tmp_path / "missing")

@@ -141,10 +141,24 @@ def _finish(summary, as_json: bool, out=None) -> None:
         raise typer.Exit(1)
 
 
-def _open_run(path: Path, *, create: bool = False, settings: Settings | None = None):
+def _open_run(path: Path):
     from anomalygen.runfolder import RunFolder
 
-    return RunFolder.create(path, settings=settings) if create else RunFolder.open(path)
+    return RunFolder.open(path)
+
+
+def _create_run(path: Path, settings: Settings, stages: tuple[str, ...] | None = None):
+    """Create (or reopen) the run folder once the ``stages`` about to run (all, by default) have read
+    the user's own input files: a bad one ends the command with one line before anything is written,
+    so the folder is left as it was (no folder, manifest or tasks.jsonl for a run that failed on its
+    input)."""
+    from anomalygen.runfolder import RunFolder
+    from anomalygen.stages import STAGES
+
+    for s in STAGES:
+        if stages is None or s.name in stages:
+            s.check_inputs(settings)
+    return RunFolder.create(path, settings=settings)
 
 
 # ----------------------------------------------------------------------------- stages
@@ -176,7 +190,7 @@ def brainstorm(
            "brainstorm.rounds": rounds, "brainstorm.tasks_file": str(tasks) if tasks else None,
            "brainstorm.tasks_text": str(tasks_text) if tasks_text else None},
     )
-    _stage("brainstorm", _open_run(run, create=True, settings=settings), settings, as_json, force=force)
+    _stage("brainstorm", _create_run(run, settings, ("brainstorm",)), settings, as_json, force=force)
 
 
 @app.command()
@@ -332,7 +346,7 @@ def run_all(
 
     settings = _common(config or demo_config_path(), seed, quiet, workers, executor, address, **{"brainstorm.n": n})
     with _json_stdout(as_json) as stream:
-        result = run_pipeline(_open_run(run, create=True, settings=settings), settings, force=force)
+        result = run_pipeline(_create_run(run, settings), settings, force=force)
         if as_json:
             print(json.dumps(result, indent=2, default=str), file=stream, flush=True)
 

@@ -202,7 +202,7 @@ class Settings(BaseSettings):
         sources: list[PydanticBaseSettingsSource] = [init_settings, env_settings]
         toml_path = _CURRENT_TOML.get("path")
         if toml_path is not None:
-            sources.append(TomlConfigSettingsSource(settings_cls, toml_file=toml_path))
+            sources.append(_ConfigFileSource(settings_cls, toml_file=toml_path))
         # each layer's old key names are read as the new ones before the layers merge, so precedence holds
         return tuple(_MovedKeys(settings_cls, s, _layer_name(s, toml_path)) for s in sources)
 
@@ -293,32 +293,42 @@ def load_settings(config_file: str | Path | None = None, overrides: dict[str, An
     ``overrides`` may use dotted keys (``{"llm.backend": "openai"}``); ``None`` values are ignored so
     CLI options that were not given do not mask lower layers.
     """
-    from anomalygen.errors import UserError
-
     path = Path(config_file) if config_file else None
-    if path is not None and not path.is_file():
-        raise UserError(f"config file not found: {path}")
+    if path is not None:
+        parse_config_file(path)  # a bad file is one line here; the settings source would skip a missing one
     nested = _nest({k: v for k, v in (overrides or {}).items() if v is not None})
     _CURRENT_TOML["path"] = path
     try:
-        if path is not None:
-            _check_toml_readable(path)
         return Settings(**nested)  # pydantic-settings deep-merges the sources
     finally:
         _CURRENT_TOML["path"] = None
 
 
-def _check_toml_readable(path: Path) -> None:
+CONFIG_FILE = "config file"
+
+
+def parse_config_file(path: Path) -> dict[str, Any]:
+    """A ``--config`` TOML, read as text by ``anomalygen.textfile`` (the one reader of user files: a
+    missing path, a folder, a binary file or text not in UTF-8 is one ``UserError`` line naming the
+    file) and parsed; invalid TOML is one line with its line and column."""
     import tomllib
 
     from anomalygen.errors import UserError
+    from anomalygen.textfile import read_text
 
+    text = read_text(path, what=CONFIG_FILE)
     try:
-        tomllib.loads(path.read_text())
-    except (OSError, UnicodeDecodeError) as exc:
-        raise UserError(f"cannot read config file {path}: {exc}") from exc
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise UserError(f"invalid TOML in {path}: {exc}") from exc
+        raise UserError(f"invalid TOML in {path}: {exc}") from None
+
+
+class _ConfigFileSource(TomlConfigSettingsSource):
+    """pydantic-settings' TOML source, reading the file with ``parse_config_file`` (so a UTF-8 file
+    with a byte-order mark, which ``tomllib`` on the raw bytes refuses, reads the same both times)."""
+
+    def _read_file(self, file_path) -> dict[str, Any]:
+        return parse_config_file(Path(file_path))
 
 
 def _nest(flat: dict[str, Any]) -> dict[str, Any]:

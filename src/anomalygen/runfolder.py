@@ -31,6 +31,7 @@ from pydantic import BaseModel, ValidationError
 
 from anomalygen.errors import UserError
 from anomalygen.schema import ItemError, RunManifest, StageRecord, format_validation_error
+from anomalygen.textfile import read_lines
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
@@ -99,21 +100,31 @@ def write_jsonl(path: Path, models: Iterable[BaseModel]) -> None:
     atomic_write_text(path, "".join(m.model_dump_json() + "\n" for m in models))
 
 
-def read_jsonl(path: Path, cls: type[M], *, strict: bool = True) -> list[M]:
+def read_jsonl(path: Path, cls: type[M], *, strict: bool = True, what: str = "JSONL file") -> list[M]:
     """Read a JSONL file of artefacts. With ``strict`` every bad line is reported, by line number."""
+    return [item for _, item in read_jsonl_numbered(path, cls, strict=strict, what=what)]
+
+
+def read_jsonl_numbered(path: Path, cls: type[M], *, strict: bool = True,
+                        what: str = "JSONL file") -> list[tuple[int, M]]:
+    """``read_jsonl`` with each artefact's line number. The file is read as text by
+    ``anomalygen.textfile`` (``what`` names it there): a folder, a binary file or text that is not
+    UTF-8 is one ``UserError`` line, strict or not. One bad line is reported on one line."""
     path = Path(path)
-    if not path.is_file():
-        raise UserError(f"missing file: {path}")
-    items: list[M] = []
+    items: list[tuple[int, M]] = []
     problems: list[str] = []
-    for lineno, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1):
+    for lineno, line in enumerate(read_lines(path, what=what), start=1):
         if not line.strip():
             continue
         try:
-            items.append(cls.model_validate_json(line))
+            items.append((lineno, cls.model_validate_json(line)))
         except ValidationError as exc:
             problems.append(f"line {lineno}: {format_validation_error(exc, limit=3)}")
     if problems and strict:
+        if len(problems) == 1:
+            line, reason = problems[0].split(": ", 1)
+            raise UserError(f"{path}, {line}: not a valid {cls.__name__}: {reason}; each line holds one "
+                            f"{cls.__name__} as JSON (see 'anomalygen schema {cls.__name__}')")
         shown = "\n  ".join(problems[:20])
         raise UserError(f"{path}: {len(problems)} invalid {cls.__name__} line(s):\n  {shown}")
     return items
@@ -159,7 +170,11 @@ class RunFolder:
     @classmethod
     def create(cls, root: str | Path, *, settings: Settings | None = None) -> RunFolder:
         run = cls(root)
-        run.root.mkdir(parents=True, exist_ok=True)
+        run._refuse_a_file()
+        try:
+            run.root.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:  # a file on the way, no permission, a read-only disk
+            raise UserError(f"{run.root}: cannot create the run folder: {(exc.strerror or str(exc)).lower()}") from None
         run.sweep_temp_files()
         if not run.manifest_path.exists():
             run.save_manifest(run._new_manifest(settings))
@@ -174,10 +189,15 @@ class RunFolder:
     @classmethod
     def open(cls, root: str | Path) -> RunFolder:
         run = cls(root)
+        run._refuse_a_file()
         if not run.root.is_dir():
             raise UserError(f"run folder not found: {run.root} (create one with 'anomalygen brainstorm --out {run.root}')")
         run.sweep_temp_files()
         return run
+
+    def _refuse_a_file(self) -> None:
+        if self.root.exists() and not self.root.is_dir():
+            raise UserError(f"{self.root}: a file, not a run folder; give --run a folder's path (a new one is created)")
 
     def sweep_temp_files(self) -> int:
         """Delete temp files left by a process killed mid-write; they were never visible as outputs."""

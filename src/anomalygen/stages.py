@@ -28,6 +28,8 @@ class Stage(Protocol):
     def run(self, run: RunFolder, settings: Settings, *, force: bool = False,
             only: list[str] | None = None) -> StageSummary: ...
 
+    def check_inputs(self, settings: Settings) -> None: ...
+
 
 @dataclass(frozen=True)
 class ModuleStage:
@@ -55,6 +57,14 @@ class ModuleStage:
         elif only:
             raise ValueError(f"stage {self.name} works on the whole run; it takes no --only")
         return fn(run, settings, **kwargs)
+
+    def check_inputs(self, settings: Settings) -> None:
+        """Read the user's own input files the stage will read (its module's ``check_inputs``, where it
+        has one) and raise ``UserError`` on a bad one; writes nothing, so it runs before the run folder
+        is created."""
+        check = getattr(importlib.import_module(self.module), "check_inputs", None)
+        if check is not None:
+            check(settings)
 
 
 STAGES: tuple[Stage, ...] = (

@@ -33,6 +33,14 @@ def _check_name(name: str) -> str:
     raise UserError(f"unknown asset name {name!r}; see 'anomalygen assets list'")
 
 
+def _png_out(path: Path) -> Path:
+    """An ``--out`` path a PNG can be written to, checked before the rendering starts: a folder there
+    is one line (the write would otherwise fail after the work, with a traceback)."""
+    if path.is_dir():
+        raise UserError(f"{path}: a folder; give --out the PNG file's path, e.g. {path / 'out.png'}")
+    return path
+
+
 @app.command("list")
 def list_cmd(
     json_out: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
@@ -134,6 +142,7 @@ def render(
     from anomalygen.assets.core import draw
     from anomalygen.assets.render import render_asset, save_png
 
+    _png_out(out_path)
     a = draw(_check_name(name), seed, real=real)
     save_png(render_asset(a, width=width, height=height, open_fraction=open_fraction), out_path)
     out.print(f"wrote {out_path}")
@@ -272,6 +281,7 @@ def gallery(
     from anomalygen.assets.render import gallery as make_gallery
     from anomalygen.assets.render import save_png
 
+    _png_out(out_path)
     names = household_names() if household else target_names()
     if real:
         names = [n for n in target_names() + household_names() if n in by_category()]

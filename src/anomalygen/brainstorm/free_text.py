@@ -27,19 +27,26 @@ from anomalygen.knowledge.grounding import NameGrounder
 from anomalygen.knowledge.mechanisms import load_mechanisms
 from anomalygen.rng import item_rng
 from anomalygen.schema import BrainstormMode, Engine, GroundingMatch, TaskProposal
+from anomalygen.textfile import read_lines
 
 USER_TEXT = "user_text"
 
 
-def read_lines(path: str | Path) -> list[str]:
-    """The non-empty lines of a text file (``#`` starts a comment line)."""
-    path = Path(path)
-    if not path.is_file():
-        raise UserError(f"{path}: no such file")
-    lines = [ln.strip() for ln in path.read_text(encoding="utf-8").splitlines()]
+# The longest line a --tasks-text file may hold. A hazard line is one description, a sentence or two
+# (the test fixture's longest is 92 characters); 1,000 leaves room for a long paragraph, and stops a
+# pasted document or a file with no line breaks before the parser and the embedder spend time on it.
+MAX_LINE_CHARS = 1000
+
+
+def read_task_lines(path: str | Path) -> list[str]:
+    """The descriptions of a --tasks-text file: its non-blank lines (``#`` starts a comment line), read
+    through ``anomalygen.textfile`` (a folder, a binary file, text not in UTF-8 or a line over
+    ``MAX_LINE_CHARS`` is one ``UserError`` line)."""
+    lines = [ln.strip() for ln in read_lines(path, what="--tasks-text file", max_chars=MAX_LINE_CHARS,
+                                               limit_reason="one hazard, a sentence or two")]
     lines = [ln for ln in lines if ln and not ln.startswith("#")]
     if not lines:
-        raise UserError(f"{path}: no task descriptions in the file")
+        raise UserError(f"{path}: no task descriptions, only blank lines and # comments; write one hazard per line")
     return lines
 
 

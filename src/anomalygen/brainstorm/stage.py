@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from anomalygen.errors import UserError
-from anomalygen.runfolder import RunFolder, now_iso, read_jsonl, write_jsonl
+from anomalygen.runfolder import RunFolder, now_iso, read_jsonl_numbered, write_jsonl
 from anomalygen.runner import StageSummary
 from anomalygen.schema import Engine, StageRecord, TaskProposal
 
@@ -23,20 +23,23 @@ if TYPE_CHECKING:
 STAGE = "brainstorm"
 
 
+# How the user's own tasks.jsonl is named in its errors (``brainstorm --tasks FILE``).
+TASKS_FILE = "--tasks file"
+
+
 def load_user_tasks(path: str | Path) -> list[TaskProposal]:
     """A user's tasks.jsonl: schema-checked per line, then checked against the catalogue, ids unique."""
     from anomalygen.brainstorm.validate import proposal_problems
     from anomalygen.knowledge import load_kb
 
     path = Path(path)
-    tasks = read_jsonl(path, TaskProposal)  # raises UserError listing every malformed line
-    if not tasks:
-        raise UserError(f"{path}: no tasks in the file")
+    numbered = read_jsonl_numbered(path, TaskProposal, what=TASKS_FILE)  # a UserError for every malformed line
+    if not numbered:
+        raise UserError(f"{path}: no tasks in the {TASKS_FILE}, only blank lines; write one TaskProposal per line")
     kb = load_kb()
     problems: list[str] = []
     seen: set[str] = set()
-    lines = [i for i, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1) if line.strip()]
-    for lineno, task in zip(lines, tasks, strict=True):
+    for lineno, task in numbered:
         if task.id in seen:
             problems.append(f"line {lineno}: duplicate id '{task.id}'")
         seen.add(task.id)
@@ -45,7 +48,22 @@ def load_user_tasks(path: str | Path) -> list[TaskProposal]:
         shown = "\n  ".join(problems[:20])
         more = f"\n  ... and {len(problems) - 20} more" if len(problems) > 20 else ""
         raise UserError(f"{path}: {len(problems)} problem(s) with the tasks:\n  {shown}{more}")
-    return tasks
+    return [task for _, task in numbered]
+
+
+def check_inputs(settings: Settings) -> None:
+    """Read the user's own file (``--tasks`` or ``--tasks-text``), if one is set, before anything is
+    written: the CLI calls this before it creates the run folder, so a file that is missing, a folder,
+    binary, not UTF-8, over-long in a line or empty ends the command with one line and leaves the run
+    folder as it was (no folder, no manifest, no tasks.jsonl). ``run_stage`` reads the file again
+    (small, cheap) rather than carrying it through the stage interface."""
+    from anomalygen.brainstorm.free_text import read_task_lines
+
+    cfg = settings.brainstorm
+    if cfg.tasks_file:
+        load_user_tasks(cfg.tasks_file)
+    elif cfg.tasks_text:
+        read_task_lines(cfg.tasks_text)
 
 
 def generate(settings: Settings, run: RunFolder | None = None) -> tuple[list[TaskProposal], dict[str, str]]:
@@ -71,9 +89,9 @@ def generate(settings: Settings, run: RunFolder | None = None) -> tuple[list[Tas
 def tasks_from_text(settings, run: RunFolder | None = None) -> tuple[list[TaskProposal], dict[str, str]]:
     """Proposals from ``brainstorm.tasks_text``: structured by the LLM engine when it is the brainstorm
     engine, else grounded offline by retrieval; per-line errors either way."""
-    from anomalygen.brainstorm.free_text import read_lines, tasks_from_lines
+    from anomalygen.brainstorm.free_text import read_task_lines, tasks_from_lines
 
-    lines = read_lines(settings.brainstorm.tasks_text)
+    lines = read_task_lines(settings.brainstorm.tasks_text)
     if settings.engine_for("brainstorm") == Engine.LLM:
         from anomalygen.brainstorm.llm_engine import LLMEngine
 
