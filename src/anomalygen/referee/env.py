@@ -46,16 +46,29 @@ class JudgedEnv(gym.Wrapper):
     def __init__(self, env: gym.Env, scene_dir: str | Path | None = None, *, judge="end"):
         super().__init__(env)
         self.scene_dir = Path(scene_dir if scene_dir is not None else env.unwrapped.scene_dir)
-        self.judging = judging_mode(judge)
+        self.judging = judge
         self.verdict = None  # the last verdict of this episode (at its end, or asked for)
+
+    @property
+    def judging(self) -> str:
+        """When the referee judges: "end" or "never" (settable, also as True / False)."""
+        return self._judging
+
+    @judging.setter
+    def judging(self, judge) -> None:
+        self._judging = judging_mode(judge)
+        # Judging off: ``step`` is the wrapped env's own bound method, so the wrapper adds no call
+        # per step (benchmarks/bench_env_step.py); judging at the end: this class's step.
+        self.step = self.env.step if self._judging == "never" else self._judged_step
 
     def reset(self, **kwargs):
         self.verdict = None
         return self.env.reset(**kwargs)
 
     def step(self, action):
-        if self.judging != "end":  # training: the env's own step, nothing added
-            return self.env.step(action)
+        return self._judged_step(action) if self._judging == "end" else self.env.step(action)
+
+    def _judged_step(self, action):
         obs, reward, terminated, truncated, info = self.env.step(action)
         if terminated or truncated:
             verdict = self.verdict_now()
