@@ -142,7 +142,7 @@ class Agent:
     def __init__(self, model: mujoco.MjModel):
         import mujoco
 
-        self._mj = mujoco
+        self._mj, self._mul_quat = mujoco, mujoco.mju_mulQuat
         self.model = model
         self.cup = int(model.body(self.CUP_BODY).id)
         self.cup_geom = int(model.geom(self.CUP_GEOM).id)
@@ -349,40 +349,48 @@ class Agent:
         self._move_target(data, action.tolist(), action, dp, dr)
 
     def _views(self, data: mujoco.MjData) -> None:
-        """Cache numpy views of ``data``'s arrays (each MjData attribute access is a pybind call) and
-        the scratch arrays of :meth:`_move_target`; the env's hot path reads them every step."""
+        """Cache views of ``data``'s arrays and the scratch quaternions of :meth:`_move_target`.
+
+        Why memoryviews: each MjData attribute access is a pybind call, and reading or writing three
+        or four floats through a memoryview costs a third of numpy's item or slice assignment; the
+        env's hot path does it every step. The bytes are MjData's own, so MuJoCo sees every write.
+        """
         self._data = data
-        self._mpos, self._mquat, self._cpos = data.mocap_pos[self.mocap], data.mocap_quat[self.mocap], data.xpos[self.cup]
-        self._active = data.eq_active
+        self._mquat_arr = data.mocap_quat[self.mocap]  # an array: mju_mulQuat's argument
+        self._mpos, self._mquat = memoryview(data.mocap_pos[self.mocap]), memoryview(self._mquat_arr)
+        self._cpos, self._active = memoryview(data.xpos[self.cup]), memoryview(data.eq_active)
         self._dq, self._q = np.zeros(4), np.zeros(4)
+        self._dq_view, self._q_view = memoryview(self._dq), memoryview(self._q)
 
     def _move_target(self, data: mujoco.MjData, vals: list, action: np.ndarray, dp: float, dr: float) -> None:
         """:meth:`move_target` on ``vals`` (``action.tolist()``, which :meth:`apply_action` has already)."""
         if data is not self._data:
             self._views(data)
         a0, a1, a2, a3, a4, a5 = vals[:6]
-        mpos, mquat, dq, q = self._mpos, self._mquat, self._dq, self._q
-        mx, my, mz = mpos.tolist()
-        cx, cy, cz = self._cpos.tolist()
+        mpos, mquat, dq = self._mpos, self._mquat, self._dq_view
+        mx, my, mz = mpos
+        cx, cy, cz = self._cpos
         lim, nlim = self.TARGET_LEASH, -self.TARGET_LEASH
         # cup + clip(target + dp * a - cup): float for float the same operations as numpy's (the
         # comparisons are min(max(v, -lim), lim) without two calls, NaN passing through alike)
         x, y, z = mx + dp * a0 - cx, my + dp * a1 - cy, mz + dp * a2 - cz
-        mpos[:] = (cx + (nlim if x < nlim else lim if x > lim else x), cy + (nlim if y < nlim else lim if y > lim else y),
-                   cz + (nlim if z < nlim else lim if z > lim else z))
+        mpos[0] = cx + (nlim if x < nlim else lim if x > lim else x)
+        mpos[1] = cy + (nlim if y < nlim else lim if y > lim else y)
+        mpos[2] = cz + (nlim if z < nlim else lim if z > lim else z)
         r = action[3:6]
         n = math.sqrt(r.dot(r))  # = np.linalg.norm(r); a Python sum of squares rounds differently
         k = n + 1e-9
-        angle = dr * min(1.0, n)
+        angle = dr * (n if n < 1.0 else 1.0)  # dr * min(1.0, n)
         if angle == 0:  # mju_axisAngle2Quat's own arithmetic, bit for bit (tests/robot/test_agent.py)
-            dq[:] = (1.0, 0.0, 0.0, 0.0)
+            dq[0], dq[1], dq[2], dq[3] = 1.0, 0.0, 0.0, 0.0
         else:
             s = math.sin(angle * 0.5)
-            dq[:] = (math.cos(angle * 0.5), a3 / k * s, a4 / k * s, a5 / k * s)
-        self._mj.mju_mulQuat(q, mquat, dq)  # q_target * dq: a turn about the cup's own axes
-        w, x, y, z = q.tolist()
+            dq[0], dq[1], dq[2], dq[3] = math.cos(angle * 0.5), a3 / k * s, a4 / k * s, a5 / k * s
+        q = self._q
+        self._mul_quat(q, self._mquat_arr, self._dq)  # q_target * dq: a turn about the cup's own axes
+        w, x, y, z = self._q_view
         k = math.sqrt(q.dot(q))  # = np.linalg.norm(q)
-        mquat[:] = (w / k, x / k, y / k, z / k)
+        mquat[0], mquat[1], mquat[2], mquat[3] = w / k, x / k, y / k, z / k
 
     def apply_action(self, data: mujoco.MjData, action, *, dp: float = STEP_POS, dr: float = STEP_ROT) -> np.ndarray:
         """Map one 7-D action onto the target and the suction toggle (no physics step): the one action
