@@ -11,7 +11,7 @@ def make_env(scene_dir, *, judge="end", **kwargs):
     wrapped in :class:`anomalygen.referee.env.JudgedEnv`.
 
     ``judge="end"`` (the default, for outside policies; ``True`` too): when an episode ends the
-    referee's verdict is in ``info["verdict"]`` and ``info["is_success"]`` (about 16 ms per episode).
+    referee's verdict is in ``info["verdict"]`` and ``info["is_success"]`` (20-60 ms per episode).
     ``judge="never"`` (``False`` too; for training loops): the env's own step and info, no referee,
     unless asked with ``env.verdict_now()``."""
     from anomalygen.referee.env import make_judged_env

@@ -3,7 +3,7 @@
 Why: a researcher's own policy must be judged exactly like ours. The wrapped env is the perception-only
 scene env (it knows nothing of the answer key); the referee (:func:`anomalygen.referee.judge`) gives
 the verdict on the state the policy left — on copies, after releasing what the cup holds and letting
-the scene settle. That costs about 16 ms, a few hundred physics steps' worth, so it happens only when
+the scene settle. That costs 20-60 ms, several hundred physics steps' worth, so it happens only when
 the caller asks, by the ``judging`` mode:
 
 - ``"end"`` (the default of :func:`anomalygen.make_env`, for outside policies): when an episode
