@@ -2,14 +2,28 @@
 
 from anomalygen.version import __version__
 
-__all__ = ["__version__", "make_env"]
+__all__ = ["__version__", "make_env", "make_vec_env"]
 
 
-def make_env(scene_dir, **kwargs):
-    """The Gymnasium env of a built scene folder, judged: the perception-only scene env
-    (:mod:`anomalygen.world.env`) wrapped in :class:`anomalygen.referee.env.JudgedEnv`, which puts the
-    referee's verdict in ``info["verdict"]`` (and ``info["is_success"]``) when an episode ends."""
-    from anomalygen.referee.env import JudgedEnv
-    from anomalygen.world.env import make_env as _make_env
+def make_env(scene_dir, *, judge="end", **kwargs):
+    """The Gymnasium env of a built scene folder: the perception-only scene env
+    (:mod:`anomalygen.world.env`; ``kwargs`` go to it: ``frameskip``, ``horizon``, ``reward_fn``, ...)
+    wrapped in :class:`anomalygen.referee.env.JudgedEnv`.
 
-    return JudgedEnv(_make_env(scene_dir, **kwargs), scene_dir)
+    ``judge="end"`` (the default, for outside policies; ``True`` too): when an episode ends the
+    referee's verdict is in ``info["verdict"]`` and ``info["is_success"]`` (20-60 ms per episode).
+    ``judge="never"`` (``False`` too; for training loops): the env's own step and info, no referee,
+    unless asked with ``env.verdict_now()``."""
+    from anomalygen.referee.env import make_judged_env
+
+    return make_judged_env(scene_dir, judge=judge, **kwargs)
+
+
+def make_vec_env(scene_dir, n_envs: int = 1, *, judge="never", subproc: bool = False, seed=None, **kwargs):
+    """A Stable-Baselines3 ``VecEnv`` (what SB3's SAC, PPO, ... take) of ``n_envs`` envs of the scene,
+    each as :func:`make_env` makes it: ``DummyVecEnv``, or ``SubprocVecEnv`` with ``subproc``. Made
+    for training, so ``judge`` defaults to "never"; ``judge="end"`` puts the verdict in the info of
+    every env whose episode ends (before SB3's automatic reset)."""
+    from anomalygen.referee.env import make_judged_vec_env
+
+    return make_judged_vec_env(scene_dir, n_envs, judge=judge, subproc=subproc, seed=seed, **kwargs)

@@ -139,3 +139,39 @@ def test_one_action_mapping_with_the_agents_step_size():
     assert agent.held(data) is None  # nothing in range of the cup at home: the grab finds nothing
     agent.apply_action(data, np.r_[np.zeros(6), 1.0])
     assert agent.held(data) is None
+
+
+def _reference_move(data, agent, action):
+    """The action mapping written in numpy and MuJoCo's own functions, as it read before the scalar
+    maths of ``Agent._move_target``: the target after one action, computed on copies."""
+    a = np.clip(np.asarray(action, dtype=float), -1.0, 1.0)
+    cup, lim = data.xpos[agent.cup], Agent.TARGET_LEASH
+    pos = cup + np.clip(data.mocap_pos[agent.mocap] + Agent.STEP_POS * a[:3] - cup, -lim, lim)
+    n = np.linalg.norm(a[3:6])
+    dq, q = np.zeros(4), np.zeros(4)
+    mujoco.mju_axisAngle2Quat(dq, a[3:6] / (n + 1e-9), Agent.STEP_ROT * min(1.0, n))
+    mujoco.mju_mulQuat(q, data.mocap_quat[agent.mocap], dq)
+    return pos, q / np.linalg.norm(q)
+
+
+def test_the_action_mappings_scalar_maths_is_numpys_and_mujocos_bit_for_bit():
+    """Every env's hot path computes the target in Python scalars (leash comparisons, the axis-angle
+    quaternion with math.sin/cos): the same bits as numpy's clip and norm and MuJoCo's
+    mju_axisAngle2Quat, so trajectories (and the learning curves pinned on them) are unchanged.
+    Actions in range and beyond it, a zero rotation, tiny and leashed moves, the arm moving between."""
+    model, data = _robot_with_box()
+    agent = Agent(model)
+    agent.set_control_mode(data, "ee_delta_pose")
+    rng = np.random.default_rng(0)
+    for i in range(300):
+        action = rng.uniform(-1.5, 1.5, 7).astype(np.float32)
+        if i % 5 == 0:
+            action[3:6] = 0.0  # no rotation: the zero-angle branch
+        elif i % 5 == 1:
+            action[3:6] *= 1e-8  # a rotation below the axis's 1e-9 guard's scale
+        action[6] = -1.0
+        pos, quat = _reference_move(data, agent, action)
+        agent.apply_action(data, action)
+        assert np.array_equal(data.mocap_pos[agent.mocap], pos), i
+        assert np.array_equal(data.mocap_quat[agent.mocap], quat), i
+        mujoco.mj_step(model, data, 2)

@@ -14,7 +14,8 @@ Public entry points:
 - :func:`load_verdict` — a learn run's verdict from a run folder;
 - :func:`load_manifest` — a scene's truth manifest;
 - :class:`~anomalygen.referee.env.JudgedEnv` — a Gymnasium wrapper that puts the verdict in ``info``
-  at the end of an episode (what ``anomalygen.make_env`` returns).
+  at the end of an episode, or judges only when asked (what ``anomalygen.make_env`` returns, with
+  ``judge="end"`` or ``"never"``; ``anomalygen.make_vec_env`` gives a Stable-Baselines3 VecEnv of them).
 """
 
 from __future__ import annotations

@@ -142,7 +142,7 @@ class Agent:
     def __init__(self, model: mujoco.MjModel):
         import mujoco
 
-        self._mj = mujoco
+        self._mj, self._mul_quat = mujoco, mujoco.mju_mulQuat
         self.model = model
         self.cup = int(model.body(self.CUP_BODY).id)
         self.cup_geom = int(model.geom(self.CUP_GEOM).id)
@@ -242,7 +242,7 @@ class Agent:
     # ---------------------------------------------------------------- grab and release
     def held(self, data: mujoco.MjData) -> str | None:
         """The body welded to the cup, if any (the first active suction weld)."""
-        active = data.eq_active
+        active = self._active if data is self._data else data.eq_active
         for k, eq in enumerate(self._eq_list):
             if active[eq]:
                 return self.suction_objects[k]
@@ -309,8 +309,13 @@ class Agent:
 
     def release(self, data: mujoco.MjData, body: str | None = None) -> None:
         """Suction off: let go of ``body`` (or of whatever is held)."""
-        if body is None:
-            data.eq_active[self._suction_eqs] = 0
+        if body is None:  # every env step without suction comes here: the cached view, no fancy index
+            if data is not self._data:
+                self._views(data)
+            active = self._active
+            for eq in self._eq_list:
+                if active[eq]:
+                    active[eq] = 0
             return
         eq = self.suction_eq(body)
         if eq >= 0:
@@ -337,30 +342,55 @@ class Agent:
 
         The arithmetic is exactly that of the SAC door benchmark's env, so its learning curves (and
         the tests that pin them) are unchanged: the axis is ``a / (|a| + 1e-9)``, and the target
-        quaternion is renormalised every step. Scalar maths where it gives numpy's exact values, and
-        MuJoCo's own quaternion functions where it would not, keep it cheap: it is every env's hot path.
+        quaternion is renormalised every step. Scalar maths where it gives numpy's (or MuJoCo's
+        ``mju_axisAngle2Quat``'s) exact values, and numpy's dot and MuJoCo's quaternion product
+        (FMA-rounded) where it would not, keep it cheap: it is every env's hot path.
         """
-        if data is not self._data:  # cache the views: each MjData attribute access is a pybind call
-            self._data = data
-            self._mpos, self._mquat, self._cpos = data.mocap_pos[self.mocap], data.mocap_quat[self.mocap], data.xpos[self.cup]
-            self._axis, self._dq, self._q = np.zeros(3), np.zeros(4), np.zeros(4)
-        a0, a1, a2, a3, a4, a5 = action.tolist()[:6]
-        mx, my, mz = self._mpos.tolist()
-        cx, cy, cz = self._cpos.tolist()
-        lim = self.TARGET_LEASH
-        # cup + clip(target + dp * a - cup): float for float the same operations as numpy's
-        self._mpos[:] = (cx + min(max(mx + dp * a0 - cx, -lim), lim), cy + min(max(my + dp * a1 - cy, -lim), lim),
-                         cz + min(max(mz + dp * a2 - cz, -lim), lim))
+        self._move_target(data, action.tolist(), action, dp, dr)
+
+    def _views(self, data: mujoco.MjData) -> None:
+        """Cache views of ``data``'s arrays and the scratch quaternions of :meth:`_move_target`.
+
+        Why memoryviews: each MjData attribute access is a pybind call, and reading or writing three
+        or four floats through a memoryview costs a third of numpy's item or slice assignment; the
+        env's hot path does it every step. The bytes are MjData's own, so MuJoCo sees every write.
+        """
+        self._data = data
+        self._mquat_arr = data.mocap_quat[self.mocap]  # an array: mju_mulQuat's argument
+        self._mpos, self._mquat = memoryview(data.mocap_pos[self.mocap]), memoryview(self._mquat_arr)
+        self._cpos, self._active = memoryview(data.xpos[self.cup]), memoryview(data.eq_active)
+        self._dq, self._q = np.zeros(4), np.zeros(4)
+        self._dq_view, self._q_view = memoryview(self._dq), memoryview(self._q)
+
+    def _move_target(self, data: mujoco.MjData, vals: list, action: np.ndarray, dp: float, dr: float) -> None:
+        """:meth:`move_target` on ``vals`` (``action.tolist()``, which :meth:`apply_action` has already)."""
+        if data is not self._data:
+            self._views(data)
+        a0, a1, a2, a3, a4, a5 = vals[:6]
+        mpos, mquat, dq = self._mpos, self._mquat, self._dq_view
+        mx, my, mz = mpos
+        cx, cy, cz = self._cpos
+        lim, nlim = self.TARGET_LEASH, -self.TARGET_LEASH
+        # cup + clip(target + dp * a - cup): float for float the same operations as numpy's (the
+        # comparisons are min(max(v, -lim), lim) without two calls, NaN passing through alike)
+        x, y, z = mx + dp * a0 - cx, my + dp * a1 - cy, mz + dp * a2 - cz
+        mpos[0] = cx + (nlim if x < nlim else lim if x > lim else x)
+        mpos[1] = cy + (nlim if y < nlim else lim if y > lim else y)
+        mpos[2] = cz + (nlim if z < nlim else lim if z > lim else z)
         r = action[3:6]
         n = math.sqrt(r.dot(r))  # = np.linalg.norm(r); a Python sum of squares rounds differently
         k = n + 1e-9
-        self._axis[:] = (a3 / k, a4 / k, a5 / k)
-        self._mj.mju_axisAngle2Quat(self._dq, self._axis, dr * min(1.0, n))
+        angle = dr * (n if n < 1.0 else 1.0)  # dr * min(1.0, n)
+        if angle == 0:  # mju_axisAngle2Quat's own arithmetic, bit for bit (tests/robot/test_agent.py)
+            dq[0], dq[1], dq[2], dq[3] = 1.0, 0.0, 0.0, 0.0
+        else:
+            s = math.sin(angle * 0.5)
+            dq[0], dq[1], dq[2], dq[3] = math.cos(angle * 0.5), a3 / k * s, a4 / k * s, a5 / k * s
         q = self._q
-        self._mj.mju_mulQuat(q, self._mquat, self._dq)  # q_target * dq: a turn about the cup's own axes
-        w, x, y, z = q.tolist()
+        self._mul_quat(q, self._mquat_arr, self._dq)  # q_target * dq: a turn about the cup's own axes
+        w, x, y, z = self._q_view
         k = math.sqrt(q.dot(q))  # = np.linalg.norm(q)
-        self._mquat[:] = (w / k, x / k, y / k, z / k)
+        mquat[0], mquat[1], mquat[2], mquat[3] = w / k, x / k, y / k, z / k
 
     def apply_action(self, data: mujoco.MjData, action, *, dp: float = STEP_POS, dr: float = STEP_ROT) -> np.ndarray:
         """Map one 7-D action onto the target and the suction toggle (no physics step): the one action
@@ -378,12 +408,13 @@ class Agent:
             raw = list(action)
         if len(raw) != 7 or isinstance(raw[0], list):  # a (1, 7) or (7, 1) array: flatten it
             raw = np.asarray(action, dtype=float).reshape(7).tolist()
-        # np.clip's values, cheaper (this runs every env step)
-        a = np.array([v if -1.0 <= v <= 1.0 else (1.0 if v > 0 else -1.0) for v in raw], dtype=float)
-        self.move_target(data, a, dp=dp, dr=dr)
+        # np.clip's values, cheaper (this runs every env step); the list goes on to the target's maths
+        vals = [v if -1.0 <= v <= 1.0 else (1.0 if v > 0 else -1.0) for v in raw]
+        a = np.array(vals, dtype=float)
+        self._move_target(data, vals, a, dp, dr)
         if not self._eq_list:
             return a
-        if a[6] > 0:
+        if vals[6] > 0:
             if self.held(data) is None:
                 self.grab(data)
         else:  # a no-op when nothing is held, and cheaper than asking first (every env step runs it)

@@ -74,7 +74,7 @@ class SceneEnv(gym.Env):
 
         from anomalygen.world.perception import load_perceived_scene
 
-        self._mj = mujoco
+        self._mj, self._mj_step = mujoco, mujoco.mj_step
         self.scene_dir = Path(scene_dir)
         # ``scene``, not ``spec``: Gymnasium keeps its EnvSpec in ``env.spec`` and ``gym.make`` sets it.
         self.model, self.data, self.scene = load_perceived_scene(self.scene_dir)
@@ -159,13 +159,15 @@ class SceneEnv(gym.Env):
         return self._observe(), self._info(False)
 
     def step(self, action):
-        d = self.data
-        a = self.agent.apply_action(d, action, dp=self.max_delta_pos, dr=self.max_delta_rot)
-        self._mj.mj_step(self.model, d, self.frameskip)
+        # The hot path (benchmarks/bench_env_step.py): each attribute read here costs a share of the
+        # frameskip mj_step calls, so the step function and the agent are read once.
+        d, agent = self.data, self.agent
+        a = agent.apply_action(d, action, dp=self.max_delta_pos, dr=self.max_delta_rot)
+        self._mj_step(self.model, d, self.frameskip)
         self.t += 1
         if self._use_sensors:  # inlined _observe fast path; suction off releases, so only 'on' asks
             self._o_sens[:] = self._v_sens
-            self._obs[-1] = 0.0 if a[6] <= 0.0 or self.agent.held(d) is None else 1.0
+            self._obs[-1] = 0.0 if a[6] <= 0.0 or agent.held(d) is None else 1.0
             obs = self._obs.copy()
         else:
             obs = self._observe()
