@@ -222,6 +222,20 @@ def test_impossible_placements_fail_with_a_clear_message(bad, says):
     assert says in S.format_validation_error(exc.value)
 
 
+def test_a_task_written_with_a_string_placement_still_loads():
+    """tasks.jsonl of runs written before the typed placement (and LLM replies) keep loading."""
+    old = json.dumps(_proposal(scenario={"hazard_object": "power_cable", "room": "bathroom",
+                                         "placement": "inside:Bathtub"}))
+    task = S.TaskProposal.model_validate_json(old)
+    assert task.scenario.placement == S.Placement(relation="inside", other="Bathtub")
+    written = json.loads(task.model_dump_json())
+    assert written["scenario"]["placement"] == {"relation": "inside", "support": None, "other": "Bathtub"}
+    assert S.TaskProposal.model_validate(written) == task
+    with pytest.raises(ValidationError) as exc:
+        S.TaskProposal.model_validate(_proposal(scenario={"hazard_object": "Knife", "room": "k", "placement": "ceiling"}))
+    assert "scenario.placement" in S.format_validation_error(exc.value)
+
+
 def test_a_template_placement_is_filled_with_the_other_object():
     tpl = S.Placement.model_validate("near:" + S.OTHER_SLOT)
     assert tpl.filled("Crib") == S.Placement(relation="near", other="Crib")

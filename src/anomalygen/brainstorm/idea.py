@@ -18,6 +18,7 @@ from anomalygen.schema import (
     AuxiliaryItem,
     BrainstormMode,
     Engine,
+    Placement,
     Provenance,
     Scenario,
     TaskProposal,
@@ -32,7 +33,7 @@ class Idea:
     class_id: str
     target: str
     hazard: str
-    placement: str
+    placement: Placement
     room: str
     person: str
     container: str | None = None
