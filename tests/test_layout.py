@@ -6,6 +6,7 @@ and controllers live in ``robot/`` only; the old homes of the skills are gone; t
 names are spelled in one module."""
 
 import ast
+import re
 from pathlib import Path
 
 import anomalygen
@@ -302,3 +303,51 @@ def test_no_module_takes_a_private_name_from_another_package():
                 if private and _package(node.module) != _package(module):
                     taken.append(f"{module}: {node.module}.{', '.join(private)}")
     assert taken == []
+
+
+def _placement_parsing(tree: ast.AST) -> list[str]:
+    """What in a module reads a placement's compact form: a ``relation:`` prefix spelled out (also as
+    the end of an f-string piece, ``f"inside:{name}"``), an edge suffix (``"_edge"``), or a string
+    method (split, partition, startswith, ...) called on a value whose expression names a placement."""
+    from anomalygen.schema import OBJECT_RELATIONS, RELATIONS
+
+    prefixes = tuple(f"{r}:" for r in OBJECT_RELATIONS)
+    ends = re.compile(rf"(?<![A-Za-z0-9_])({'|'.join(OBJECT_RELATIONS)}):$")  # "...inside:" but not "position:"
+    pieces = {part for r in RELATIONS for part in r.word.split("{support}") if part and part != r.word}
+    docstrings = {id(n.body[0].value) for n in ast.walk(tree)
+                  if isinstance(n, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)) and n.body
+                  and isinstance(n.body[0], ast.Expr) and isinstance(n.body[0].value, ast.Constant)}
+    in_fstring = {id(v) for n in ast.walk(tree) if isinstance(n, ast.JoinedStr) for v in n.values}
+    methods = {"split", "rsplit", "partition", "rpartition", "startswith", "endswith", "removeprefix"}
+    hits = []
+    for n in ast.walk(tree):
+        if isinstance(n, ast.Constant) and isinstance(n.value, str) and id(n) not in docstrings:
+            s = n.value
+            if s.startswith(prefixes) or s in pieces or (id(n) in in_fstring and ends.search(s)):
+                hits.append(repr(s))
+        elif isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute) and n.func.attr in methods \
+                and "placement" in ast.unparse(n.func.value).lower():
+            hits.append(ast.unparse(n))
+    return hits
+
+
+def test_placements_are_parsed_in_the_schema_only():
+    """The compact placement words ("counter_edge", "inside:Bathtub") are read by ``schema/placement.py``
+    alone; everywhere else reads the typed ``Placement``'s fields (relation, support, other)."""
+    found = {}
+    for path in ROOT.rglob("*.py"):
+        rel = path.relative_to(ROOT).as_posix()
+        if rel.startswith("schema/"):
+            continue
+        hits = _placement_parsing(ast.parse(path.read_text()))
+        if hits:
+            found[rel] = hits
+    assert found == {}
+
+
+def test_the_checker_sees_a_placement_parsed():
+    src = ('def f(sc, name):\n    """near:Crib is fine in a docstring."""\n'
+           '    a = sc.placement.split(":", 1)[1]\n    b = "inside:Bathtub"\n    c = f"on:{name}"\n'
+           '    d = kind.replace("_edge", "")\n    return p.startswith("near:")\n')
+    hits = _placement_parsing(ast.parse(src))
+    assert len(hits) == 5 and not any("Crib" in h for h in hits), hits

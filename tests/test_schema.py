@@ -121,3 +121,122 @@ def test_joint_state_is_closed_is_the_one_closed_test():
     flap = JointState(name="f", label="flap", value=-1.0, range=(-2.0, 0.0), closed_value=0.0)
     assert flap.open_fraction_at(-0.1) == pytest.approx(0.05) and flap.is_closed(value=-0.1)
     assert not flap.is_closed()
+
+
+# ---------------------------------------------------------------- Placement
+OLD_WORDS = ("floor", "walkway", "table", "low_table", "table_edge", "counter", "counter_edge", "shelf", "shelf_edge",
+             "on:Stove", "inside:Bathtub", "near:Sink")
+
+
+def _data_placements() -> set[str]:
+    """Every placement the knowledge data files write (as compact words)."""
+    from anomalygen.knowledge.models import KNOWLEDGE_DIR
+
+    found: set[str] = set()
+
+    def walk(node):
+        if isinstance(node, dict):
+            for key, value in node.items():
+                if key == "placements" and isinstance(value, list):  # (aliases.json's is a table of words)
+                    found.update(value)
+                else:
+                    walk(value)
+        elif isinstance(node, list):
+            for value in node:
+                walk(value)
+
+    for path in KNOWLEDGE_DIR.glob("*.json"):
+        walk(json.loads(path.read_text()))
+    return found
+
+
+@pytest.mark.parametrize("word", OLD_WORDS)
+def test_every_old_placement_word_round_trips(word):
+    p = S.Placement.model_validate(word)
+    assert p.key == str(p) == word
+    assert S.Placement.model_validate(p.model_dump()) == p
+    assert S.Placement.model_validate_json(p.model_dump_json()) == p
+
+
+def test_the_old_words_read_as_relation_support_and_other():
+    read = {w: S.Placement.model_validate(w) for w in OLD_WORDS}
+    assert read["counter_edge"] == S.Placement(relation="at_edge", support="counter")
+    assert read["table"] == S.Placement(relation="on", support="table")
+    assert read["floor"] == S.Placement(relation="on", support="floor")
+    assert read["walkway"] == S.Placement(relation="walkway") == S.Placement(relation="walkway", support="floor")
+    assert read["inside:Bathtub"] == S.Placement(relation="inside", other="Bathtub")
+    assert read["on:Stove"] == S.Placement(relation="on", other="Stove")
+    assert read["near:Sink"] == S.Placement(relation="near", other="Sink")
+    assert read["shelf_edge"].furniture == "shelf" and read["walkway"].furniture is None
+    assert read["on:Stove"].furniture is None
+    assert len(set(read.values())) == len(OLD_WORDS)  # hashable, and no two words read alike
+
+
+def test_the_knowledge_data_placements_all_round_trip():
+    words = _data_placements()
+    assert {"counter_edge", "near:{other}", "inside:Refrigerator"} <= words
+    for word in words:
+        assert S.Placement.model_validate(word).key == word
+
+
+def test_the_derived_views_come_from_the_one_list_of_relations():
+    from typing import get_args
+
+    assert get_args(S.Placement.model_fields["relation"].annotation) == tuple(S.RELATION_KINDS)
+    assert [r.name for r in S.RELATIONS] == list(S.RELATION_KINDS)
+    assert set(S.OBJECT_RELATIONS) == {"inside", "on", "near"}
+    assert {p.key for p in S.SUPPORT_PLACEMENTS} == set(OLD_WORDS[:9])
+    assert all(p.other is None for p in S.SUPPORT_PLACEMENTS)
+
+
+def test_the_tables_keyed_by_the_compact_word_cover_every_support_placement():
+    """Phrase tables keyed by the word (grounding's meanings, the phrase bank's places, the alias table's
+    targets) name exactly the placements the schema knows; the support kinds are the knowledge base's."""
+    from anomalygen.brainstorm.realise import bank
+    from anomalygen.knowledge import SUPPORT_HEIGHTS
+    from anomalygen.knowledge.grounding import PLACEMENT_TEXTS, _aliases
+
+    words = {p.key for p in S.SUPPORT_PLACEMENTS}
+    assert set(PLACEMENT_TEXTS) == words == set(bank()["place"])
+    assert set(_aliases()["placements"].values()) <= words
+    assert set(SUPPORT_HEIGHTS) == set(S.SUPPORT_KINDS)
+
+
+@pytest.mark.parametrize(("bad", "says"), [
+    ("inside", "is not one of"),
+    ("ceiling", "is not one of"),
+    ("low_table_edge", "is not one of"),
+    ("inside:", "needs the name of the other object"),
+    ("under:Table", "'under' is not a relation to another object"),
+    ({"relation": "inside"}, "needs the name of another object"),
+    ({"relation": "on"}, "needs a support kind"),
+    ({"relation": "at_edge", "support": "floor"}, "takes table, counter, shelf, not 'floor'"),
+    ({"relation": "walkway", "other": "Sink"}, "names no other object"),
+    ({"relation": "on", "support": "table", "other": "Stove"}, "not both"),
+    ({"relation": "under", "other": "Table"}, "relation"),
+    ({"relation": "on", "support": "ceiling"}, "support"),
+])
+def test_impossible_placements_fail_with_a_clear_message(bad, says):
+    with pytest.raises(ValidationError) as exc:
+        S.Placement.model_validate(bad)
+    assert says in S.format_validation_error(exc.value)
+
+
+def test_a_task_written_with_a_string_placement_still_loads():
+    """tasks.jsonl of runs written before the typed placement (and LLM replies) keep loading."""
+    old = json.dumps(_proposal(scenario={"hazard_object": "power_cable", "room": "bathroom",
+                                         "placement": "inside:Bathtub"}))
+    task = S.TaskProposal.model_validate_json(old)
+    assert task.scenario.placement == S.Placement(relation="inside", other="Bathtub")
+    written = json.loads(task.model_dump_json())
+    assert written["scenario"]["placement"] == {"relation": "inside", "support": None, "other": "Bathtub"}
+    assert S.TaskProposal.model_validate(written) == task
+    with pytest.raises(ValidationError) as exc:
+        S.TaskProposal.model_validate(_proposal(scenario={"hazard_object": "Knife", "room": "k", "placement": "ceiling"}))
+    assert "scenario.placement" in S.format_validation_error(exc.value)
+
+
+def test_a_template_placement_is_filled_with_the_other_object():
+    tpl = S.Placement.model_validate("near:" + S.OTHER_SLOT)
+    assert tpl.filled("Crib") == S.Placement(relation="near", other="Crib")
+    assert S.Placement(relation="on", support="table").filled("Crib") == S.Placement(relation="on", support="table")

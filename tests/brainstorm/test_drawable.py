@@ -7,6 +7,7 @@ import numpy as np
 from anomalygen.brainstorm.drawable import fits_inside, placements_for, why_not_drawable
 from anomalygen.knowledge import load_kb
 from anomalygen.scene import asset_choice
+from anomalygen.schema import Placement
 
 
 def test_an_object_longer_than_every_interior_is_never_placed_inside():
@@ -16,9 +17,9 @@ def test_an_object_longer_than_every_interior_is_never_placed_inside():
     assert not fits_inside(kb, "spoon", "Toaster") and not fits_inside(kb, "fork", "Toaster")
     assert fits_inside(kb, "fork", "Microwave")
     water = kb.hazard_classes["take_electrical_out_of_water"]
-    assert "inside:Sink" not in placements_for(kb, water, "power_cable")
-    assert "inside:Bathtub" in placements_for(kb, water, "power_cable")
-    assert "inside:Sink" in placements_for(kb, water, "PowerStrip")
+    assert Placement(relation="inside", other="Sink") not in placements_for(kb, water, "power_cable")
+    assert Placement(relation="inside", other="Bathtub") in placements_for(kb, water, "power_cable")
+    assert Placement(relation="inside", other="Sink") in placements_for(kb, water, "PowerStrip")
     # a class whose only object never fits its only holder is not drawn at all, and says why
     toaster = kb.hazard_classes["remove_item_from_toaster"]
     assert "room inside" in why_not_drawable(kb, toaster)
@@ -71,7 +72,7 @@ def test_the_food_a_chemical_stands_among_is_not_a_second_hazard():
     foods = set()
     for _ in range(60):
         idea = sampler.idea_for(rng, chem, "bleach_bottle", agent=None, agent_index=0, round_=1)
-        foods.add(idea.placement.split(":", 1)[1] if ":" in idea.placement else idea.co_objects[0])
+        foods.add(idea.placement.other or idea.co_objects[0])
     assert foods and foods <= {"apple", "banana", "bread_loaf"}, foods
 
 
@@ -83,6 +84,6 @@ def test_the_text_names_the_object_beside_the_hazard_once():
 
     for p in KnowledgeEngine(seed=0, embed_fn=lambda texts: np.eye(len(texts), 8)).run(40):
         place = p.scenario.placement
-        if ":" in place:
-            name = nice(place.split(":", 1)[1])
+        if place.other is not None:
+            name = nice(place.other)
             assert p.description.lower().count(name) <= 1, (place, p.description)

@@ -8,6 +8,7 @@ import pytest
 from anomalygen.brainstorm.free_text import TextGrounder, tasks_from_lines
 from anomalygen.brainstorm.line_compose import Refused
 from anomalygen.knowledge import load_kb
+from anomalygen.schema import Placement
 
 
 @pytest.fixture(scope="module")
@@ -29,7 +30,7 @@ def reader():
 ])
 def test_a_line_becomes_the_hazard_it_states(reader, line, cls, hazard, placement):
     task = reader.proposal(line, 1)
-    assert (task.hazard_class, task.scenario.hazard_object, task.scenario.placement) == (cls, hazard, placement)
+    assert (task.hazard_class, task.scenario.hazard_object, task.scenario.placement.key) == (cls, hazard, placement)
     assert task.description == line and task.source == "user_text"
     by_field = {m.field: m for m in task.grounding}
     assert by_field["mechanism"].method == "composed" and by_field["scenario.hazard_object"].method == "parsed"
@@ -67,7 +68,7 @@ def test_one_bad_line_fails_alone_and_the_power_strip_in_a_full_sink_is_built_as
     assert [t.scenario.hazard_object for t in tasks] == ["kitchen_knife", "PowerStrip", "pill_bottle"]
     assert set(errors) == {"line2"} and "broken" in errors["line2"]
     strip = tasks[1]
-    assert (strip.scenario.placement, strip.scenario.room) == ("inside:Sink", "bathroom")
+    assert (strip.scenario.placement, strip.scenario.room) == (Placement(relation="inside", other="Sink"), "bathroom")
     assert strip.scenario.states == {"Sink": ["contains_water"]}
 
 

@@ -15,6 +15,7 @@ from anomalygen.brainstorm.llm_reply import LLMProposal
 from anomalygen.knowledge import load_kb
 from anomalygen.llm import get_client
 from anomalygen.llm.schema_tools import reply_token_budget
+from anomalygen.schema import Placement
 from support.fixtures import llm_config_for
 from support.openai_server import text
 
@@ -57,7 +58,7 @@ SLIPS = [
          "explanation": "A toddler could swallow the tablets.", "category": "child_safety", "hazard_class": "other",
          "target_asset": "Safe", "hazard_object": "blister pack", "room": "living room", "placement": "coffee table", "container": "medicine cabinet"},
         {"hazard_class": "secure_medications", "scenario.hazard_object": "blister_pack", "scenario.room": "living_room",
-         "scenario.placement": "low_table", "scenario.container": "medicine_cabinet"},
+         "scenario.placement": Placement(relation="on", support="low_table"), "scenario.container": "medicine_cabinet"},
     ),
 ]
 

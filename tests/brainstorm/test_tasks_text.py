@@ -18,7 +18,7 @@ from anomalygen.brainstorm.llm_engine import reply_json
 from anomalygen.brainstorm.validate import proposal_problems
 from anomalygen.knowledge import load_kb
 from anomalygen.runfolder import read_jsonl
-from anomalygen.schema import TaskProposal
+from anomalygen.schema import Placement, TaskProposal
 from support.fixtures import llm_config_for
 from support.ids import assert_ids_carry_no_task_words
 from support.openai_server import text
@@ -69,7 +69,7 @@ def test_tasks_text_with_the_llm_engine_grounds_the_models_names(scripted_server
     assert summary.done == 1 and summary.failed == 0
     [task] = read_jsonl(run.tasks_path, TaskProposal)
     assert (task.target_asset, task.scenario.hazard_object, task.hazard_class) == ("Kettle", "Kettle", "switch_off_appliance")
-    assert (task.scenario.room, task.scenario.placement) == ("kitchen", "counter")
+    assert (task.scenario.room, task.scenario.placement) == ("kitchen", Placement(relation="on", support="counter"))
     assert task.description == "The kettle was left switched on and is boiling away."
     assert_ids_carry_no_task_words([task])
     assert "boiling away" in srv.requests[0]["messages"][-1]["content"]

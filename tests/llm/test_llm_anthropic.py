@@ -42,7 +42,7 @@ def test_repair_retry_and_text_fallback(scripted_server, tmp_path):
         [status(529), tool_use({"hazard_object": "knife", "room": 1}), text("ok: " + VALID_TEXT)]
     )
     client = anthropic_client(srv, tmp_path, http_retries=2)
-    assert client.complete(USER, schema=Scenario).placement == "counter_edge"
+    assert client.complete(USER, schema=Scenario).placement.key == "counter_edge"
     assert len(srv.requests) == 3
     repair_turn = srv.requests[2]["messages"]
     assert [m["role"] for m in repair_turn] == ["user", "assistant", "user"]

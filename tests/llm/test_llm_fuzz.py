@@ -50,7 +50,7 @@ CASES: list[tuple[str, str, bool]] = [
     ("huge string value", _with(hazard_object="x" * 1_000_000), False),
     ("emoji and rtl", _with(room="k\u202eitchen 🔪\u200b"), True),
     ("optional fields", _with(container="drawer", co_objects=["plate", "cup"]), True),
-    ("nested braces inside strings", _with(placement="floor {not json} ]["), True),
+    ("nested braces inside strings", _with(room="kitchen {not json} ]["), True),
     ("escaped unicode", _with(room="\\u006b\\u0069tchen").replace("\\\\", "\\"), True),
     ("null container", _with(container=None), True),
     ("truncated 10", VALID_TEXT[:10], False),

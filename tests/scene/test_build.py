@@ -139,14 +139,16 @@ def test_build_is_deterministic(built_scenes, scene_settings, tmp_path):
     assert spec.robot_base == first.robot_base  # the start pose is drawn from the scene's generator
 
 
-def test_unknown_placement_fails_with_one_line_reason(scene_settings, tmp_path):
-    from anomalygen.errors import ItemFailed
-    from anomalygen.scene.build import build_scene
+def test_unknown_placement_is_refused_with_one_line_reason():
+    """A placement the builder has no relation kind for never reaches it: the task itself does not load
+    (the schema's ``Placement`` knows every kind the builder builds)."""
+    from pydantic import ValidationError
+
+    from anomalygen.schema import format_validation_error
 
     from .conftest import make_task
 
-    task = make_task("t-bad", "remove_choking_hazards", "Safe", "button_battery", "ceiling")
-    with pytest.raises(ItemFailed) as err:
-        build_scene(task, seed=0, settings=scene_settings, out_dir=tmp_path / "bad")
-    assert "\n" not in str(err.value) and "ceiling" in str(err.value)
-    assert not (tmp_path / "bad" / "scene.json").exists()
+    with pytest.raises(ValidationError) as err:
+        make_task("t-bad", "remove_choking_hazards", "Safe", "button_battery", "ceiling")
+    reason = format_validation_error(err.value)
+    assert "\n" not in reason and "ceiling" in reason

@@ -12,13 +12,14 @@ from .conftest import TASKS, make_task
 
 def test_build_resume_and_failure_reason(tmp_path):
     run = RunFolder.create(tmp_path / "run")
-    bad = make_task("t-bad", "remove_choking_hazards", "Safe", "button_battery", "ceiling")
+    # loads (a placement the schema knows), but a banana has no interior to put the battery in
+    bad = make_task("t-bad", "remove_choking_hazards", "Safe", "button_battery", "inside:banana")
     write_jsonl(run.tasks_path, [TASKS["floor"], bad])
     settings = Settings(workers=1, quiet=True, build={"clutter": 0})
     first = run_stage(run, settings)
     assert (first.done, first.failed) == (1, 1)
     reason = run.errors("build")[0].error
-    assert "ceiling" in reason and "\n" not in reason
+    assert "inside:banana" in reason and "\n" not in reason
     assert read_model(run.scene_dir("t-floor") / "scene.json", SceneSpec).validation.ok
     assert (run.scenes_dir / "contact_sheet.png").stat().st_size > 1000
     second = run_stage(run, settings, only=["t-floor"])

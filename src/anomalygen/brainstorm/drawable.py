@@ -4,9 +4,10 @@ built and fixed today.
 The knowledge base composes classes over objects and places the builder or the robot may not have
 yet (a sink that holds water, a skill to turn a pan handle). Proposing those would make tasks that
 fail later, so the engine draws from the intersection of the composed space with what the asset
-catalogue holds (``assets``), the placements and states the builder sets up (``scene/capabilities``)
-and the recipe actions the planner can carry out (``plan/planner.plannable``). Nothing is listed by
-hand: a new asset, placement or skill becomes drawable as soon as it exists.
+catalogue holds (``assets``), the states the builder sets up (``scene/capabilities``; it builds every
+placement relation of ``schema/placement.py``) and the recipe actions the planner can carry out
+(``plan/planner.plannable``). Nothing is listed by hand: a new asset, relation kind, state or skill
+becomes drawable as soon as it exists.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from __future__ import annotations
 import functools
 
 from anomalygen.knowledge import HazardClass, KnowledgeBase
-from anomalygen.schema import part_labels
+from anomalygen.schema import Placement, part_labels
 
 
 @functools.cache
@@ -75,15 +76,13 @@ def _part_ok(hc: HazardClass, variable: str | None, obj: str) -> bool:
     return art is None or variable is None or art.variable != variable or has_part(obj, art.part)
 
 
-def buildable_placement(placement: str) -> bool:
-    from anomalygen.scene.capabilities import can_place
-
-    if not can_place(placement):
-        return False
-    parent = placement.split(":", 1)[1] if ":" in placement else None
+def buildable_placement(placement: Placement) -> bool:
+    """Every relation kind is built (``scene/placement.py``); one to another object needs that object's
+    asset, and inside it an interior."""
+    parent = placement.other
     if parent is None:
         return True
-    return parent in catalogue() and (not placement.startswith("inside:") or has_interior(parent))
+    return parent in catalogue() and (placement.relation != "inside" or has_interior(parent))
 
 
 @functools.cache
@@ -168,7 +167,7 @@ def harmless_first(kb: KnowledgeBase, objects: list[str]) -> list[str]:
     return [o for o in objects if o not in bad] or objects
 
 
-def placements_for(kb: KnowledgeBase, hc: HazardClass, hazard: str) -> list[str]:
+def placements_for(kb: KnowledgeBase, hc: HazardClass, hazard: str) -> list[Placement]:
     """The class's placements for ``hazard`` that the builder can set up with objects it has."""
     var = relation_variable(hc)
     states = needed_states(kb, hc).get(var, []) if var else []
@@ -176,8 +175,8 @@ def placements_for(kb: KnowledgeBase, hc: HazardClass, hazard: str) -> list[str]
     for p in kb.placements_for(hc, hazard):
         if not buildable_placement(p):
             continue
-        parent = p.split(":", 1)[1] if ":" in p else None
-        if p.startswith("inside:") and not fits_inside(kb, hazard, parent):
+        parent = p.other
+        if p.relation == "inside" and not fits_inside(kb, hazard, parent):
             continue
         if parent is not None and var is not None and not (all(state_shown(kb, parent, s) for s in states)
                                                            and _part_ok(hc, var, parent)):

@@ -148,7 +148,7 @@ class TextGrounder:
                                   alternatives=[x for x in (c.kind, c.condition, c.place, c.fix) if x]))
         out.append(GroundingMatch(field="hazard_class", written=line, grounded=hc.id, method="composed"))
         out += [
-            GroundingMatch(field="scenario.placement", written=line, grounded=placement,
+            GroundingMatch(field="scenario.placement", written=line, grounded=placement.key,
                            method="parsed" if placement_said else "class_default"),
             GroundingMatch(field="scenario.room", written=line, grounded=room, method="normalised" if room_said else "class_default"),
             GroundingMatch(field="target_asset", written=line, grounded=target,

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 from anomalygen.brainstorm.llm_reply import LLMProposal
 from anomalygen.knowledge.grounding import GENERIC_CLASS_WORDS, NameGrounder, normalise
-from anomalygen.schema import GroundingMatch, HazardCategory
+from anomalygen.schema import GroundingMatch, HazardCategory, Placement
 
 #: Values that mean "no such thing" (an empty container, no co-objects).
 EMPTY_WORDS = frozenset({"", "none", "null", "n_a", "na", "nothing", "no", "empty", "no_container", "not_applicable", "nil"})
@@ -33,7 +33,7 @@ class GroundedNames:
     target_asset: str
     hazard_object: str
     room: str
-    placement: str
+    placement: Placement | None  # None: the written placement was not grounded (a problem says so)
     container: str | None
     co_objects: list[str]
     matches: list[GroundingMatch] = field(default_factory=list)
@@ -44,6 +44,11 @@ class GroundedNames:
 def _closest(m: GroundingMatch) -> str:
     shown = m.alternatives[:3]
     return f" (closest: {', '.join(shown)})" if shown else ""
+
+
+def grounded_placement(m: GroundingMatch) -> Placement | None:
+    """The placement a grounded match names (its compact word), None when it was not grounded."""
+    return Placement.model_validate(m.grounded) if m.grounded is not None else None
 
 
 def is_empty(value: str | None) -> bool:
@@ -86,7 +91,9 @@ def ground_llm_names(raw: LLMProposal, g: NameGrounder, *, reader=None) -> Groun
         target = options[0] if options else (hc.target_assets[0] if hc is not None and hc.target_assets else "Table")
         matches.append(GroundingMatch(field="target_asset", written=raw.target_asset, grounded=target, method="class_default"))
     room = keep(g.room(raw.room))
-    placement = keep(g.placement(raw.placement))
+    placement_match = g.placement(raw.placement)
+    keep(placement_match)
+    placement = grounded_placement(placement_match)
     container = None
     if is_empty(raw.container):
         if raw.container is not None:
@@ -135,7 +142,7 @@ def _hazard_class(raw: LLMProposal, g: NameGrounder, hazard: str, category: str,
     if raw.new_class is not None:
         from anomalygen.brainstorm.new_class import to_class
 
-        placement = g.placement(raw.placement).grounded or "floor"
+        placement = grounded_placement(g.placement(raw.placement)) or Placement(relation="on", support="floor")
         target = g.target(raw.target_asset).grounded or ""
         container = None if is_empty(raw.container) else g.object(raw.container or "", "new_class").grounded
         hc, bad = to_class(raw.new_class, kb, category=HazardCategory(category), placement=placement, target=target,

@@ -20,6 +20,7 @@ from anomalygen.schema import (
     Engine,
     GroundingMatch,
     HazardCategory,
+    Placement,
     Provenance,
     Scenario,
     TaskProposal,
@@ -34,7 +35,7 @@ class Idea:
     class_id: str
     target: str
     hazard: str
-    placement: str
+    placement: Placement
     room: str
     person: str
     container: str | None = None

@@ -11,17 +11,20 @@ in the catalogue and its hazard's preconditions can be set up by the scene build
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import TypeVar
 
 import numpy as np
 
 from anomalygen.brainstorm.idea import Idea
 from anomalygen.knowledge import HazardClass, KnowledgeBase, RoleProfile
+from anomalygen.schema import Placement
 
 #: Weight ratio between successive options of a typicality-ordered list for the role-less generator.
 TYPICAL_DECAY = 0.35
+T = TypeVar("T")
 
 
-def weighted(rng: np.random.Generator, options: list[str], weights: dict[str, float] | None = None) -> str:
+def weighted(rng: np.random.Generator, options: list[T], weights: dict[T, float] | None = None) -> T:
     if not options:
         raise ValueError("nothing to choose from")
     w = np.array([max(1e-6, (weights or {}).get(o, 1.0)) for o in options], dtype=float)
@@ -91,10 +94,10 @@ class IdeaSampler:
         self.benign = [b for b in kb.benign_objects() if "floor" not in kb.objects[b].supports]
         #: How often the group has already used a class/object/room/placement (set by the engine in
         #: brainstorm mode, where agents see the shared pool): choices lean away from repeats.
-        self.seen: dict[str, int] = {}
+        self.seen: dict[str | Placement, int] = {}
 
     # ---------------------------------------------------------------- weights
-    def _w(self, kind: str, options: list[str] | None = None) -> dict[str, float] | None:
+    def _w(self, kind: str, options: list | None = None) -> dict | None:
         if self.role is None and options is not None and kind != "object_target":
             # No persona and no group: fall back on the most typical choice (lists are ordered by
             # typicality in the knowledge base), as a plainly prompted generator tends to.
@@ -173,8 +176,8 @@ class IdeaSampler:
             pool = [c for c in candidates if c != avoid_hazard] or candidates
             hazard = weighted(rng, pool, self._w("object", pool))
         placements = placements_for(kb, hc, hazard)
-        parents = harmless_first(kb, [p.split(":", 1)[1] for p in placements if ":" in p])
-        placements = [p for p in placements if ":" not in p or p.split(":", 1)[1] in parents]
+        parents = harmless_first(kb, [p.other for p in placements if p.other is not None])
+        placements = [p for p in placements if p.other is None or p.other in parents]
         placement = weighted(rng, placements, self._w("placement", placements))
         rooms = [r for r in hc.rooms if r in kb.objects[hazard].rooms] or list(hc.rooms)
         room = weighted(rng, rooms, self._w("room", rooms))
@@ -188,8 +191,8 @@ class IdeaSampler:
         co: list[str] = []
         related = relation_variable(hc)
         for var in secondary_variables(hc):
-            if var == related and ":" in placement:  # the burner the towel is on: the placement's object
-                co.append(placement.split(":", 1)[1])
+            if var == related and placement.other is not None:  # the burner the towel is on: the placement's object
+                co.append(placement.other)
             else:
                 co.append(weighted(rng, harmless_first(kb, self.kb.static_candidates(hc, var))))
         if self.rich:

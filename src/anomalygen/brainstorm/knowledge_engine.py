@@ -24,7 +24,7 @@ from anomalygen.brainstorm.idea_sampler import IdeaSampler
 from anomalygen.brainstorm.realise import realise
 from anomalygen.knowledge import KnowledgeBase, load_kb
 from anomalygen.rng import item_rng
-from anomalygen.schema import BrainstormMode, Engine, TaskProposal
+from anomalygen.schema import BrainstormMode, Engine, Placement, TaskProposal
 
 EmbedFn = Callable[[list[str]], np.ndarray]
 
@@ -186,9 +186,9 @@ class KnowledgeEngine:
             kept.append((i, idea, texts))
         return kept
 
-    def _usage_counts(self) -> dict[str, int]:
+    def _usage_counts(self) -> dict[str | Placement, int]:
         """What the group has proposed so far (agents in a session see the shared pool)."""
-        counts: dict[str, int] = {}
+        counts: dict[str | Placement, int] = {}
         for a in self.accepted:
             i = a.idea
             for key in {i.class_id, i.hazard, i.target, i.room, i.placement}:

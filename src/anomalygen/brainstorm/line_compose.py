@@ -21,6 +21,7 @@ from anomalygen.brainstorm.line_parse import (
 from anomalygen.knowledge import HazardClass, KnowledgeBase
 from anomalygen.knowledge.grounding import NameGrounder
 from anomalygen.knowledge.mechanisms import MechanismSet
+from anomalygen.schema import RELATION_KINDS, Placement
 
 #: Evidence weights (unitless scores): a relation to a fitting object outweighs cue words, which
 #: outweigh a place or condition the class needs no words for.
@@ -33,14 +34,16 @@ EXTRA_CUE = 0.25  # each further cue word of the same place (a line that dwells 
 MAX_EXTRA_CUES = 3
 
 #: Words that name a surface, and the placement each gives (an edge word turns it into its edge).
-SURFACE_WORDS: tuple[tuple[tuple[str, ...], str], ...] = (
+SURFACE_WORDS: tuple[tuple[tuple[str, ...], Placement], ...] = (
     (("coffee table", "side table", "low table", "nightstand", "bedside table", "bedside", "footstool", "ottoman",
-      "sofa table", "end table"), "low_table"),
-    (("counter", "countertop", "worktop", "benchtop", "kitchen counter", "work surface", "draining board"), "counter"),
-    (("table", "desk", "dining table", "kitchen table", "workbench"), "table"),
-    (("shelf", "shelves", "bookshelf", "bookcase", "top shelf", "high shelf"), "shelf"),
-    (("hallway", "corridor", "walkway", "doorway", "middle of the floor", "middle of the room", "path"), "walkway"),
-    (("floor", "ground", "carpet", "rug", "floorboards", "tiles"), "floor"),
+      "sofa table", "end table"), Placement(relation="on", support="low_table")),
+    (("counter", "countertop", "worktop", "benchtop", "kitchen counter", "work surface", "draining board"),
+     Placement(relation="on", support="counter")),
+    (("table", "desk", "dining table", "kitchen table", "workbench"), Placement(relation="on", support="table")),
+    (("shelf", "shelves", "bookshelf", "bookcase", "top shelf", "high shelf"), Placement(relation="on", support="shelf")),
+    (("hallway", "corridor", "walkway", "doorway", "middle of the floor", "middle of the room", "path"),
+     Placement(relation="walkway")),
+    (("floor", "ground", "carpet", "rug", "floorboards", "tiles"), Placement(relation="on", support="floor")),
 )
 EDGE_WORDS = ("edge", "rim", "brink", "hanging over", "overhanging", "half off", "corner of", "teetering", "lip")
 
@@ -188,18 +191,18 @@ def _no_mechanism(p: ParsedLine, subjects: list[Mention], near: list, kb: Knowle
     return f"no mechanism for {said}; closest: {hc.id} (needs {missing})"
 
 
-def placement_for(p: ParsedLine, hc: HazardClass, comp: Composition, ms: MechanismSet) -> tuple[str, bool]:
+def placement_for(p: ParsedLine, hc: HazardClass, comp: Composition, ms: MechanismSet) -> tuple[Placement, bool]:
     """The scenario placement the line states for ``comp`` (True), or the class's own first one (False)."""
     place = ms.places[hc.composition.place]
     if comp.other is not None:
         for tpl in place.placements:
-            cand = tpl.replace("{other}", comp.other.name)
-            if ":" in cand and cand.split(":", 1)[1] == comp.other.name:
+            cand = tpl.filled(comp.other.name)
+            if cand.other == comp.other.name:
                 return cand, True
     for m in p.mentions:  # a legacy class's own holders: sour milk inside the fridge, a fork in the microwave
         if m is comp.fault or m.relation not in ("inside", "on"):
             continue
-        cand = f"{m.relation}:{m.name}"
+        cand = Placement(relation=m.relation, other=m.name)
         if cand in hc.placements:
             return cand, True
     surface = None
@@ -208,11 +211,11 @@ def placement_for(p: ParsedLine, hc: HazardClass, comp: Composition, ms: Mechani
             surface = kind
             break
     if surface is not None:
-        edge = surface in ("table", "counter", "shelf") and bool(p.said(EDGE_WORDS))
-        wanted = f"{surface}_edge" if edge else surface
+        edge = surface.support in RELATION_KINDS["at_edge"].supports and bool(p.said(EDGE_WORDS))
+        wanted = Placement(relation="at_edge", support=surface.support) if edge else surface
         if wanted in hc.placements:
             return wanted, True
-        if edge and f"{surface}_edge" not in hc.placements and surface in hc.placements:
+        if edge and wanted not in hc.placements and surface in hc.placements:
             return surface, True
         if surface in hc.placements:
             return surface, True

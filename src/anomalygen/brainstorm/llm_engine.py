@@ -23,8 +23,8 @@ from anomalygen.brainstorm.idea import ASPECTS, Idea, Texts, build_proposal, tas
 from anomalygen.brainstorm.knowledge_engine import agent_roles, split_quota
 from anomalygen.brainstorm.llm_reply import LLMProposal
 from anomalygen.brainstorm.validate import proposal_problems
-from anomalygen.knowledge import PLACEMENTS, RECIPE_ARGS, ROOMS, KnowledgeBase, load_kb
-from anomalygen.knowledge.grounding import NameGrounder, shared_grounder
+from anomalygen.knowledge import RECIPE_ARGS, ROOMS, KnowledgeBase, load_kb
+from anomalygen.knowledge.grounding import GROUNDED_RELATIONS, PLACEMENT_TEXTS, NameGrounder, shared_grounder
 from anomalygen.knowledge.predicates import PREDICATES
 from anomalygen.llm.schema_tools import reply_token_budget
 from anomalygen.rng import item_rng
@@ -33,6 +33,7 @@ from anomalygen.schema import (
     AuxiliaryItem,
     BrainstormMode,
     Engine,
+    Placement,
     TaskProposal,
     format_validation_error,
 )
@@ -43,6 +44,9 @@ ROBOT_LIMITS = (
     "and switches. It cannot assemble or take apart anything, and it cannot clean: no wiping, mopping, "
     "sweeping or washing. Every task must be solvable with those skills."
 )
+#: Stands in for a placement the grounder could not read, so the rest of the proposal is still checked
+#: (the proposal itself goes back for repair: the grounding problem names the written placement).
+UNGROUNDED_PLACEMENT = Placement(relation="on", support="floor")
 
 
 @dataclass
@@ -170,7 +174,8 @@ class LLMEngine:
             "Target categories: " + ", ".join(kb.targets),
             "Other catalogue objects: " + ", ".join(kb.household),
             "Rooms: " + ", ".join(ROOMS),
-            "Placements of the hazard object: " + ", ".join(PLACEMENTS) + ", inside:<catalogue name>, on:<catalogue name>",
+            "Placements of the hazard object: "
+            + ", ".join([*PLACEMENT_TEXTS, *(f"{r}:<catalogue name>" for r in GROUNDED_RELATIONS)]),
             "Use only catalogue names, exactly as written, for target_asset, hazard_object, container and co_objects.",
         ]
         return "\n\n".join(parts)
@@ -267,7 +272,8 @@ class LLMEngine:
             class_id=g.hazard_class,
             target=g.target_asset,
             hazard=g.hazard_object,
-            placement=g.placement,
+            # an ungrounded placement is a problem already (g.problems): the proposal goes back
+            placement=g.placement or UNGROUNDED_PLACEMENT,
             room=g.room,
             person=raw.person_at_risk,
             container=g.container,

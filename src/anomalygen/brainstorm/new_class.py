@@ -19,7 +19,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from anomalygen.knowledge import HazardClass, KnowledgeBase
 from anomalygen.knowledge.base import RUN_CLASSES, add_run_classes
 from anomalygen.rng import stable_hash
-from anomalygen.schema import HazardCategory, PredicateCall, format_validation_error
+from anomalygen.schema import HazardCategory, Placement, PredicateCall, format_validation_error
 
 ROLE_WORDS = {"$hazard": "the object at fault", "$target": "the articulated object at fault",
               "$container": "where the fix stores it", "$support": "where the fix puts it"}
@@ -51,7 +51,7 @@ def class_id(raw: LLMClass) -> str:
     return f"llm_{slug}_{digest:06x}"
 
 
-def to_class(raw: LLMClass, kb: KnowledgeBase, *, category: HazardCategory, placement: str, target: str,
+def to_class(raw: LLMClass, kb: KnowledgeBase, *, category: HazardCategory, placement: Placement, target: str,
              container: str | None, support: str | None) -> tuple[HazardClass | None, list[str]]:
     """The proposal as a HazardClass, or (None, problems) against the vocabulary."""
     calls = [*raw.preconditions, *raw.success]

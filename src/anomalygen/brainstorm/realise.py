@@ -20,7 +20,7 @@ import numpy as np
 from anomalygen.brainstorm.idea import Idea, Texts
 from anomalygen.knowledge import KnowledgeBase
 from anomalygen.knowledge.base import KNOWLEDGE_DIR
-from anomalygen.schema import DOOR
+from anomalygen.schema import DOOR, Placement
 
 _NICE_NAMES = {
     "StorageFurniture": "cabinet",
@@ -272,7 +272,7 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     verb = _choice(rng, verbs)
     risk = _choice(rng, class_bank(b, "risk_word", hc))
     pshort = "" if articulated else place_phrase_bank(idea.placement, room, rng, fragment=_place_fragment(hc))
-    beside = idea.placement.split(":", 1)[1] if ":" in idea.placement else None  # already said by the place
+    beside = idea.placement.other  # already said by the place
     co_names = [nice(c) for c in idea.co_objects if c not in (idea.hazard, idea.container, beside)]
     if "co_objects" not in idea.borrowed and len(co_names) > 1:
         # background clutter is detail: name one piece, unless borrowing the setting is the idea's point
@@ -400,25 +400,25 @@ def _place_fragment(hc) -> str | None:
     return hc.composition.place if hc.composition is not None and not hc.composition.legacy else None
 
 
-def place_phrase_bank(placement: str, room: str, rng: np.random.Generator, *, fragment: str | None = None) -> str:
+def place_phrase_bank(placement: Placement, room: str, rng: np.random.Generator, *, fragment: str | None = None) -> str:
     """Where the object is, from the phrase bank (containers/supports name the catalogue object); a
     composed class's place may have words of its own (a heavy pan 'on the top shelf', not any shelf)."""
     own = bank().get("place_by_fragment", {}).get(fragment or "")
     if own:
         return _choice(rng, own).format(room=room)
-    for prefix, options in _HOLDER_PLACES.items():
-        if placement.startswith(prefix):
-            return _choice(rng, options).format(x=nice(placement[len(prefix) :]))
-    options = bank()["place"].get(placement, ["in the {room}"])
+    holder = _HOLDER_PLACES.get(placement.relation) if placement.other is not None else None
+    if holder:
+        return _choice(rng, holder).format(x=nice(placement.other))
+    options = bank()["place"].get(placement.key, ["in the {room}"])  # phrasing.json's "place", by compact word
     if room != "kitchen":  # sinks, hobs and kettles only stand in kitchens
         options = [o for o in options if not any(w in o for w in _KITCHEN_ONLY)] or options
     return _choice(rng, options).format(room=room)
 
 
-# placements in or on another object ("inside:Refrigerator"): the object is {x}
+# placements in, on or near another object (inside the Refrigerator), by relation: the object is {x}
 _HOLDER_PLACES = {
-    "inside:": ["inside the {x}", "at the back of the {x}", "tucked into the {x}", "deep in the {x}", "in the {x}"],
-    "on:": ["on top of the {x}", "on the {x}", "atop the {x}", "perched on the {x}"],
-    "near:": ["right next to the {x}", "beside the {x}", "up against the {x}", "a hand's width from the {x}", "by the {x}"],
+    "inside": ["inside the {x}", "at the back of the {x}", "tucked into the {x}", "deep in the {x}", "in the {x}"],
+    "on": ["on top of the {x}", "on the {x}", "atop the {x}", "perched on the {x}"],
+    "near": ["right next to the {x}", "beside the {x}", "up against the {x}", "a hand's width from the {x}", "by the {x}"],
 }
 _KITCHEN_ONLY = ("sink", "hob", "chopping", "kettle", "toaster", "bread bin")

@@ -1,25 +1,21 @@
 """Checks a TaskProposal against the catalogue and the knowledge base, beyond its pydantic schema.
 
 Schema validation says a proposal is well-formed; these checks say it can be *built*: every object
-is a catalogue name, the hazard class exists, the placement is one the scene builder implements.
+is a catalogue name, the hazard class exists, the object a placement names is a catalogue name (the
+placement's form is the schema's: ``Placement``).
 Used for LLM output (the problems go back to the model as a repair prompt) and for a user's own
 tasks.jsonl (the problems are reported per line).
 """
 
 from __future__ import annotations
 
-from anomalygen.knowledge import PLACEMENTS, ROOMS, KnowledgeBase
-from anomalygen.knowledge.models import PLACEMENT_PREFIXES
-from anomalygen.schema import TaskProposal
+from anomalygen.knowledge import ROOMS, KnowledgeBase
+from anomalygen.schema import Placement, TaskProposal
 
 
-def placement_ok(placement: str, names: set[str]) -> bool:
-    if placement in PLACEMENTS:
-        return True
-    for prefix in PLACEMENT_PREFIXES:
-        if placement.startswith(prefix) and placement[len(prefix):] in names:
-            return True
-    return False
+def placement_ok(placement: Placement, names: set[str]) -> bool:
+    """A placement on a support kind, or one naming an object of the catalogue."""
+    return placement.other is None or placement.other in names
 
 
 def proposal_problems(p: TaskProposal, kb: KnowledgeBase) -> list[str]:
@@ -50,7 +46,7 @@ def proposal_problems(p: TaskProposal, kb: KnowledgeBase) -> list[str]:
     out += [f"auxiliary_items: '{a.name}' is not a catalogue object" for a in p.auxiliary_items if a.name not in names]
     out += [f"articulations: '{a.object}' is not a catalogue object" for a in p.articulations if a.object not in names]
     if not placement_ok(s.placement, names):
-        out.append(f"scenario.placement '{s.placement}' is not one of {', '.join(PLACEMENTS)}, inside:<object>, on:<object>, near:<object>")
+        out.append(f"scenario.placement '{s.placement}': '{s.placement.other}' is not a catalogue object")
     if s.room not in ROOMS:
         out.append(f"scenario.room '{s.room}' is not one of {', '.join(ROOMS)}")
     return out

@@ -19,14 +19,15 @@ from anomalygen.schema import (
     DRAWER,
     GraphObject,
     JointState,
+    Placement,
     Relation,
     SceneGraph,
     part_labels,
 )
 
-#: Top-surface heights (m) per placement, inside the knowledge base's SUPPORT_HEIGHTS ranges.
-SURFACE_TOP = {"table": 0.75, "table_edge": 0.75, "counter": 0.9, "counter_edge": 0.9, "shelf": 1.4, "low_table": 0.42}
-EDGE_GAP = 0.04  # distance to the edge for *_edge placements (m)
+#: Top-surface heights (m) per support kind, inside the knowledge base's SUPPORT_HEIGHTS ranges.
+SURFACE_TOP = {"table": 0.75, "counter": 0.9, "shelf": 1.4, "low_table": 0.42}
+EDGE_GAP = 0.04  # distance to the edge for at_edge placements (m)
 CLUTTER_X = (0.08, 0.64, -0.2, 1.2, 0.36, 0.92)  # m: clutter spots along the counter (x -0.4..1.4), 0.28 m apart
 
 
@@ -92,20 +93,20 @@ RANKED_FIRST_BY_DESIGN: dict[tuple[str, str | None], tuple[str, str]] = {
 class Case:
     hazard_class: str
     obj: str
-    placement: str
+    placement: Placement
     graph: SceneGraph
     instance: str
     ranked_first: str = ""  # the class the detector must name first: hazard_class unless set by design
 
 
-def _expected(hc_id: str, placement: str, inst: str) -> tuple[str, str]:
+def _expected(hc_id: str, placement: Placement, inst: str) -> tuple[str, str]:
     """(instance, class) the detector must rank first on a case's scene (RANKED_FIRST_BY_DESIGN)."""
-    parent = placement.partition(":")[2] or None
+    parent = placement.other or None
     first, whose = RANKED_FIRST_BY_DESIGN.get((hc_id, parent), (hc_id, "hazard"))
     return (f"{parent.lower()}_0" if whose == "other" and parent else inst), first
 
 
-def _hazard_objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObject], list[Relation], str]:
+def _hazard_objects(kb, hc, obj: str, placement: Placement) -> tuple[list[GraphObject], list[Relation], str]:
     name = f"{obj.lower()}_0"
     props = _props(kb, obj)
     if hc.about_target and hc.articulation is not None:
@@ -119,10 +120,10 @@ def _hazard_objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObject]
             objs.append(_obj(f"{hot.lower()}_0", hot, _props(kb, hot), pos=(0.5, 1.6, 0.95), size=(0.2, 0.2, 0.1),
                              height=0.9, on_floor=False, edge=0.25))
         return objs, [], name
-    if placement in ("floor", "walkway"):
+    if placement.support == "floor":
         return [_obj(name, obj, props, pos=(1.0, -0.8, 0.03), size=(0.1, 0.1, 0.06), height=0.0, on_floor=True)], [], name
-    if placement.startswith("inside:"):
-        parent = placement.split(":", 1)[1]
+    if placement.relation == "inside":
+        parent = placement.other
         info = kb.objects.get(parent)
         if info is not None and info.supports and "floor" not in info.supports:
             # a counter-top appliance (a microwave): it stands on the counter, door shut, the item inside
@@ -135,11 +136,11 @@ def _hazard_objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObject]
         holder = "refrigerator_0" if parent == "Refrigerator" else "storage_0"
         o = _obj(name, obj, props, pos=(-0.6, 1.6, 0.5), size=(0.1, 0.1, 0.06), height=0.5, on_floor=False, reach=False)
         return [o], [Relation(subject=name, predicate="inside", object=holder)], name
-    top = SURFACE_TOP.get(placement.split(":", 1)[-1], 0.75)
-    edge = EDGE_GAP if placement.endswith("_edge") else 0.3
+    top = SURFACE_TOP.get(placement.support, 0.75)  # on or near another object: at a table's height
+    edge = EDGE_GAP if placement.relation == "at_edge" else 0.3
     o = _obj(name, obj, props, pos=(1.6, 0.5, top + 0.03), size=(0.1, 0.1, 0.06), height=top, on_floor=False, edge=edge,
              reach=top <= CHILD_REACH)
-    support = "counter_0" if "counter" in placement else "table_0"
+    support = "counter_0" if placement.support == "counter" else "table_0"
     return [o], [Relation(subject=name, predicate="on", object=support)], name
 
 
@@ -160,10 +161,10 @@ def _parent(kb, parent: str) -> GraphObject:
                 height=top, on_floor=False, edge=0.2)
 
 
-def _composed_objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObject], list[Relation], str] | None:
+def _composed_objects(kb, hc, obj: str, placement: Placement) -> tuple[list[GraphObject], list[Relation], str] | None:
     """A composed class's hazard with the other object its placement names (the crib beside a cable, the
     sink a power strip lies in); None for a placement without one (the plain builder's spots)."""
-    kind, _, parent = placement.partition(":")
+    kind, parent = placement.relation, placement.other
     if not parent or (kind == "inside" and parent in ("Refrigerator", "StorageFurniture")):
         return None
     other = _parent(kb, parent)
@@ -182,7 +183,7 @@ def _composed_objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObjec
     return [other, o], [], name
 
 
-def _set_up(kb, hc, objs: list[GraphObject], inst: str, placement: str) -> list[GraphObject]:
+def _set_up(kb, hc, objs: list[GraphObject], inst: str, placement: Placement) -> list[GraphObject]:
     """What a composed class's scene must show beyond its objects: each object's own states (a candle is
     lit), the mechanism's set-up states (a sink holds water), and the control its fix works left on."""
     from anomalygen.knowledge.mechanisms import load_mechanisms, setup_states
@@ -190,7 +191,7 @@ def _set_up(kb, hc, objs: list[GraphObject], inst: str, placement: str) -> list[
     ms = load_mechanisms()
     place = ms.places.get(hc.composition.place)
     relvar = place.relation.variable if place is not None and place.relation is not None else None
-    parent = placement.partition(":")[2]
+    parent = placement.other
     names = {hc.hazard_variable: inst}
     if relvar and parent:
         names[relvar] = f"{parent.lower()}_0"
@@ -213,7 +214,7 @@ def _set_up(kb, hc, objs: list[GraphObject], inst: str, placement: str) -> list[
     return out
 
 
-def _objects(kb, hc, obj: str, placement: str) -> tuple[list[GraphObject], list[Relation], str]:
+def _objects(kb, hc, obj: str, placement: Placement) -> tuple[list[GraphObject], list[Relation], str]:
     if hc.composition is None or hc.composition.legacy:
         return _hazard_objects(kb, hc, obj, placement)
     objs, rels, inst = _composed_objects(kb, hc, obj, placement) or _hazard_objects(kb, hc, obj, placement)
@@ -252,7 +253,7 @@ def sweep(kb=None, *, n_clutter: int = 0, k: int = 3) -> dict:
         top1 += bool(got) and got[0] == want
         topk += want in got
         if not got or got[0] != want:
-            failures.append({"class": c.hazard_class, "object": c.obj, "placement": c.placement, "got": got[:k]})
+            failures.append({"class": c.hazard_class, "object": c.obj, "placement": c.placement.key, "got": got[:k]})
     n = len(all_cases)
     return {"cases": n, "clutter": n_clutter, "top1": round(top1 / n, 4) if n else 0.0,
             f"top{k}": round(topk / n, 4) if n else 0.0, "failures": failures}

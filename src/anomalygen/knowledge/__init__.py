@@ -6,7 +6,6 @@ thing in brainstorming, scene building, detection, planning and evaluation.
 
 from anomalygen.knowledge.base import KnowledgeBase, load_kb
 from anomalygen.knowledge.models import (
-    PLACEMENTS,
     PROPERTIES,
     RECIPE_ARGS,
     ROOMS,
@@ -21,7 +20,6 @@ from anomalygen.knowledge.models import (
 from anomalygen.schema import HazardCategory
 
 __all__ = [
-    "PLACEMENTS",
     "PROPERTIES",
     "RECIPE_ARGS",
     "ROOMS",

@@ -15,8 +15,6 @@ from typing import Any
 from anomalygen.knowledge.models import (
     DATA_DIR,
     KNOWLEDGE_DIR,
-    PLACEMENT_PREFIXES,
-    PLACEMENTS,
     PROPERTIES,
     RECIPE_ARGS,
     ROOMS,
@@ -24,22 +22,14 @@ from anomalygen.knowledge.models import (
     ObjectInfo,
     RoleProfile,
 )
-from anomalygen.schema import LATCHING_PROPERTY, HazardCategory, PredicateCall
-
-#: Placement -> the support kind an object must usually rest on for it to be plausible.
-PLACEMENT_SUPPORT: dict[str, str] = {
-    "floor": "floor",
-    "walkway": "floor",
-    "table": "table",
-    "low_table": "low_table",
-    "table_edge": "table",
-    "counter": "counter",
-    "counter_edge": "counter",
-    "shelf": "shelf",
-    "shelf_edge": "shelf",
-}
-
-
+from anomalygen.schema import (
+    LATCHING_PROPERTY,
+    OTHER_SLOT,
+    SUPPORT_KINDS,
+    HazardCategory,
+    Placement,
+    PredicateCall,
+)
 
 
 def _data(name: str) -> Any:
@@ -74,18 +64,18 @@ class KnowledgeBase:
                 self.hazard_classes[hc.id] = own.model_copy(update={"composition": hc.composition})
                 continue
             self.hazard_classes[hc.id] = hc
-            if any("{other}" in p for p in hc.placements):
+            if any(p.other == OTHER_SLOT for p in hc.placements):
                 self.hazard_classes[hc.id] = hc.model_copy(update={"placements": self._spelled_placements(hc)})
 
-    def _spelled_placements(self, hc: HazardClass) -> list[str]:
+    def _spelled_placements(self, hc: HazardClass) -> list[Placement]:
         from anomalygen.knowledge.mechanisms import load_mechanisms
 
         place = load_mechanisms().places[hc.composition.place]
         var = place.relation.variable if place.relation else None
         others = self.static_candidates(hc, var) if var else []
-        out: list[str] = []
+        out: list[Placement] = []
         for p in hc.placements:
-            out += [p.replace("{other}", o) for o in others] if "{other}" in p else [p]
+            out += [p.filled(o) for o in others] if p.other == OTHER_SLOT else [p]
         return out
 
     # ------------------------------------------------------------------ simple views
@@ -199,15 +189,17 @@ class KnowledgeBase:
             return kinds
         return self.latching_containers_for(hc, obj) or kinds
 
-    def placements_for(self, hc: HazardClass, obj: str) -> list[str]:
-        """Class placements that are plausible for ``obj`` given where it usually rests."""
+    def placements_for(self, hc: HazardClass, obj: str) -> list[Placement]:
+        """Class placements that are plausible for ``obj`` given where it usually rests: on or at the
+        edge of a support kind it rests on, inside something it is kept in (or the fridge), or on or
+        near another object."""
         info = self.objects.get(obj)
         out = []
         for p in hc.placements:
-            if p.startswith("inside:"):
-                if info is None or p.split(":", 1)[1] in info.containers or p.split(":", 1)[1] == "Refrigerator":
+            if p.relation == "inside":
+                if info is None or p.other in info.containers or p.other == "Refrigerator":
                     out.append(p)
-            elif info is None or not info.supports or PLACEMENT_SUPPORT.get(p) in info.supports or p.startswith(("on:", "near:")):
+            elif info is None or not info.supports or p.support in info.supports or p.other is not None:
                 out.append(p)
         return out or list(hc.placements)
 
@@ -246,8 +238,7 @@ class KnowledgeBase:
                 if v.startswith("$") and v not in declared:
                     out.append(f"{where}: recipe uses undeclared variable {v}")
         for p in hc.placements:
-            ok = p in PLACEMENTS or any(p.startswith(x) and p[len(x):] in names for x in PLACEMENT_PREFIXES)
-            if not ok:
+            if p.other is not None and p.other not in names:
                 out.append(f"{where}: unknown placement {p}")
         out += [f"{where}: unknown container {c}" for c in hc.default_containers if c not in names]
         out += [f"{where}: unknown support {c}" for c in hc.default_supports if c not in names]
@@ -277,7 +268,7 @@ class KnowledgeBase:
             out += [f"object {o.name}: unknown property {p}" for p in o.properties if p not in PROPERTIES]
             out += [f"object {o.name}: unknown room {r}" for r in o.rooms if r not in ROOMS]
             out += [f"object {o.name}: unknown container {c}" for c in o.containers if c not in names]
-            out += [f"object {o.name}: unknown support {s}" for s in o.supports if s not in PLACEMENT_SUPPORT.values()]
+            out += [f"object {o.name}: unknown support {s}" for s in o.supports if s not in SUPPORT_KINDS]
             lo, hi = o.size_range
             if not 0 < lo <= hi:
                 out.append(f"object {o.name}: bad size_range {o.size_range}")

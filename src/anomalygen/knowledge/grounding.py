@@ -23,8 +23,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from anomalygen.knowledge.base import KnowledgeBase
-from anomalygen.knowledge.models import PLACEMENTS, ROOMS
-from anomalygen.schema import GroundingMatch, HazardCategory
+from anomalygen.knowledge.models import ROOMS
+from anomalygen.schema import GroundingMatch, HazardCategory, Placement, object_relation
 
 #: Cosine similarity a retrieved object must reach to be accepted without a repair round. Measured
 #: with all-MiniLM-L6-v2: "coffee mug" -> mug 0.78, "sofa" -> Chair 0.52, while words naming nothing
@@ -42,7 +42,10 @@ CLASS_THRESHOLD = 0.35
 #: Words that name no class at all: the hazard is then read from the proposal's own text.
 GENERIC_CLASS_WORDS = frozenset({"", "other", "hazard", "unknown", "none", "general", "misc", "safety", "anomaly"})
 
-#: What each placement means, in words, for retrieval of free phrasings ("perched at the counter's rim").
+#: What each placement on or at a support kind means, in words, for retrieval of free phrasings
+#: ("perched at the counter's rim"); keyed by its compact word (``Placement.key``), in the order the
+#: grounder's vocabulary and the LLM engine's prompt list them (``tests/test_schema.py`` checks that
+#: it names every word of ``schema.SUPPORT_PLACEMENTS``).
 PLACEMENT_TEXTS: dict[str, str] = {
     "floor": "lying on the floor",
     "walkway": "on the floor in a walkway, hallway or doorway where people walk",
@@ -54,6 +57,9 @@ PLACEMENT_TEXTS: dict[str, str] = {
     "shelf": "on a high shelf",
     "shelf_edge": "at the very edge of a high shelf, about to fall",
 }
+#: The relations to another object whose object the grounder grounds in a written placement
+#: (``inside:<object>``, ``on:<object>``); the LLM engine offers the model these.
+GROUNDED_RELATIONS: tuple[str, ...] = ("inside", "on")
 
 _SPLIT_CAMEL = re.compile(r"(?<=[a-z0-9])(?=[A-Z])")
 _NON_WORD = re.compile(r"[^a-z0-9]+")
@@ -200,7 +206,8 @@ class NameGrounder:
         )
         self.rooms = Vocabulary("room", list(ROOMS), [words_of(r) for r in ROOMS], aliases.get("rooms", {}), OBJECT_THRESHOLD)
         self.placements = Vocabulary(
-            "placement", list(PLACEMENTS), [PLACEMENT_TEXTS[p] for p in PLACEMENTS], aliases.get("placements", {}), OBJECT_THRESHOLD
+            "placement", list(PLACEMENT_TEXTS), list(PLACEMENT_TEXTS.values()), aliases.get("placements", {}),
+            OBJECT_THRESHOLD,
         )
         self.classes = Vocabulary(
             "class",
@@ -239,12 +246,14 @@ class NameGrounder:
         return self.rooms.spelled(written, set(ROOMS)) is not None
 
     def placement(self, written: str, where: str = "scenario.placement") -> GroundingMatch:
-        """A placement, including ``inside:<object>`` / ``on:<object>`` with the object grounded too."""
-        for prefix in ("inside:", "on:"):
-            if written.startswith(prefix):
-                inner = self.object(written[len(prefix):], where)
-                grounded = prefix + inner.grounded if inner.grounded else None
-                return inner.model_copy(update={"written": written, "grounded": grounded})
+        """A placement, including ``inside:<object>`` / ``on:<object>`` with the object grounded too;
+        ``grounded`` is its compact word (``Placement`` reads it)."""
+        split = object_relation(written)
+        if split is not None and split[0] in GROUNDED_RELATIONS:
+            relation, other = split
+            inner = self.object(other, where)
+            grounded = Placement(relation=relation, other=inner.grounded).key if inner.grounded else None
+            return inner.model_copy(update={"written": written, "grounded": grounded})
         return self.placements.ground(written, where)
 
     def classes_with_hazard(self, obj: str) -> set[str]:

@@ -28,7 +28,7 @@ from anomalygen.knowledge.models import (
     KBModel,
     RecipeStep,
 )
-from anomalygen.schema import HazardCategory, PredicateCall
+from anomalygen.schema import HazardCategory, Placement, PredicateCall
 
 FAULT = "$F"  # the placeholder the fragments use for the mechanism's object at fault
 #: Cosmetic: how composed class names join a kind's words to a place's.
@@ -61,7 +61,7 @@ class Fragment(KBModel):
     cues: list[str] = Field(default_factory=list, description="words that say this fragment in a user's line")
     variables: dict[str, str] = Field(default_factory=dict, description="variables it introduces, with what they are")
     params: dict[str, str] = Field(default_factory=dict, description="values a fix may use, e.g. {label}")
-    placements: list[str] = Field(default_factory=list, description="scenario placements that set it up; '{other}' = the related object")
+    placements: list[Placement] = Field(default_factory=list, description="scenario placements that set it up; '{other}' = the related object")
     hazard_objects: list[str] = Field(default_factory=list, description="a kind's curated objects (empty: any that fits)")
     articulation: PartState | None = None
     states: dict[str, list[str]] = Field(default_factory=dict, description="instance states a scene must show, by variable")
@@ -94,7 +94,7 @@ class Composition(KBModel):
     supports: list[str] = Field(default_factory=list)
     targets: list[str] = Field(default_factory=list)
     rooms: list[str] = Field(default_factory=list)
-    placements: list[str] = Field(default_factory=list, description="overrides the place's placements")
+    placements: list[Placement] = Field(default_factory=list, description="overrides the place's placements")
     assume_condition: bool = Field(False, description="a user's line need not state the condition (a heater is on)")
 
 

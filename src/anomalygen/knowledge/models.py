@@ -12,7 +12,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from anomalygen.schema import HazardCategory, PredicateCall, ScalarArg
+from anomalygen.schema import HazardCategory, Placement, PredicateCall, ScalarArg
 
 DATA_DIR = Path(__file__).resolve().parent.parent / "data"
 KNOWLEDGE_DIR = DATA_DIR / "knowledge"
@@ -64,22 +64,6 @@ SUPPORT_HEIGHTS: dict[str, tuple[float, float]] = {
     "counter": (0.85, 0.95),
     "shelf": (1.2, 1.6),
 }
-
-#: The scenario placements the scene builder implements (``TaskProposal.scenario.placement``).
-#: ``inside:<name>`` and ``on:<name>`` take a catalogue name.
-PLACEMENTS: tuple[str, ...] = (
-    "floor",
-    "walkway",
-    "table",
-    "low_table",
-    "table_edge",
-    "counter",
-    "counter_edge",
-    "shelf",
-    "shelf_edge",
-)
-#: ``near:<name>``: the object stands beside the named one (on the floor or the same support).
-PLACEMENT_PREFIXES: tuple[str, ...] = ("inside:", "on:", "near:")
 
 ROOMS: tuple[str, ...] = (
     "kitchen",
@@ -187,7 +171,8 @@ class HazardClass(KBModel):
     preconditions: list[PredicateCall]
     recipe: list[RecipeStep]
     success: list[PredicateCall]
-    placements: list[str] = Field(description="scenario placements under which the class can be set up")
+    placements: list[Placement] = Field(description="scenario placements under which the class can be set up "
+                                        "(the data files write them as compact words: 'counter_edge', 'near:{other}')")
     default_containers: list[str] = Field(default_factory=list)
     default_supports: list[str] = Field(default_factory=list, description="catalogue names for $support (place_on)")
     hazard_objects: list[str] = Field(

@@ -20,20 +20,13 @@ from anomalygen.scene.asset_choice import container_room
 from anomalygen.scene.instances import instance_name
 from anomalygen.scene.layout import Placed
 from anomalygen.scene.set_states import set_initial_states
-from anomalygen.schema import ObjectRole, TaskProposal, part_labels
+from anomalygen.schema import ObjectRole, Placement, TaskProposal, part_labels
 
 MAX_AUX = 3
 CONTAINER_REDRAWS = 4  # other container sizes drawn before a smaller hazard is tried
 CLUTTER_MAX_SIZE = 0.3
 SAFE_STATE = {"open": "closed", "on": "off"}  # a part's state in a hazard-free scene
 OPPOSITE_STATE = {"open": "closed", "closed": "open", "on": "off", "off": "on"}
-
-
-def _parse_placement(placement: str) -> tuple[str, str | None]:
-    for prefix in ("inside:", "on:", "near:"):
-        if placement.startswith(prefix):
-            return prefix[:-1], placement[len(prefix) :]
-    return placement, None
 
 
 def is_dressing(kb, name: str) -> bool:
@@ -65,8 +58,6 @@ class Selection:
     rng: np.random.Generator
     kb: object
     hc: object  # the task's HazardClass, or None
-    kind: str  # placement kind: floor, walkway, a surface, inside, on
-    parent_raw: str | None
     used: set[str] = field(default_factory=set)
     by_catalogue: dict[str, asset_choice.Chosen] = field(default_factory=dict)
     target: asset_choice.Chosen | None = None
@@ -80,6 +71,16 @@ class Selection:
     hints: object | None = None  # scene/hints.py: sizes, positions and auxiliaries from the LLM engine
     hazard_free: bool = False  # build the task's hazard in its safe state (scene/mix.py)
     real_assets: bool = True  # draw a category's real (packaged) models where it has any (build.real_assets)
+
+    @property
+    def placement(self) -> Placement:
+        """Where the scenario puts the hazard object."""
+        return self.task.scenario.placement
+
+    @property
+    def parent_raw(self) -> str | None:
+        """The object the placement names as written (the stove the towel is on), if any."""
+        return self.placement.other
 
     @property
     def variables(self) -> set[str]:
@@ -120,9 +121,8 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
     ``real_assets`` False builds every object from the procedural generators (a comparison run)."""
     kb = load_kb()
     sc = task.scenario
-    kind, parent_raw = _parse_placement(sc.placement)
-    sel = Selection(task, rng, kb, kb.hazard_classes.get(task.hazard_class), kind, parent_raw, hints=hints,
-                    real_assets=real_assets)
+    sel = Selection(task, rng, kb, kb.hazard_classes.get(task.hazard_class), hints=hints, real_assets=real_assets)
+    relation, parent_raw = sel.placement.relation, sel.parent_raw
     hc, variables = sel.hc, sel.variables
     sel.hazard_is_target = asset_choice.resolve_name(sc.hazard_object) == asset_choice.resolve_name(task.target_asset)
     if hc is not None and hc.about_target and not sel.hazard_is_target:
@@ -130,7 +130,7 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
         raise ItemFailed(f"{hc.id} is about the target itself, but the task names {sc.hazard_object} at fault "
                          f"and {task.target_asset} as the target: it would be built as the {task.target_asset}'s hazard")
     # what goes inside the parent needs room there (only a real model is turned down for lacking it)
-    holder = asset_choice.resolve_name(parent_raw) if kind == "inside" and parent_raw else None
+    holder = asset_choice.resolve_name(parent_raw) if relation == "inside" and parent_raw else None
     # a target that is also the named container must have room for the hazard: it keeps its draw
     stores_hazard = bool(sc.container) and not sel.hazard_is_target and \
         asset_choice.resolve_name(sc.container) == asset_choice.resolve_name(task.target_asset)
@@ -145,9 +145,9 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
     )
     parent = sel.parent = sel.choose(parent_raw, ObjectRole.AUXILIARY, room_for=room_for) if parent_raw else None
     cap = None
-    if kind == "inside" and parent is not None:
+    if relation == "inside" and parent is not None:
         if not parent.asset.cavities:
-            raise ItemFailed(f"placement inside:{parent_raw} but {parent.catalogue} has no interior")
+            raise ItemFailed(f"placement {sel.placement} but {parent.catalogue} has no interior")
         cap = asset_choice.cavity_cap(parent.asset)
     hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=cap)
     if hazard is target:
@@ -266,7 +266,7 @@ def set_initial_joints(sel: Selection) -> None:
             uses.setdefault(var_obj.catalogue, []).append(
                 (hc.articulation.part, hc.articulation.initial_state)
             )
-    if sel.kind == "inside" and parent is not None:
+    if sel.placement.relation == "inside" and parent is not None:
         cav = asset_choice.biggest_cavity(parent.asset)
         if cav.joint is not None and not any(
             part_labels.encloses(p) and s == "closed" for p, s in uses.get(parent.catalogue, [])
@@ -288,7 +288,7 @@ def set_initial_joints(sel: Selection) -> None:
 
 def bind_roles(sel: Selection, support: Placed | None) -> dict[str, str]:
     """The role variables ($hazard, $target, $container, $support) bound to instance names."""
-    kind, parent = sel.kind, sel.parent
+    relation, parent = sel.placement.relation, sel.parent
     bindings = {"$hazard": sel.hazard_var.name, "$target": sel.target.name}
     if sel.container is not None:
         bindings["$container"] = sel.container.name
@@ -296,9 +296,9 @@ def bind_roles(sel: Selection, support: Placed | None) -> dict[str, str]:
         bindings["$support"] = sel.support_var.name
     elif support is not None:
         bindings["$support"] = support.name
-    elif kind == "on" and parent is not None:
+    elif relation == "on" and parent is not None:
         bindings["$support"] = parent.name
-    if kind == "inside" and parent is not None and sel.container is None:
+    if relation == "inside" and parent is not None and sel.container is None:
         bindings["$container"] = parent.name
     return bindings
 

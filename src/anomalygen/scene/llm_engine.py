@@ -67,9 +67,8 @@ def task_objects(task: TaskProposal, kb: KnowledgeBase) -> list[str]:
     the class's default container when the fix stores the object and the scenario names none)."""
     sc = task.scenario
     names = [task.target_asset, sc.hazard_object]
-    for prefix in ("inside:", "on:"):
-        if sc.placement.startswith(prefix):
-            names.append(sc.placement[len(prefix):])
+    if sc.placement.relation in ("inside", "on") and sc.placement.other is not None:  # what it is in or on (not near)
+        names.append(sc.placement.other)
     hc = kb.hazard_classes.get(task.hazard_class)
     if sc.container:
         names.append(sc.container)

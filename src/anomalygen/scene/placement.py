@@ -39,7 +39,6 @@ if TYPE_CHECKING:
     from anomalygen.config import Settings
 
 
-SURFACE_PLACEMENTS = {"table", "low_table", "table_edge", "counter", "counter_edge", "shelf", "shelf_edge"}
 NEAR_GAP = (0.03, 0.12)  # m between a 'near:<name>' hazard and that object (the knowledge base's near: <= 0.2-0.3)
 LOOSE_ON_SUPPORT_MAX = 0.35  # m: a loose task object smaller than this goes on the support, not the floor
 FACING_TRIES = 16  # draws of a parent's spot on its support until its door faces the robot
@@ -48,9 +47,9 @@ FACING_TRIES = 16  # draws of a parent's spot on its support until its door face
 def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed], Placed | None]:
     """Place every chosen object (and the clutter) in the room; returns the layout, the placed
     objects by name and the support the hazard stands on (if any)."""
-    rng, kind, used = sel.rng, sel.kind, sel.used
+    rng, used = sel.rng, sel.used
     target, parent, hazard = sel.target, sel.parent, sel.hazard
-    support_kind = kind if kind in SURFACE_PLACEMENTS else None
+    support_kind = sel.placement.furniture  # the table, counter or shelf it is on or at the edge of
     lay = Layout(rng, relevant_in_cube=settings.build.relevant_in_unit_cube)
     if sel.hints is not None:
         for ch in sel.by_catalogue.values():
@@ -60,16 +59,15 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
     placed: dict[str, Placed] = {}
     support: Placed | None = None
     if support_kind is not None:
-        base_kind = support_kind.replace("_edge", "")
         if (
             target.catalogue == "Table"
-            and base_kind == "table"
+            and support_kind == "table"
             and not sel.hazard_is_target
             and _table_height_ok(target.asset)
         ):
             support = placed.setdefault(target.name, placed_instance(target))
         else:
-            support = placed_support(base_kind, instance_name(furniture.CATEGORY[base_kind], used), rng)
+            support = placed_support(support_kind, instance_name(furniture.CATEGORY[support_kind], used), rng)
         lay.place_on_floor(support, relevant=True, face=True)
         placed[support.name] = support
     side: Placed | None = None
@@ -112,7 +110,7 @@ def place(sel: Selection, settings: Settings) -> tuple[Layout, dict[str, Placed]
             # onto), not the high shelf the hazardous version stands it on
             place_hazard_safely(sel, lay, placed, fix_support or support)
         else:
-            _place_hazard(sel, lay, placed, support, support_kind)
+            _place_hazard(sel, lay, placed, support)
 
     # Remaining loose task objects: on the support (away from its edge) or on the floor; in a
     # hazard-free scene, one that could fire the class itself goes where the made-safe hazard went.
@@ -180,18 +178,20 @@ def _floor_the_holder(lay: Layout, holder: Placed, inside: Placed) -> None:
     lay.place_in_cavity(inside, holder, (lo, hi), front=cavity_front(holder, cav))
 
 
-def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None,
-                  support_kind: str | None) -> None:
-    """The hazard object, where the scenario says."""
-    kind, parent, hazard = sel.kind, sel.parent, sel.hazard
+def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], support: Placed | None) -> None:
+    """The hazard object, where the scenario says: one branch per relation kind of ``schema/placement.py``
+    (on the floor, in the walkway, on or at the edge of the scene's support, inside, on or near another
+    object); a new kind gets its branch here."""
+    where, parent, hazard = sel.placement, sel.parent, sel.hazard
+    kind = where.relation
     hp = placed[hazard.name] = placed_instance(hazard)
-    if kind == "floor":
+    if kind == "on" and where.support == "floor":
         lay.place_on_floor(hp, relevant=True, face=reached_from_front(hp))
     elif kind == "walkway":
         fixtures = [p for p in lay.items if p.fixed]
         lay.place_on_floor(hp, relevant=True, face=reached_from_front(hp), clear_of=fixtures)
     elif support is not None:
-        edge = support_kind.endswith("_edge")
+        edge = kind == "at_edge"
         lay.place_on_surface(
             hp, support, surface_of(support), edge=edge, inward=0.0 if edge else INWARD, near_side=HAZARD_NEAR_SIDE
         )
@@ -211,7 +211,7 @@ def _place_hazard(sel: Selection, lay: Layout, placed: dict[str, Placed], suppor
         else:
             lay.place_on_surface(hp, ppl, surface_of(ppl), inward=0.0)
     else:
-        raise ItemFailed(f"unsupported placement {sel.task.scenario.placement!r}")
+        raise ItemFailed(f"unsupported placement '{sel.placement}'")
 
 
 def _place_near(lay: Layout, hp: Placed, ppl: Placed, placed: dict[str, Placed]) -> None:

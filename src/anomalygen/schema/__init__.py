@@ -4,7 +4,9 @@ Every artefact is a file in the run folder, so each class is strict (unknown fie
 silently dropped) and carries a ``schema_version`` so old runs can be detected rather than misread.
 Stages depend on these classes, never on each other's internals. One module per stage owns its
 artefacts (``tasks``, ``scenes``, ``detection``, ``skills``, ``verdicts``, ``run``) over the shared
-``base`` and ``vocabulary``; import every name from ``anomalygen.schema``. ``part_labels`` is the one
+``base`` and ``vocabulary``; import every name from ``anomalygen.schema``. ``placement`` is the typed
+``Placement`` of a scenario (and of the knowledge base's classes), the one list of relation kinds and
+the only reader of the old compact placement words. ``part_labels`` is the one
 table of joint labels (what shuts, encloses, switches) that every stage decides by.
 """
 
@@ -51,6 +53,18 @@ from anomalygen.schema.part_labels import (
     WINDOW,
     PartKind,
     PartLabel,
+)
+from anomalygen.schema.placement import (
+    OBJECT_RELATIONS,
+    OTHER_SLOT,
+    RELATION_KINDS,
+    RELATIONS,
+    SUPPORT_KINDS,
+    SUPPORT_PLACEMENTS,
+    Placement,
+    RelationKind,
+    SupportKind,
+    object_relation,
 )
 from anomalygen.schema.run import (
     ItemError,
@@ -148,6 +162,16 @@ __all__ = [
     "SkillMethod",
     "PredicateCall",
     "PredicateResult",
+    "Placement",
+    "RelationKind",
+    "RELATIONS",
+    "RELATION_KINDS",
+    "OBJECT_RELATIONS",
+    "SUPPORT_KINDS",
+    "SupportKind",
+    "SUPPORT_PLACEMENTS",
+    "OTHER_SLOT",
+    "object_relation",
     "Provenance",
     "AuxiliaryItem",
     "ArticulationUse",

@@ -7,6 +7,7 @@ from typing import Literal
 from pydantic import Field
 
 from anomalygen.schema.base import Artefact, Strict
+from anomalygen.schema.placement import Placement
 from anomalygen.schema.vocabulary import BrainstormMode, Engine, HazardCategory
 
 
@@ -45,7 +46,10 @@ class Scenario(Strict):
 
     hazard_object: str = Field(description="catalogue name of the object that is the hazard")
     room: str = Field(description="kitchen, living_room, bedroom, bathroom, hallway, ...")
-    placement: str = Field(description="where the hazard object is: floor, table, counter_edge, shelf, inside:<object>, ...")
+    placement: Placement = Field(
+        description="where the hazard object is: a relation to a support kind or to another object "
+        "(the compact words 'counter_edge', 'inside:Bathtub' read too)"
+    )
     person_at_risk: str = ""
     container: str | None = Field(None, description="catalogue name of the safe destination, if the fix stores it")
     co_objects: list[str] = Field(default_factory=list, description="other catalogue objects in the story")
