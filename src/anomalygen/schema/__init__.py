@@ -21,6 +21,15 @@ from anomalygen.schema.base import (
     Vec3,
     format_validation_error,
 )
+from anomalygen.schema.bench import (
+    BenchClassRow,
+    BenchReport,
+    BenchRun,
+    CallRecord,
+    EpisodeRecord,
+    SuiteManifest,
+    SuiteScene,
+)
 from anomalygen.schema.detection import (
     Detection,
     Hypothesis,
@@ -129,6 +138,9 @@ ARTEFACTS: dict[str, type[BaseModel]] = {
         Verdict,
         RunManifest,
         ItemError,
+        SuiteManifest,
+        EpisodeRecord,
+        BenchReport,
     )
 }
 
@@ -215,5 +227,12 @@ __all__ = [
     "LLMUsage",
     "RunManifest",
     "ItemError",
+    "SuiteScene",
+    "SuiteManifest",
+    "CallRecord",
+    "EpisodeRecord",
+    "BenchClassRow",
+    "BenchRun",
+    "BenchReport",
     "ARTEFACTS",
 ]
