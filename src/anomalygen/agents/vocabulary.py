@@ -46,15 +46,15 @@ class Call(Strict):
     args: dict[str, str | float] = Field(default_factory=dict)
 
     def text(self) -> str:
-        """``pick_place(knife_0, drawer_0)``: required arguments by position, the rest as key=value."""
+        """``pick_place(knife_0, drawer_0)``: arguments by position while none is skipped, the rest as key=value."""
         spec = VOCABULARY.get(self.skill)
-        if spec is None:
-            return f"{self.skill}({', '.join(f'{k}={v}' for k, v in self.args.items())})"
-        order = [p.name for p in spec.params]
-        pos = [_show(self.args[p.name]) for p in spec.params if p.required and p.name in self.args]
-        kw = [f"{k}={_show(v)}" for k, v in sorted(self.args.items(), key=lambda kv: (
-            order.index(kv[0]) if kv[0] in order else len(order), kv[0]))
-              if not (k in order and spec.param(k).required)]
+        order = [p.name for p in spec.params] if spec is not None else []
+        pos: list[str] = []
+        for name in order:
+            if name not in self.args:
+                break
+            pos.append(_show(self.args[name]))
+        kw = [f"{k}={_show(v)}" for k, v in self.args.items() if k not in order[:len(pos)]]
         inner = ", ".join(pos + kw)
         return f"{self.skill}({inner})" if inner else self.skill
 
