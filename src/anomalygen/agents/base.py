@@ -11,6 +11,9 @@ An agent has two methods and two optional attributes::
         def act(self, obs):                      # one call: text, a dict, or a Call
             return self.todo.pop(0) if self.todo else "done"
 
+        def result(self, info):                  # optional: the env's info after each call (its error,
+            pass                                 # the sub-tasks it ran)
+
         def detections(self):                    # optional: what it believes is wrong (schema.Hypothesis),
             return None                          # scored against the scene's truth when the episode is over
 
@@ -37,6 +40,9 @@ class Agent:
 
     def act(self, obs: dict):  # pragma: no cover - the contract
         raise NotImplementedError
+
+    def result(self, info: dict) -> None:
+        """The env's ``info`` after the agent's last call (``error``, ``executed``): optional feedback."""
 
     def detections(self):
         """The hazards the agent reports for the episode (``schema.Hypothesis``), or None."""

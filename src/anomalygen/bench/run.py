@@ -89,6 +89,8 @@ def bench_item(item_id: str, payload: dict[str, Any], ctx: StageContext) -> dict
             ts = time.perf_counter()
             action = agent.act(obs)
             obs, _reward, terminated, truncated, info = env.step(action)
+            if callable(getattr(agent, "result", None)):
+                agent.result(info)
             calls.append(CallRecord(action=_text(action), call=info["call"], error=info["error"],
                                     executed=[SubTaskResult.model_validate(r) for r in info["executed"]],
                                     control_steps=info["control_steps"], wall_s=round(time.perf_counter() - ts, 3)))
