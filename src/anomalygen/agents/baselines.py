@@ -40,7 +40,7 @@ class Random(Agent):
     Each call: a skill drawn uniformly from :data:`RANDOM_SKILLS`, then each required argument
     uniformly from the objects it may name (a movable object for what is carried, any other object
     for a destination, one of the object's parts of the right kind); a draw the env would refuse is
-    drawn again. Seeded per episode from the env's seed and the scene's id."""
+    drawn again. Seeded per episode from the env's seed and the scene graph's id."""
 
     observe = ("objects",)
 
@@ -52,7 +52,8 @@ class Random(Agent):
     def reset(self, obs, info):
         from anomalygen.rng import item_rng
 
-        self.rng = item_rng(int(info.get("seed", 0)), "random-agent", str(info.get("scene", "")))
+        scene = (info.get("built_graph") or {}).get("scene_id", "")
+        self.rng = item_rng(int(info.get("seed", 0)), "random-agent", str(scene))
         self.made = 0
 
     def act(self, obs):

@@ -49,9 +49,9 @@ class Pipeline(Agent):
 
         s = self.settings
         kb = load_kb()
-        self.task_id = str(info.get("scene", ""))
         self.before = SceneGraph.model_validate(obs["graph"])  # the learn stage's "before" for its look again
         built = SceneGraph.model_validate(info["built_graph"]) if info.get("built_graph") else self.before
+        self.task_id = built.scene_id  # names the detection and the plan; the bench files them by scene
         self.detection = detect_scene(self.task_id, built, s)
         hyps = [h.model_dump(mode="json") for h in self.detection.hypotheses]
         try:

@@ -19,9 +19,12 @@ level="skills")`` gives this env wrapped in the referee's :class:`~anomalygen.re
   budget (truncated); the scene settles for ``learn/execute.py::FINAL_SETTLE_STEPS`` control steps
   first, as the learn stage settles before it saves the final state. The reward is 0: the verdict
   is the referee's, added to ``info`` by the wrapper.
-- Perception only, as the low-level env: the scene is loaded through ``world.perception``, ``info``
-  holds no task words and nothing of the answer key (the scene's id is its folder's name: a counter
-  and a hash).
+- Perception only, as the low-level env: the scene is loaded through ``world.perception``; ``info``
+  holds no task words, no task id and nothing of the answer key. At ``reset`` it holds the episode's
+  ``seed``, the vocabulary (``skills``), ``max_calls`` and ``built_graph``: the scene graph the builder
+  saved with the scene, which the detect stage reads (it differs from the live graph of the same state
+  by micrometres). The episode is seeded with the seed and the scene folder's name, as the learn stage
+  seeds it with the task id (``rng.item_rng``).
 """
 
 from __future__ import annotations
@@ -50,7 +53,7 @@ class SkillEnv(gym.Env):
         from anomalygen.skills.episode import LearningSettings
 
         self.scene_dir = Path(scene_dir)
-        self.task_id = self.scene_dir.name  # the folder's name: a counter and a hash, no task words
+        self.task_id = self.scene_dir.name  # the folder's name (the task id): seeds the episode, never shown
         self.max_calls = None if max_calls is None else int(max_calls)
         self.observe_keys = tuple(observe)
         self.cameras = tuple(cameras)
@@ -78,7 +81,7 @@ class SkillEnv(gym.Env):
         episode_seed = int(seed) if seed is not None else int(self.np_random.integers(2**31 - 1))
         self._load(episode_seed)
         self.calls = 0
-        info = {"scene": self.task_id, "seed": episode_seed, "skills": [c.signature() for c in VOCABULARY.values()],
+        info = {"seed": episode_seed, "skills": [c.signature() for c in VOCABULARY.values()],
                 "max_calls": self.max_calls, "built_graph": self._built_graph()}
         return self._observe(), info
 
