@@ -33,6 +33,7 @@ FIX = "fix"
 WAIT_STEPS = 25  # control steps a bare ``wait`` lets the scene settle (as the learn stage does after a plan)
 MAX_WAIT_STEPS = 500  # a wait longer than 5 s of simulated time is a mistake, not a plan
 MOVE_AWAY_M = 0.6  # default distance of move_away (the knowledge base's electrical-from-water fix)
+QUOTE = 400  # characters of an unreadable action quoted back in its error
 
 
 class CallError(AnomalygenError, ValueError):
@@ -154,7 +155,7 @@ def parse_call(action) -> Call:
         raise CallError(f"an action is a call as text or a dict, not {type(action).__name__}")
     m = _CALL.match(action.strip().strip("`"))
     if m is None:
-        raise CallError(f"not a call: {action[:80]!r} (write it as skill(arg, ...), e.g. pick_place(knife_0, drawer_0))")
+        raise CallError(f"not a call: {action[:QUOTE]!r} (write it as skill(arg, ...), e.g. pick_place(knife_0, drawer_0))")
     name, inner = m.group(1), (m.group(2) or "").strip()
     positional: list[str] = []
     named: dict[str, str] = {}
@@ -162,12 +163,12 @@ def parse_call(action) -> Call:
     while pos < len(inner):
         t = _TOKEN.match(inner, pos)
         if t is None or t.end() == pos:
-            raise CallError(f"cannot read the arguments of {action[:80]!r}")
+            raise CallError(f"cannot read the arguments of {action[:QUOTE]!r}")
         key, value = t.group(1), _unquote(t.group(2))
         if key:
             named[key] = value
         elif named:
-            raise CallError(f"{name}: a positional argument after a named one in {action[:80]!r}")
+            raise CallError(f"{name}: a positional argument after a named one in {action[:QUOTE]!r}")
         else:
             positional.append(value)
         pos = t.end()
