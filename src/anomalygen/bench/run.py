@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from anomalygen.errors import UserError
+from anomalygen.learn.stage import run_item_id, split_run_item
 from anomalygen.runfolder import RunFolder, try_read_model, write_model
 from anomalygen.runner import StageContext, config_section, run_items
 from anomalygen.scene_files import EPISODE, FINAL_STATE, RESULT, SCENE_SPEC, SCENE_XML, TRUTH, VERDICT
@@ -42,15 +43,6 @@ if TYPE_CHECKING:
     from anomalygen.config import Settings
 
 STAGE = "bench"
-
-
-def _item_id(task_id: str, seed: int) -> str:
-    return f"{task_id}@seed{seed}"
-
-
-def _split(item_id: str) -> tuple[str, int]:
-    task_id, seed = item_id.rsplit("@seed", 1)
-    return task_id, int(seed)
 
 
 def prepare(out: Path, suite: Suite, settings: Settings) -> RunFolder:
@@ -76,7 +68,7 @@ def bench_item(item_id: str, payload: dict[str, Any], ctx: StageContext) -> dict
     from anomalygen.world.state import save_state
 
     run = ctx.run
-    task_id, seed = _split(item_id)
+    task_id, seed = split_run_item(item_id)
     agent = make_agent(load_agent(payload["agent"]), ctx.settings, **payload.get("options", {}))
     env = make_env(run.scene_dir(task_id), level="skills", observe=tuple(getattr(agent, "observe", ())),
                    max_calls=payload["max_calls"], settings=ctx.settings)
@@ -145,18 +137,19 @@ def run_bench(agent: str, suite: Suite, out: Path, settings: Settings, *, seeds:
     check_only(only, suite.task_ids)
     ids = [t for t in suite.task_ids if not only or t in only]
     payload = {"agent": agent, "options": options or {}, "max_calls": max_calls or MAX_CALLS}
-    items = [(_item_id(t, k), payload) for t in ids for k in range(seeds)]
+    items = [(run_item_id(t, k), payload) for t in ids for k in range(seeds)]
 
     def done(item_id: str) -> bool:
-        task_id, seed = _split(item_id)
+        task_id, seed = split_run_item(item_id)
         return try_read_model(run.skill_dir(task_id, seed) / VERDICT, Verdict) is not None
 
     def inputs(item_id: str) -> list[Path]:
-        scene = run.scene_dir(_split(item_id)[0])
+        scene = run.scene_dir(split_run_item(item_id)[0])
         return [scene / SCENE_SPEC, scene / SCENE_XML, scene / TRUTH]
 
     summary = run_items(run, STAGE, items, bench_item, settings=settings, is_done=done, force=force,
                         description=f"bench {agent}", inputs=inputs,
-                        config=[config_section(settings, s) for s in ("detect", "plan", "learn")])
+                        config=[config_section(settings, "detect"), config_section(settings, "plan"),
+                                config_section(settings, "learn", exclude=("seeds", "video"))])  # the env records no video
     return write_report(run, agent, suite, ids, seeds, errors=summary.errors)
 
