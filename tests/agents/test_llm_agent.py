@@ -92,3 +92,19 @@ def test_the_llm_agent_runs_on_the_bundled_gguf(skill_scenes):
         done = terminated or truncated
     assert info["verdict"].status in ("no_action_needed", "acted_on_safe")
     assert agent.client.usage.requests >= 1
+
+
+def test_with_a_vision_endpoint_the_agent_shows_the_front_camera_too(skill_scenes, scripted_server, tmp_path):
+    srv = scripted_server([text(json.dumps({"problem": "nothing", "skill": "done"}))])
+    settings = Settings()
+    settings.llm = llm_config_for(srv, tmp_path, cache=False, vision=True)
+    agent = LLMAgent(settings=settings)
+    env = anomalygen.make_env(skill_scenes["pan"][1], level="skills", observe=agent.observe, settings=settings,
+                              width=64, height=48)
+    obs, info = env.reset(seed=0)
+    agent.reset(obs, info)
+    assert agent.act(obs).text() == "done" and agent.detections() == []
+    (user,) = [m["content"] for m in srv.requests[0]["messages"] if m["role"] == "user"]
+    kinds = [part["type"] for part in user]
+    assert kinds == ["text", "image_url"] and user[1]["image_url"]["url"].startswith("data:image/png;base64,")
+    env.close()
