@@ -37,6 +37,8 @@ from gymnasium import spaces
 
 from anomalygen.agents import observe as obs_mod
 from anomalygen.agents.vocabulary import DONE, VOCABULARY, WAIT, WAIT_STEPS, CallError, SceneView, parse_call
+from anomalygen.errors import AnomalygenError
+from anomalygen.knowledge.predicates import PredicateError
 
 ENV_ID = "anomalygen/Skills-v0"
 MAX_CALLS = 12  # calls per episode: our pipeline makes at most 3 fixes, a look, 3 repairs and done
@@ -105,6 +107,8 @@ class SkillEnv(gym.Env):
                 info["executed"] = [r.model_dump(mode="json") for r in self._run(call)]
         except CallError as exc:
             info["error"] = str(exc)
+        except (AnomalygenError, PredicateError) as exc:  # a skill's expected failure: this call, not the episode
+            info["error"] = f"{info['call']}: {exc}"
         truncated = not terminated and bool(
             (self.max_calls is not None and self.calls >= self.max_calls) or ep.budget.spent(ep.steps))
         if truncated:
