@@ -26,13 +26,14 @@ FLOORS = (
     ("world",),  # what a built scene is, as the robot perceives it
     ("scene", "skills", "detect", "plan", "referee"),  # the builder, the robot's side, the referee: apart
     ("learn", "evaluate"),
-    ("brainstorm",),
+    ("brainstorm", "agents"),  # agents: the skill-level env and the baseline agents, on the robot's side
     ("stages",),  # the stage table
-    ("pipeline",),
+    ("pipeline", "bench"),  # bench: suites (built by the stages) and any agent over them, judged
     ("cli", ""),  # "": the package's own __init__ (make_env)
 )
 # The robot's side: it perceives the scene through the world package and acts on it.
-ROBOT_SIDE = ("anomalygen.detect", "anomalygen.plan", "anomalygen.learn", "anomalygen.robot", "anomalygen.skills")
+ROBOT_SIDE = ("anomalygen.detect", "anomalygen.plan", "anomalygen.learn", "anomalygen.robot", "anomalygen.skills",
+              "anomalygen.agents")
 # What it may not reach, directly or through any module in between: the builder, the answer key, the
 # referee, and what is built on them (the evaluation and report, the task generator and its words).
 FORBIDDEN = ("anomalygen.scene", "anomalygen.truth", "anomalygen.referee", "anomalygen.evaluate",
@@ -189,6 +190,7 @@ def test_the_robot_side_reaches_neither_the_builder_nor_the_answer_key_nor_the_r
     edges = _module_graph()
     robot = [m for m in edges if _under(m, ROBOT_SIDE)]
     assert "anomalygen.learn.stage" in robot and "anomalygen.detect.stage" in robot
+    assert "anomalygen.agents.skill_env" in robot and "anomalygen.agents.pipeline" in robot
     # the answer-key side is real and reaches what it must: the builder writes truth.json, the referee reads it
     assert _forbidden_paths(edges, ("anomalygen.scene.build",), ("anomalygen.truth",))
     assert _forbidden_paths(edges, ("anomalygen.referee.stage",), ("anomalygen.truth",))

@@ -59,6 +59,16 @@ def _example(cls):
         S.Verdict: S.Verdict(task_id="t", seed=0, status="unresolved", resolved=False, hazards=[S.HazardVerdict(
             hazard_class="close_open_refrigerator", object="fridge_0", source="intended", resolved=False,
             still_firing=["close_open_refrigerator"])], new_hazards=["x on y"], released=["mug_0"]),
+        S.SuiteManifest: S.SuiteManifest(name="tiny", version=1, engine="knowledge", seed=0, package_version="0",
+                                         created="2026-01-01T00:00:00+00:00", tasks=2, not_built=["t2"],
+                                         scenes=[S.SuiteScene(task_id="t1", sha256="ab" * 32, files=9)]),
+        S.EpisodeRecord: S.EpisodeRecord(task_id="t", seed=0, agent="m:A", ended="done", calls=[S.CallRecord(
+            action="close(fridge_0, door)", call="close(fridge_0, door)", executed=[S.SubTaskResult(
+                id="s1_close_joint", method="primitive", success=True, steps=40)], control_steps=60)]),
+        S.BenchReport: S.BenchReport(agent="m:A", suite="tiny v1", suite_dir="/s", seeds=1, package_version="0",
+                                     created="2026-01-01T00:00:00+00:00", runs=1, runs_with_hazards=1, resolved=1,
+                                     by_class={"close_open_refrigerator": S.BenchClassRow(hazards=1, runs=1, resolved=1)},
+                                     per_run=[S.BenchRun(task_id="t", seed=0, status="resolved", calls=2)]),
     }
     return examples[cls]
 

@@ -390,8 +390,11 @@ def _register_subapps() -> None:
     for name, module, help_text in (
         ("assets", "anomalygen.assets.cli", "Asset library: list, show, render, validate, search, gallery."),
         ("llm", "anomalygen.llm.cli", "Talk to the configured LLM: ping, ask."),
+        ("suite", "anomalygen.bench.cli", "Frozen suites of built scenes: build, list, verify."),
     ):
         app.add_typer(importlib.import_module(module).app, name=name, help=help_text)
+    # any agent over a suite, judged (docs/agents.md)
+    app.command("bench")(importlib.import_module("anomalygen.bench.cli").bench)
 
 
 _register_subapps()

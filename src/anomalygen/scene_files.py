@@ -23,6 +23,12 @@ FINAL_GRAPH = "final_graph.json"  # the final state's scene graph as the robot p
 VIDEO = "video.mp4"
 VERDICT = "verdict.json"  # Verdict: the referee's judgement of the released, settled final state
 JUDGED_GRAPH = "judged_graph.json"  # the released, settled final state's scene graph the verdict read
+EPISODE = "episode.json"  # EpisodeRecord: an agent's calls in a bench run (anomalygen bench)
+
+# a suite's folder (a run folder) and a bench run's folder
+SUITE_MANIFEST = "suite.json"  # SuiteManifest: how the suite was built, a checksum of every scene
+BENCH_REPORT = "bench.json"  # BenchReport: the referee's table of one agent on one suite
+BENCH_PAGE = "bench.html"  # the same as a page
 
 
 def render_file(camera: str) -> str:

@@ -5,24 +5,21 @@ until its episode ends (then the referee's verdict)."""
 from __future__ import annotations
 
 import json
-from typing import get_args
 
 import numpy as np
 import pytest
 
 import anomalygen
 from anomalygen.config import Settings
-from anomalygen.knowledge import load_kb
-from anomalygen.knowledge.models import PROPERTIES, ROOMS, SUPPORT_HEIGHTS
 from anomalygen.runfolder import read_model
-from anomalygen.schema import Relation, SceneSpec
+from anomalygen.schema import SceneSpec
 from anomalygen.world.perception import (
     UNKNOWN_ROLE,
     load_perceived_scene,
     load_perceived_spec,
     load_scene_graph,
 )
-from support.ids import task_text, words
+from support.ids import assert_no_task_words
 
 OBS_KEYS = {"robot_qpos", "robot_qvel", "ee_pos", "ee_quat", "object_pos", "object_quat", "object_joints", "suction"}
 
@@ -39,41 +36,6 @@ def scene(tmp_path_factory):
     return task, folder
 
 
-def _keys_and_values(obj, keys: set[str], values: list[str]) -> None:
-    if isinstance(obj, dict):
-        for k, v in obj.items():
-            keys.add(str(k))
-            _keys_and_values(v, keys, values)
-    elif isinstance(obj, list):
-        for v in obj:
-            _keys_and_values(v, keys, values)
-    elif isinstance(obj, str):
-        values.append(obj)
-
-
-def _assert_no_task_words(task, dumps: dict[str, object]) -> None:
-    """No distinctive word of the task (one that is not an object, room, property, part, relation,
-    support or field name, all of which the robot may see) appears in any value; nor its id, class
-    or name."""
-    kb = load_kb()
-    keys: set[str] = set()
-    found: dict[str, list[str]] = {}
-    for what, dump in dumps.items():
-        found[what] = []
-        _keys_and_values(dump, keys, found[what])
-    visible = [*kb.objects, *ROOMS, *PROPERTIES, *keys, *get_args(Relation.model_fields["predicate"].annotation),
-               *(p.label for o in kb.objects.values() for p in o.parts), *SUPPORT_HEIGHTS, "support"]
-    seen_anyway = set().union(*(words(n) for n in visible))
-    distinctive = words(task_text(task)) - seen_anyway
-    assert len(distinctive) >= 5, distinctive  # the check has teeth
-    for what, values in found.items():
-        text = " ".join(values).lower()
-        leaked = distinctive & words(text)
-        assert not leaked, (what, leaked)
-        for secret in (task.id, task.hazard_class, task.name.lower()):
-            assert secret.lower() not in text, (what, secret)
-
-
 def test_perceived_spec_and_graph_carry_no_answer_key_or_task_words(scene):
     task, folder = scene
     spec = load_perceived_spec(folder)
@@ -85,7 +47,7 @@ def test_perceived_spec_and_graph_carry_no_answer_key_or_task_words(scene):
     model, data, live = load_perceived_scene(folder)
     assert live == spec and model.nbody > len(spec.objects)
     model_names = [model.sensor(i).name for i in range(model.nsensor)] + [model.camera(i).name for i in range(model.ncam)]
-    _assert_no_task_words(task, {
+    assert_no_task_words(task, {
         "perceived spec": spec.model_dump(mode="json"),
         "scene graph": load_scene_graph(folder).model_dump(mode="json"),
         "sensor and camera names": model_names,
@@ -111,7 +73,7 @@ def test_make_env_shows_no_answer_key_before_the_end_and_the_verdict_at_it(scene
     assert ends == [False] * 5 + [True]
     assert set(base.obs_layout) == OBS_KEYS and obs.size == env.observation_space.shape[0]
     assert all(info == {} for info in infos[:-1])  # no success to claim: the env has no answer key
-    _assert_no_task_words(task, {
+    assert_no_task_words(task, {
         "env scene": base.scene.model_dump(mode="json"),
         "env layout": {"layout": sorted(base.obs_layout), "objects": base.object_names},
         "env info before the end": json.loads(json.dumps(infos[:-1])),

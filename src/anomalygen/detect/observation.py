@@ -29,7 +29,7 @@ def joint_phrase(joint: JointState) -> str:
     return f"{joint.label} {round(frac * 100)}% open"
 
 
-def _object_facts(obj: GraphObject) -> list[str]:
+def object_facts(obj: GraphObject) -> list[str]:
     facts: list[str] = []
     if obj.on_floor:
         facts.append("on the floor")
@@ -44,7 +44,7 @@ def _object_facts(obj: GraphObject) -> list[str]:
     return facts
 
 
-def _relation_phrase(rel) -> str:
+def relation_phrase(rel) -> str:
     if rel.predicate == "on_floor":
         return f"{rel.subject} is on the floor"
     words = {"on": "is on", "inside": "is inside", "near": "is near", "under": "is under", "blocks": "blocks"}
@@ -74,7 +74,7 @@ def observation_json(graph: SceneGraph) -> dict[str, Any]:
         if obj.joints:
             item["joints"] = [joint_phrase(j) for j in obj.joints]
         objects.append(item)
-    relations = [_relation_phrase(r) for r in graph.relations if r.predicate != "on_floor"]
+    relations = [relation_phrase(r) for r in graph.relations if r.predicate != "on_floor"]
     return {"room": graph.room, "objects": objects, "relations": relations}
 
 
@@ -84,8 +84,8 @@ def observation_text(graph: SceneGraph) -> str:
     for obj in graph.objects:
         props = f" [{', '.join(obj.properties)}]" if obj.properties else ""
         dims = "x".join(f"{v:.2f}" for v in obj.size)
-        lines.append(f"- {obj.name} ({obj.category}{props}), size {dims} m: " + "; ".join(_object_facts(obj)))
-    rels = [_relation_phrase(r) for r in graph.relations if r.predicate != "on_floor"]
+        lines.append(f"- {obj.name} ({obj.category}{props}), size {dims} m: " + "; ".join(object_facts(obj)))
+    rels = [relation_phrase(r) for r in graph.relations if r.predicate != "on_floor"]
     if rels:
         lines.append("Relations:")
         lines.extend(f"- {r}" for r in rels)

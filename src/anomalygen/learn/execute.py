@@ -31,7 +31,10 @@ if TYPE_CHECKING:  # pragma: no cover
 
 CEM_NOT_EXECUTED = ("not executed: CEM plans the motion of a legged robot (the Gymnasium Ant); household "
                     "scenes carry the wheeled arm")
-SAC_OFF = "not executed: sac_steps is 0"  # a SAC skill that did not run: no primitive runs in its place
+SAC_OFF = "not executed: sac_steps is 0"
+#: Control steps the scene settles after the plan (before the robot looks again) and at the end, before
+#: the final state is saved; the skill-level env (``anomalygen.agents``) settles as many on ``wait`` and ``done``.
+FINAL_SETTLE_STEPS = 25  # a SAC skill that did not run: no primitive runs in its place
 
 def _evaluate(calls, ep: Episode, bindings) -> list[PredicateResult]:
     from anomalygen.knowledge.predicates import evaluate_all
@@ -185,10 +188,10 @@ def _execute_here(scene_dir, plan: Plan, seed: int, video_path, max_wall_s: floa
 
     results = run_subtasks(ep, plan, retries)
     if before is not None and plan.subtasks:
-        ep.settle(25)
+        ep.settle(FINAL_SETTLE_STEPS)
         results += _look_again(ep, before, plan, recheck_fixes, retries)
 
-    ep.settle(25)
+    ep.settle(FINAL_SETTLE_STEPS)
     final = _evaluate(plan.success.predicates, ep, plan.bindings)
     if final_graph_path is not None:
         from anomalygen.runfolder import write_model

@@ -14,6 +14,7 @@ One such pass; what is still wrong after it is left for the referee to count.
 from __future__ import annotations
 
 from anomalygen.errors import ItemFailed
+from anomalygen.plan.fixes import Fix
 from anomalygen.schema import Plan, SceneGraph, SceneSpec
 
 
@@ -57,20 +58,34 @@ def spec_as_it_stands(spec: SceneSpec, graph: SceneGraph) -> SceneSpec:
     return spec.model_copy(update={"objects": objects})
 
 
+def repair_fixes(found: list[tuple[str, str]], graph: SceneGraph, kb, *,
+                 max_fixes: int) -> tuple[list[Fix], list[tuple[str, str]]]:
+    """The new hazards (at most ``max_fixes``) with their roles bound from the graph just read
+    (``plan.bind``); (class, problem) for those that cannot be bound."""
+    from anomalygen.plan.bind import bind_fix
+
+    fixes, problems = [], []
+    for obj, cls in found[:max_fixes]:
+        try:
+            fixes.append(Fix(cls, obj, bind_fix(kb.hazard_classes[cls], obj, graph, kb)))
+        except ItemFailed as exc:
+            problems.append((cls, f"{cls} on {obj}: {exc}"))
+    return fixes, problems
+
+
 def repair_plan(task_id: str, found: list[tuple[str, str]], graph: SceneGraph, spec: SceneSpec, kb, *,
                 max_fixes: int, sac_actions=()) -> tuple[Plan | None, list[tuple[str, str]]]:
     """One plan fixing the new hazards (at most ``max_fixes``); (class, problem) for those it cannot plan."""
-    from anomalygen.plan.bind import bind_fix
     from anomalygen.plan.planner import merge_plans, plan_from_kb
 
-    plans, problems = [], []
-    for obj, cls in found[:max_fixes]:
-        hc = kb.hazard_classes[cls]
+    fixes, problems = repair_fixes(found, graph, kb, max_fixes=max_fixes)
+    plans = []
+    for f in fixes:
         try:
-            bindings = bind_fix(hc, obj, graph, kb)
-            plans.append(plan_from_kb(task_id, cls, bindings, spec=spec, source="detected", sac_actions=sac_actions))
+            plans.append(plan_from_kb(task_id, f.hazard_class, f.bindings, spec=spec, source="detected",
+                                      sac_actions=sac_actions))
         except ItemFailed as exc:
-            problems.append((cls, f"{cls} on {obj}: {exc}"))
+            problems.append((f.hazard_class, f"{f.hazard_class} on {f.object}: {exc}"))
     if not plans:
         return None, problems
     merged = merge_plans(plans)  # run with this plan: its bindings resolve a single fix's variables

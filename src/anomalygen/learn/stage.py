@@ -27,11 +27,12 @@ if TYPE_CHECKING:
 STAGE = "learn"
 
 
-def _item_id(task_id: str, seed: int) -> str:
+def run_item_id(task_id: str, seed: int) -> str:
+    """``t0001-3fa2c1d9@seed0``: one execution of a task's scene (also a bench episode's item)."""
     return f"{task_id}@seed{seed}"
 
 
-def _split(item_id: str) -> tuple[str, int]:
+def split_run_item(item_id: str) -> tuple[str, int]:
     task_id, seed = item_id.rsplit("@seed", 1)
     return task_id, int(seed)
 
@@ -40,7 +41,7 @@ def learn_item(item_id: str, payload: dict, ctx: StageContext) -> dict:
     from anomalygen.learn.execute import execute_plan
 
     run, settings = ctx.run, ctx.settings
-    task_id, seed = _split(item_id)
+    task_id, seed = split_run_item(item_id)
     plan = try_read_model(run.plan_path(task_id), Plan)
     if plan is None:
         raise ItemFailed(f"no valid plan for {task_id}")
@@ -70,7 +71,7 @@ def success_table(run: RunFolder, items: list[tuple[str, dict]], classes: dict[s
     condition held). Not the referee's verdict: that comes after this stage (``anomalygen judge``)."""
     acc: dict[str, dict[str, int]] = defaultdict(lambda: dict.fromkeys(TABLE_COUNTS, 0))
     for item_id, _payload in items:
-        task_id, seed = _split(item_id)
+        task_id, seed = split_run_item(item_id)
         res = try_read_model(run.skill_dir(task_id, seed) / RESULT, SkillResult)
         row = acc[classes.get(task_id, "unknown")]
         row["n"] += 1
@@ -114,14 +115,14 @@ def run_stage(run: RunFolder, settings: Settings, *, force: bool = False, only: 
         if not run.plan_path(t.id).is_file() or not (run.scene_dir(t.id) / SCENE_SPEC).is_file():
             continue
         for seed in range(settings.learn.seeds):
-            items.append((_item_id(t.id, seed), {}))
+            items.append((run_item_id(t.id, seed), {}))
 
     def done(item_id: str) -> bool:
-        task_id, seed = _split(item_id)
+        task_id, seed = split_run_item(item_id)
         return try_read_model(run.skill_dir(task_id, seed) / RESULT, SkillResult) is not None
 
     summary = run_items(run, STAGE, items, learn_item, settings=settings, is_done=done, force=force,
-                        inputs=lambda item_id: _inputs(run, _split(item_id)[0]),
+                        inputs=lambda item_id: _inputs(run, split_run_item(item_id)[0]),
                         config=reads(settings))
     table = success_table(run, items, {t.id: t.hazard_class for t in tasks})
     summary.results["by_class"] = table

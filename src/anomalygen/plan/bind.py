@@ -34,14 +34,17 @@ STABLE_TOPS = ("Table", "counter", "shelf", "StorageFurniture")  # categories wi
 EDGE_ROOM_M = 0.15  # a support should leave the object this far from its edges on both sides
 
 
-def bind_fix(hc, fault: str, graph: SceneGraph, kb) -> dict[str, str]:
-    """Every role variable of ``hc``'s recipe bound to a perceived object; ItemFailed when one cannot be."""
+def bind_fix(hc, fault: str, graph: SceneGraph, kb, given: dict[str, str] | None = None) -> dict[str, str]:
+    """Every role variable of ``hc``'s recipe bound to a perceived object; ItemFailed when one cannot be.
+
+    ``given`` binds some roles already (``{"$container": "drawer_0"}``: an agent's own choice); the
+    others are chosen here around them."""
     from anomalygen.knowledge.predicates import PredicateError, match_class
 
     names = {o.name: o for o in graph.objects}
     if fault not in names:
         raise ItemFailed(f"the detected object {fault!r} is not in the scene")
-    bindings = {hc.hazard_variable: fault}
+    bindings = {hc.hazard_variable: fault, **(given or {})}
     try:
         matches = match_class(hc, graph, fixed=dict(bindings))
     except PredicateError:

@@ -156,12 +156,15 @@ def switch_off_subtasks(index: int, args: dict[str, str], bindings: dict[str, st
     as a fraction (the joint term scaled by 1 / travel, so a 4.7 rad knob and a 4 mm button weigh the
     same) plus the cup near the part; the class's predicates check the last one, earlier ones are
     checked by their joint term. With no part on in the spec (a plan from a wrong detection) the first
-    part is planned, as for the other joint steps.
+    part is planned, as for the other joint steps. ``args["joint"]`` (not a recipe argument) names one
+    part, by its joint's name or the part of it after the object's name: only that part is planned.
     """
     target_obj = _resolve(args.get("object", "$target"), bindings)
     wanted = set(part_labels.alternatives(args["label"]) if "label" in args else SWITCH_LABELS)
     joints = [js for obj in (spec.objects if spec else []) if obj.name == target_obj
               for js in obj.joint_states if js.label in wanted]
+    if args.get("joint"):  # one named part (a call of the skill-level env: switch_off(stove_0, knob_2))
+        joints = [js for js in joints if args["joint"] in (js.name, js.name.split("/")[-1])]
     on = sorted([js for js in joints if not js.is_off()], key=lambda js: -js.open_fraction)
     chosen = on or joints[:1]
     vars_here = set(args.values())
@@ -256,9 +259,6 @@ def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, s
     cls = kb.hazard_classes.get(hazard_class)
     if cls is None:
         raise ItemFailed(f"hazard class {hazard_class!r} is not in the knowledge base; no recipe to plan from")
-    # A step goes to SAC when the knowledge base says so (``"method": "sac"``: a contact-rich part
-    # motion with a shipped warm start, such as switch_off) or the user lists its action in
-    # ``plan.sac_actions``; it keeps its reward spec either way.
     # the four role variables keep their old reading (a scene-less plan names them); any other one (the
     # lit burner of a composed class) must be bound, or the step would act on a '$source' that is nothing
     unbound = [v for v in cls.recipe_variable_names() if v not in bindings and v not in ROLE_VARIABLES]
@@ -267,15 +267,28 @@ def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, s
     blocked = [step.action for step in cls.recipe if not plannable(step.action)]
     if blocked:
         raise ItemFailed(f"no skill for {blocked[0]} yet: {hazard_class}'s fix needs it")
+    return plan_from_recipe(task_id, list(cls.recipe), list(cls.success), bindings, spec=spec, source=source,
+                            sac_actions=sac_actions)
+
+
+def plan_from_recipe(task_id: str, recipe: list, success: list[PredicateCall], bindings: dict[str, str], *,
+                     spec: SceneSpec | None = None, source: str = "detected",
+                     sac_actions: tuple[str, ...] | list[str] = ()) -> Plan:
+    """A plan from recipe steps (``knowledge.models.RecipeStep``) and the success condition they serve:
+    a class's recipe (:func:`plan_from_kb`), or the steps of one call of the skill-level env
+    (``anomalygen.agents``), through the same sub-task, access and take-out machinery."""
+    # A step goes to SAC when the recipe says so (``"method": "sac"``: a contact-rich part motion with a
+    # shipped warm start, such as switch_off) or the user lists its action in ``plan.sac_actions``; it
+    # keeps its reward spec either way.
     subtasks = []
-    for i, step in enumerate(cls.recipe):
+    for i, step in enumerate(recipe):
         method = SkillMethod.SAC if step.method == "sac" or step.action in sac_actions else SkillMethod.PRIMITIVE
         if step.action == "switch_off":
-            subtasks += switch_off_subtasks(i, dict(step.args), bindings, spec, list(cls.success), method)
+            subtasks += switch_off_subtasks(i, dict(step.args), bindings, spec, list(success), method)
             continue
-        st = step_to_subtask(i, step.action, dict(step.args), bindings, spec, list(cls.success))
+        st = step_to_subtask(i, step.action, dict(step.args), bindings, spec, list(success))
         subtasks.append(st.model_copy(update={"method": method}) if method != st.method else st)
-    for step in cls.recipe:
+    for step in recipe:
         # A container shut in the scene is opened before the object goes in (or comes out) and shut after.
         if step.action in ("place_inside", "take_out_of"):
             container = _resolve(step.args.get("container", "$container"), bindings)
@@ -286,9 +299,9 @@ def plan_from_kb(task_id: str, hazard_class: str, bindings: dict[str, str], *, s
                 shut = shut.model_copy(update={"success": SuccessSpec(predicates=[*shut.success.predicates, *after_shut])})
                 subtasks = [opened, *subtasks, shut]
             break
-    subtasks = _take_out_first(subtasks, cls, bindings, spec)
+    subtasks = _take_out_first(subtasks, recipe, bindings, spec)
     return Plan(task_id=task_id, source=source, engine=Engine.KNOWLEDGE, subtasks=subtasks,
-                success=SuccessSpec(predicates=list(cls.success)), bindings=dict(bindings))
+                success=SuccessSpec(predicates=list(success)), bindings=dict(bindings))
 
 
 def _checks_after_shutting(subtasks: list[SubTask], container: str) -> tuple[list[SubTask], list[PredicateCall]]:
@@ -305,7 +318,7 @@ def _checks_after_shutting(subtasks: list[SubTask], container: str) -> tuple[lis
     return out, moved
 
 
-def _take_out_first(subtasks: list[SubTask], cls, bindings: dict[str, str], spec: SceneSpec | None) -> list[SubTask]:
+def _take_out_first(subtasks: list[SubTask], recipe: list, bindings: dict[str, str], spec: SceneSpec | None) -> list[SubTask]:
     """A recipe that starts with a pick, for an object lying in a container with doors or drawers
     (sour milk on a fridge shelf): the pick becomes take_out_of through the opening, with the part
     in front of the object opened before and shut after (a fridge door left open is a hazard too).
@@ -314,9 +327,9 @@ def _take_out_first(subtasks: list[SubTask], cls, bindings: dict[str, str], spec
     the shutting last, once the object is where it belongs. The scene spec says what lies inside what;
     that is geometry the robot perceives (the perceived spec keeps it), not the answer key.
     """
-    if spec is None or not cls.recipe or cls.recipe[0].action != "pick":
+    if spec is None or not recipe or recipe[0].action != "pick":
         return subtasks
-    obj = _resolve(cls.recipe[0].args.get("object", "$hazard"), bindings)
+    obj = _resolve(recipe[0].args.get("object", "$hazard"), bindings)
     source = next((o.inside for o in spec.objects if o.name == obj), None)
     labels = sorted({js.label for o in spec.objects if o.name == source for js in o.joint_states
                      if js.label in (DRAWER, DOOR)}, key=CLOSURES.index)

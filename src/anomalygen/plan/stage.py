@@ -23,7 +23,7 @@ from anomalygen.errors import ItemFailed, UserError
 from anomalygen.runfolder import RunFolder, read_jsonl, try_read_model, write_model
 from anomalygen.runner import StageContext, StageSummary, check_only, config_section, run_items
 from anomalygen.scene_files import SCENE_GRAPH, SCENE_SPEC
-from anomalygen.schema import Detection, DroppedFix, Engine, Plan, SceneSpec, SuccessSpec, TaskProposal
+from anomalygen.schema import Detection, Engine, Plan, SceneSpec, SuccessSpec, TaskProposal
 
 if TYPE_CHECKING:
     from anomalygen.config import Settings
@@ -62,6 +62,7 @@ def _plan_from_perception(task_id: str, payload: dict, ctx: StageContext) -> Pla
     """Fix what was detected, most severe first, with every role chosen from the perceived scene."""
     from anomalygen.knowledge import load_kb
     from anomalygen.plan.bind import bind_fix
+    from anomalygen.plan.fixes import choose_fixes, fixes_to_make
     from anomalygen.plan.planner import merge_plans, plan_from_kb
     from anomalygen.world.perception import load_perceived_spec, load_scene_graph
 
@@ -74,55 +75,26 @@ def _plan_from_perception(task_id: str, payload: dict, ctx: StageContext) -> Pla
     if spec is None or graph is None:
         raise ItemFailed(f"no built scene in {ctx.run.scene_dir(task_id)}")
     kb = load_kb()
-    chosen = fixes_to_make(det["hypotheses"], kb, max_fixes=settings.plan.max_fixes,
-                           min_score=settings.plan.min_score)
-    if not chosen:  # nothing detected worth acting on: the right plan is to leave the scene alone
-        return Plan(task_id=task_id, source="detected", engine=settings.engine_for("plan"), subtasks=[],
-                    success=SuccessSpec(predicates=[]), bindings={})
     if settings.engine_for("plan").value == "llm":
+        chosen = fixes_to_make(det["hypotheses"], kb, max_fixes=settings.plan.max_fixes,
+                               min_score=settings.plan.min_score)
+        if not chosen:
+            return _nothing_to_fix(task_id, settings)
         top = chosen[0]
         bindings = bind_fix(kb.hazard_classes[top["hazard_class"]], top["target_object"], graph, kb)
         return _plan_with_llm(task_id, payload, ctx, top["hazard_class"], bindings, spec, top)
-    plans, dropped = [], []
-    for first in chosen:
-        # the object's most severe class first; when its fix cannot be bound here (no container the
-        # toy fits), the object's next detected class (the toy taken off the stairs)
-        for hyp in [first, *other_classes_of(det["hypotheses"], kb, first, min_score=settings.plan.min_score)]:
-            hc = kb.hazard_classes[hyp["hazard_class"]]
-            try:
-                bindings = bind_fix(hc, hyp["target_object"], graph, kb)
-            except ItemFailed as exc:
-                dropped.append(DroppedFix(hazard_class=hc.id, object=hyp["target_object"], reason=str(exc)))
-                continue
-            plans.append(plan_from_kb(task_id, hc.id, bindings, spec=spec, source="detected",
-                                      sac_actions=settings.plan.sac_actions))
-            break
-    if not plans:
-        raise ItemFailed("; ".join(f"{d.hazard_class} on {d.object}: {d.reason}" for d in dropped))
+    fixes, dropped = choose_fixes(det["hypotheses"], graph, kb, max_fixes=settings.plan.max_fixes,
+                                  min_score=settings.plan.min_score)
+    if not fixes:  # nothing detected worth acting on: the right plan is to leave the scene alone
+        return _nothing_to_fix(task_id, settings)
+    plans = [plan_from_kb(task_id, f.hazard_class, f.bindings, spec=spec, source="detected",
+                          sac_actions=settings.plan.sac_actions) for f in fixes]
     return merge_plans(plans).model_copy(update={"dropped": dropped})
 
 
-def fixes_to_make(hypotheses: list[dict], kb, *, max_fixes: int, min_score: float) -> list[dict]:
-    """Hypotheses worth acting on: a known class, a score at or above ``min_score``, one per object,
-    most severe class first (ties by detector rank), at most ``max_fixes``."""
-    seen: set[str] = set()
-    out = []
-    usable = [h for h in hypotheses if h.get("hazard_class") in kb.hazard_classes
-              and float(h.get("score") or 0.0) >= min_score]
-    for h in sorted(usable, key=lambda h: (-kb.hazard_classes[h["hazard_class"]].severity, h["rank"])):
-        if h["target_object"] in seen:
-            continue
-        seen.add(h["target_object"])
-        out.append(h)
-    return out[:max_fixes]
-
-
-def other_classes_of(hypotheses: list[dict], kb, chosen: dict, *, min_score: float) -> list[dict]:
-    """The other usable hypotheses about ``chosen``'s object, most severe class first."""
-    same = [h for h in hypotheses if h is not chosen and h.get("target_object") == chosen["target_object"]
-            and h.get("hazard_class") in kb.hazard_classes and h.get("hazard_class") != chosen.get("hazard_class")
-            and float(h.get("score") or 0.0) >= min_score]
-    return sorted(same, key=lambda h: (-kb.hazard_classes[h["hazard_class"]].severity, h["rank"]))
+def _nothing_to_fix(task_id: str, settings: Settings) -> Plan:
+    return Plan(task_id=task_id, source="detected", engine=settings.engine_for("plan"), subtasks=[],
+                success=SuccessSpec(predicates=[]), bindings={})
 
 
 def _plan_with_llm(task_id: str, payload: dict, ctx: StageContext, hazard_class: str, bindings: dict[str, str],

@@ -23,6 +23,15 @@ from anomalygen.schema.base import (
     Vec3,
     format_validation_error,
 )
+from anomalygen.schema.bench import (
+    BenchClassRow,
+    BenchReport,
+    BenchRun,
+    CallRecord,
+    EpisodeRecord,
+    SuiteManifest,
+    SuiteScene,
+)
 from anomalygen.schema.detection import (
     Detection,
     Hypothesis,
@@ -143,6 +152,9 @@ ARTEFACTS: dict[str, type[BaseModel]] = {
         Verdict,
         RunManifest,
         ItemError,
+        SuiteManifest,
+        EpisodeRecord,
+        BenchReport,
     )
 }
 
@@ -239,5 +251,12 @@ __all__ = [
     "LLMUsage",
     "RunManifest",
     "ItemError",
+    "SuiteScene",
+    "SuiteManifest",
+    "CallRecord",
+    "EpisodeRecord",
+    "BenchClassRow",
+    "BenchRun",
+    "BenchReport",
     "ARTEFACTS",
 ]

@@ -49,7 +49,8 @@ class PerceptionNoise(Strict):
 class Detection(Artefact):
     task_id: str
     scene_id: str
-    detector: Literal["rules", "llm", "hybrid"]
+    detector: Literal["rules", "llm", "hybrid", "agent"] = Field(
+        description="agent: what an agent of the skill-level env reported (anomalygen bench)")
     hypotheses: list[Hypothesis]
     error: str | None = None
     judgements: list[Judgement] = Field(default_factory=list, description="legacy, not written any more")
