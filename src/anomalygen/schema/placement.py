@@ -84,6 +84,26 @@ def object_relation(written: str) -> tuple[str, str] | None:
     return (relation, other) if colon and relation in OBJECT_RELATIONS else None
 
 
+def _shapes_schema(schema: dict[str, Any]) -> None:
+    """The JSON schema states each relation's valid shapes (``on`` with a support kind, ``on`` with an
+    object, ...), one ``anyOf`` branch each, derived from ``RELATIONS``: a grammar-constrained model
+    (and a schema that keeps only required fields) then cannot write ``on`` with neither."""
+    shapes = []
+    for r in RELATIONS:
+        relation = {"const": r.name}
+        if r.supports:
+            shapes.append({"type": "object", "additionalProperties": False, "required": ["relation", "support"],
+                           "properties": {"relation": relation,
+                                          "support": {"type": "string", "enum": list(r.supports)}}})
+        if r.names_other:
+            shapes.append({"type": "object", "additionalProperties": False, "required": ["relation", "other"],
+                           "properties": {"relation": relation,
+                                          "other": {"type": "string", "description": "catalogue name of the other object"}}})
+    for key in ("properties", "required", "additionalProperties", "type"):
+        schema.pop(key, None)
+    schema["anyOf"] = shapes
+
+
 class Placement(BaseModel):
     """Where the object is: one relation (``RELATIONS``) to a support kind or to another catalogue object.
 
@@ -91,7 +111,7 @@ class Placement(BaseModel):
     ``on`` + ``Stove``; ``near`` + ``Sink``. Reads the compact words too (``counter_edge``, ``inside:Bathtub``).
     """
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, json_schema_extra=_shapes_schema)
 
     relation: RelationName = Field(description=", ".join(RELATION_KINDS))
     support: SupportKind | None = Field(None, description="the support kind it is on or at the edge of")
