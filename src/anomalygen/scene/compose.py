@@ -13,6 +13,7 @@ import numpy as np
 
 from anomalygen.mjgeom import FLOOR_GEOM
 from anomalygen.robot.agent import Agent
+from anomalygen.schema import part_labels
 from anomalygen.scene import furniture, viewpoint, walls
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.viewpoint import CAMERA_FOVY, FRAME_TOP
@@ -178,7 +179,10 @@ def latch_switched_on(model, placed: dict[str, Placed], mjspec) -> None:
             if value is None or abs(value - j.closed_value) < 1e-9:
                 continue
             jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{p.name}/{j.name}")
-            if jid < 0 or model.jnt_stiffness[jid] <= 0:
+            if jid < 0:
+                continue
+            if model.jnt_stiffness[jid] <= 0:
+                _hold_switch_set_on(model, mjspec, p, j, jid)
                 continue
             stiffness = float(model.jnt_stiffness[jid])
             model.jnt_stiffness[jid] = 0.0
@@ -191,6 +195,19 @@ def latch_switched_on(model, placed: dict[str, Placed], mjspec) -> None:
             body = int(model.jnt_bodyid[jid])
             model.body_gravcomp[body] = 1.0
             mjspec.body(model.body(body).name).gravcomp = 1.0
+
+
+def _hold_switch_set_on(model, mjspec, p: Placed, j, jid: int) -> None:
+    """A switch with no spring that was set on stays on until something turns it: its weight is
+    compensated. A single-lever tap holds any position in its cartridge, but MuJoCo's friction is a
+    soft constraint that creeps under a steady load: a bathtub's lever, set 70 % open and held by 1.3x
+    its gravity torque, crept shut in 4 s, so a scene where nobody did anything read "resolved".
+    Turned off, it rests on its limit as before; only on/off controls are held, never doors or lids."""
+    if j.type != "hinge" or not part_labels.is_switch(j.label):
+        return
+    body = int(model.jnt_bodyid[jid])
+    model.body_gravcomp[body] = 1.0
+    mjspec.body(model.body(body).name).gravcomp = 1.0
 
 
 def hold_gravity_hinges(model, placed: dict[str, Placed], mjspec) -> None:
