@@ -51,3 +51,24 @@ def test_a_latched_button_holds_where_it_is_set_either_way(tmp_path):
     mujoco.mj_forward(m, d)
     ep.settle(200)
     assert abs(float(d.joint(BUTTON).qpos[0])) < 2e-4
+
+
+@pytest.mark.slow
+def test_a_lever_tap_set_running_stays_running_until_turned(tmp_path):
+    """A single-lever tap the builder set running keeps its opening: its weight is compensated, as a
+    real tap cartridge holds any position. Held by friction alone, MuJoCo's soft friction let the
+    bathtub's lever creep shut in about 4 s (the seed-0 task t0084), so a robot that did nothing was
+    judged to have turned the tap off."""
+    from anomalygen.world.states import RUNNING
+    from support.built_task import episode_on_built_task
+
+    ep = episode_on_built_task(Path(__file__).parent / "fixtures" / "bathtub_tap_running.json", tmp_path / "scene")
+    m, d = ep.driver.model, ep.driver.data
+    lever = "bathtub_0/lever_hinge"
+    jid = m.joint(lever).id
+    assert m.body_gravcomp[m.jnt_bodyid[jid]] == 1.0
+    opened = float(d.joint(lever).qpos[0])
+    assert opened < -0.3  # about 90 % of its 0.6 rad lift: running
+    ep.settle(1000)  # 2 s of nothing
+    assert abs(float(d.joint(lever).qpos[0]) - opened) < 1e-3
+    assert RUNNING in ep.graph().get("bathtub_0").states
