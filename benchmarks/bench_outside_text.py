@@ -35,6 +35,7 @@ from urllib.parse import urlparse
 from anomalygen import procs
 
 DATA = Path(__file__).parent / "data" / "outside_hazards.jsonl"
+PARAPHRASES = Path(__file__).parent / "data" / "outside_paraphrases.jsonl"
 
 
 def load_set(half: str = "all") -> list[dict]:
@@ -53,29 +54,96 @@ def source_of(row: dict) -> str:
 
 
 def judge(row: dict, kb, tg) -> dict:
-    """What the reader did with one line, and how that compares with the label."""
+    """What the reader did with one line, and how that compares with the label.
+
+    A line with a danger label is in scope: reading it faithfully means composing that danger on the
+    labelled object, either a catalogue name or, for a free word ("oven cleaner"), a proxy shape of its
+    kind that keeps the user's word (``Mention.called``). Refusing it is a wrong refusal. A line with
+    no danger label is out of scope and should be refused; composing it is a substitution."""
     from anomalygen.brainstorm.line_compose import Refused
+    from anomalygen.knowledge.grounding import normalise
 
     objects = [o for o in row["object"] if o in kb.objects]
-    expect_refusal = not objects or not row["danger"]
-    out = {"id": row["id"], "half": row["half"], "source": source_of(row), "line": row["line"]}
+    free = [normalise(o) for o in row["object"] if o not in kb.objects]
+    expect_refusal = not row["danger"]
+    out = {"id": row["id"], "half": row["half"], "source": source_of(row), "line": row["line"],
+           "in_scope": not expect_refusal}
     try:
         _, comp = tg.compose(row["line"])
     except Refused as exc:
         out.update(outcome="refused", reason=str(exc), verdict="faithful" if expect_refusal else "wrong_refusal")
         return out
     mech = comp.hc.composition.mechanism
-    ok = not expect_refusal and comp.fault.name in objects and mech in row["danger"]
+    called = normalise(comp.fault.called) if getattr(comp.fault, "called", None) else None  # (older readers lack it)
+    said_as_labelled = called is not None and any(f == called or f.endswith("_" + called) or called.endswith("_" + f)
+                                                  for f in free)
+    right_object = comp.fault.name in objects or said_as_labelled
+    ok = not expect_refusal and right_object and mech in row["danger"]
     # the task the line becomes must put the state on that object too: a class about its target
     # (left on, left open) sets it on the task's target_asset
     task = tg.proposal(row["line"], 1)
     built_on = task.target_asset if comp.hc.about_target else task.scenario.hazard_object
     ok = ok and built_on == comp.fault.name
     out.update(outcome="composed", hazard_class=comp.hc.id, mechanism=mech, object=comp.fault.name,
-               other=comp.other.name if comp.other else None, built_on=built_on,
+               called=getattr(comp.fault, "called", None), other=comp.other.name if comp.other else None, built_on=built_on,
                verdict="faithful" if ok else "substitution")
     missing = [n for n in (comp.fault.name, comp.other.name if comp.other else None) if n and n not in tg_catalogue()]
     out["needs_assets"] = missing
+    return out
+
+
+def reading(line: str, tg) -> tuple:
+    """What a line reads as, in the terms a paraphrase must keep: refused, or the composed class with
+    its object at fault (shape and kind), the related object and how it relates."""
+    from anomalygen.brainstorm.line_compose import Refused
+
+    try:
+        _, comp = tg.compose(line)
+    except Refused:
+        return ("refused",)
+    other = comp.other
+    return (comp.hc.id, _object_identity(comp.fault), _object_identity(other) if other else None,
+            other.relation if other else None)
+
+
+def _object_identity(m) -> frozenset:
+    """An object as a paraphrase must keep it: its catalogue shape, or any kind of the lexicon it is
+    (a proxy's kind, or every kind the shape stands for), so "pills" and "tablets" are one object."""
+    try:
+        from anomalygen.knowledge.lexicon import load_lexicon
+    except ImportError:  # a reader from before the lexicon
+        return frozenset({m.name})
+    kinds = {k.id for k in load_lexicon().kinds.values() if m.name in k.proxies}
+    own = getattr(m, "kind", None)
+    return frozenset({own} if own else kinds or {m.name})
+
+
+def _same(a: tuple, b: tuple) -> bool:
+    if len(a) != len(b) or a[0] != b[0]:
+        return False
+    if len(a) == 1:
+        return True
+    return bool(a[1] & b[1]) and ((a[2] is None) == (b[2] is None)) and (a[2] is None or bool(a[2] & b[2])) \
+        and a[3] == b[3]
+
+
+def paraphrase_agreement(rows: list[dict], tg) -> dict:
+    """Per half: lines whose every paraphrase reads as the line does (``reading``), and paraphrases that do."""
+    by_id = {json.loads(x)["id"]: json.loads(x)["paraphrases"]
+             for x in PARAPHRASES.read_text(encoding="utf-8").splitlines() if x.strip()} if PARAPHRASES.exists() else {}
+    out: dict[str, dict] = {}
+    for r in rows:
+        alts = by_id.get(r["id"])
+        if not alts:
+            continue
+        base = reading(r["line"], tg)
+        same = [_same(reading(a, tg), base) for a in alts]
+        for key in ("all", r["half"]):
+            t = out.setdefault(key, {"lines": 0, "lines_all_same": 0, "paraphrases": 0, "paraphrases_same": 0})
+            t["lines"] += 1
+            t["lines_all_same"] += all(same)
+            t["paraphrases"] += len(same)
+            t["paraphrases_same"] += sum(same)
     return out
 
 
@@ -99,6 +167,10 @@ def table(results: list[dict]) -> dict:
         "refused": sum(r["outcome"] == "refused" for r in results),
         "composed": len(composed),
         "composed_needing_assets": sum(bool(r.get("needs_assets")) for r in composed),
+        "in_scope": sum(r["in_scope"] for r in results),
+        "in_scope_faithful": sum(r["in_scope"] and r["verdict"] == "faithful" for r in results),
+        "out_of_scope": sum(not r["in_scope"] for r in results),
+        "out_of_scope_refused": sum(not r["in_scope"] and r["outcome"] == "refused" for r in results),
     }
 
 
@@ -161,7 +233,8 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=Path("runs/outside_text"))
     ap.add_argument("--workers", type=int, default=1, help="worker processes of each pipeline stage (--build)")
     ap.add_argument("--json", action="store_true")
-    ap.add_argument("--lines", action="store_true", help="print every line's outcome")
+    ap.add_argument("--lines", action="store_true", help="print every line's outcome (dev half only)")
+    ap.add_argument("--paraphrases", action="store_true", help="also score agreement across paraphrases")
     args = ap.parse_args()
 
     from anomalygen.brainstorm.free_text import TextGrounder
@@ -180,15 +253,19 @@ def main() -> None:
     for r in results:
         by_source[r["source"]].append(r)
     report["sources"] = {s: table(rs) for s, rs in sorted(by_source.items())}
-    report["refusal_reasons"] = {r["id"]: r["reason"] for r in results if r["outcome"] == "refused"}
+    # line by line only for the development half: the held-out half is scored in aggregate alone
+    dev = [r for r in results if r["half"] == "dev"]
+    report["refusal_reasons"] = {r["id"]: r["reason"] for r in dev if r["outcome"] == "refused"}
     report["substitutions"] = {r["id"]: f"{r['object']} / {r['mechanism']} ({r['hazard_class']})"
-                               for r in results if r["verdict"] == "substitution"}
+                               for r in dev if r["verdict"] == "substitution"}
+    if args.paraphrases:
+        report["paraphrases"] = paraphrase_agreement(rows, tg)
     if args.build:
         buildable = [r["line"] for r in results if r["verdict"] == "faithful" and r["outcome"] == "composed"
                      and not r.get("needs_assets")]
         report["pipeline"] = run_pipeline(buildable, args.out, args.workers)
     if args.lines:
-        for r in results:
+        for r in dev:
             what = r.get("reason") or f"{r['object']} / {r['mechanism']} / {r['hazard_class']}"
             print(f"{r['id']} {r['half']:8s} {r['verdict']:13s} {what[:90]} | {r['line']}")
     if args.json:
@@ -198,17 +275,22 @@ def main() -> None:
         print(f"{name:9s} lines {t['lines']:3d}  faithful {t['faithful']:3d} ({t['faithful_pct']:5.1f} %)  "
               f"substitutions {t['substitutions']:2d} ({t['substitution_pct']:4.1f} %)  wrong refusals {t['wrong_refusals']:2d}  "
               f"refused {t['refused']:2d}  composed {t['composed']:2d} (needing assets {t['composed_needing_assets']})")
+        print(f"{'':9s} in scope {t['in_scope']:3d}: {t['in_scope_faithful']:3d} faithful; out of scope "
+              f"{t['out_of_scope']:2d}: {t['out_of_scope_refused']:2d} refused")
     print("per source:")
     for s, t in report["sources"].items():
         print(f"  {s:40s} {t['faithful']:2d}/{t['lines']:2d} faithful, {t['substitutions']} substituted, "
               f"{t['wrong_refusals']} wrongly refused")
-    print("refused lines:")
+    print("refused lines (dev half):")
     for rid, reason in report["refusal_reasons"].items():
         print(f"  {rid}: {reason}")
     if report["substitutions"]:
-        print("substitutions:")
+        print("substitutions (dev half):")
         for rid, what in report["substitutions"].items():
             print(f"  {rid}: {what}")
+    for half, t in report.get("paraphrases", {}).items():
+        print(f"paraphrases {half:8s}: {t['lines_all_same']}/{t['lines']} lines read the same in every paraphrase; "
+              f"{t['paraphrases_same']}/{t['paraphrases']} paraphrases read as their line")
     if "pipeline" in report:
         print("pipeline:", json.dumps(report["pipeline"]))
 

@@ -49,7 +49,7 @@ def test_the_scene_is_told_the_states_and_parts_the_line_needs(reader):
 
 @pytest.mark.parametrize(("line", "reason"), [
     ("Shards of a broken glass are scattered on the kitchen floor.", "broken"),
-    ("A curling iron was left on by the bathroom sink.", "no object 'curling iron'"),
+    ("A chainsaw was left running on the hallway floor.", "no object 'chainsaw'"),
     ("A bottle of cooking oil stands right on the hob.", "no object 'cooking oil'"),
     ("An extension cord runs under the living room rug.", "under rug"),
     ("A laptop is lying on the sofa.", "closest"),
@@ -57,6 +57,29 @@ def test_the_scene_is_told_the_states_and_parts_the_line_needs(reader):
 def test_a_line_no_mechanism_covers_is_refused_with_a_reason(reader, line, reason):
     with pytest.raises(Refused, match=reason):
         reader.compose(line)
+
+
+@pytest.mark.parametrize(("line", "said", "kind"), [
+    ("A curling iron was left on by the bathroom sink.", "curling iron", "heated_hand_tool"),
+    ("Somebody left the oven cleaner on the low coffee table.", "oven cleaner", None),
+    ("The paracetamol is on the bedside table where the toddler can reach it.", "paracetamol", None),
+])
+def test_a_word_the_catalogue_lacks_is_built_as_its_kind_under_the_users_word(reader, line, said, kind):
+    """The household lexicon: a proxy shape of the word's kind, named as the user named it everywhere
+    the task speaks of it, and never under the proxy's own name."""
+    from anomalygen.brainstorm.realise import nice
+    from anomalygen.knowledge.lexicon import load_lexicon
+
+    task = reader.proposal(line, 1)
+    proxy = task.scenario.hazard_object
+    assert task.scenario.called[proxy] == said
+    reading = load_lexicon().read(said)
+    assert reading is not None and reading.proxy == proxy and (kind is None or reading.kind == kind)
+    assert set(load_kb().objects[proxy].properties) >= set(load_lexicon().kinds[reading.kind].properties)
+    for text in (task.name, task.solution, task.success_condition, task.explanation):
+        assert nice(proxy) not in text.lower() or nice(proxy) in said, (proxy, text)
+    fault = next(m for m in task.grounding if m.field == "scenario.hazard_object")
+    assert (fault.method, fault.written, fault.kind) == ("lexicon", said, reading.kind)
 
 
 def test_one_bad_line_fails_alone_and_the_power_strip_in_a_full_sink_is_built_as_stated():

@@ -64,7 +64,7 @@ def _text(n: int = MAX_NAME, min_length: int = 1) -> spaces.Text:
 def object_space() -> spaces.Dict:
     part = spaces.Dict({"name": _text(), "label": _text(), "state": _text()})
     return spaces.Dict({
-        "name": _text(), "kind": _text(),
+        "name": _text(), "kind": _text(), "called": _text(min_length=0),
         "position": spaces.Box(-1e3, 1e3, shape=(3,), dtype=np.float64),
         "size": spaces.Box(0.0, 1e3, shape=(3,), dtype=np.float64),
         "movable": spaces.Discrete(2), "container": spaces.Discrete(2),
@@ -106,7 +106,7 @@ def objects_of(graph: SceneGraph, spec: SceneSpec) -> tuple[dict, ...]:
         p = placed.get(o.name)
         states = [*object_facts(o), *o.states, *(["held by the robot"] if o.held else [])]
         out.append({
-            "name": clean(o.name), "kind": clean(o.category),
+            "name": clean(o.name), "kind": clean(o.category), "called": clean(o.called or ""),
             "position": np.asarray(o.position, dtype=np.float64), "size": np.asarray(o.size, dtype=np.float64),
             "movable": int(p is not None and not p.fixed),
             "container": int(p is not None and bool(p.cavities)),

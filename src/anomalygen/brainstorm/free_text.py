@@ -24,6 +24,7 @@ from anomalygen.brainstorm.realise import realise
 from anomalygen.errors import UserError
 from anomalygen.knowledge import KnowledgeBase
 from anomalygen.knowledge.grounding import NameGrounder
+from anomalygen.knowledge.lexicon import load_lexicon
 from anomalygen.knowledge.mechanisms import load_mechanisms
 from anomalygen.rng import item_rng
 from anomalygen.schema import BrainstormMode, Engine, GroundingMatch, TaskProposal
@@ -72,7 +73,7 @@ class TextGrounder:
 
     def compose(self, line: str) -> tuple[ParsedLine, Composition]:
         """The line read and its hazard composed; raises Refused (a ValueError) with the reason."""
-        parsed = parse_line(line, self.g)
+        parsed = parse_line(line, self.g, lexicon=load_lexicon(), buildable=self.catalogue)
         comp = compose_line(parsed, self.kb, self.ms, self.g)
         missing = [m.name for m in (comp.fault, comp.other) if m is not None and m.name not in self.catalogue]
         if missing:
@@ -102,9 +103,12 @@ class TextGrounder:
         rng = item_rng(self.seed, "tasks-text", index)
         idea = Idea(class_id=hc.id, target=target, hazard=hazard, placement=placement, room=room, person=hc.at_risk,
                     container=container, support=support, co_objects=tuple(others))
-        words = realise(idea, kb, rng, perspective=False)
+        called = {m.name: m.called for m in (comp.fault, comp.other) if m is not None and m.called}
+        words = realise(idea, kb, rng, perspective=False, called=called)
         texts = Texts(words.name, words.explanation, line, words.solution, words.success_condition)
         proposal = to_proposal(idea, texts, index, kb, engine=Engine.KNOWLEDGE, mode=BrainstormMode.PLAIN, seed=self.seed)
+        if called:
+            proposal = proposal.model_copy(update={"scenario": proposal.scenario.model_copy(update={"called": called})})
         matches = self._record(line, parsed, comp, placement, placement_said, room, bool(rooms_said), target,
                                container, mentioned)
         return proposal.model_copy(update={"grounding": matches, "id": task_id(index, line), "source": USER_TEXT})
@@ -131,10 +135,11 @@ class TextGrounder:
                 container, mentioned) -> list[GroundingMatch]:
         hc = comp.hc
         out = [GroundingMatch(field="scenario.hazard_object", written=comp.fault.words, grounded=comp.fault.name,
-                              method="parsed")]
+                              method="lexicon" if comp.fault.called else "parsed", kind=comp.fault.kind)]
         if comp.other is not None:
             out.append(GroundingMatch(field=f"relation.{comp.other.relation}", written=f"{comp.other.prep} {comp.other.words}",
-                                      grounded=comp.other.name, method="parsed"))
+                                      grounded=comp.other.name, method="lexicon" if comp.other.called else "parsed",
+                                      kind=comp.other.kind))
         if comp.condition_words:
             out.append(GroundingMatch(field="state", written=", ".join(comp.condition_words),
                                       grounded=hc.composition.condition, method="parsed"))

@@ -13,9 +13,10 @@ import re
 from dataclasses import dataclass, field
 
 from anomalygen.knowledge.grounding import NameGrounder, singular
+from anomalygen.knowledge.lexicon import Lexicon
 from anomalygen.schema import part_labels
 
-_WORD = re.compile(r"[a-z0-9]+(?:'[a-z]+)?|[,.;:!?]")
+_WORD = re.compile(r"[a-z0-9]+_|[a-z0-9]+(?:'[a-z]+)?|[,.;:!?]")
 
 #: Preposition phrases (longest first) and the relation they put the next named object in.
 RELATIONS: tuple[tuple[str, str], ...] = (
@@ -46,6 +47,15 @@ STOP = frozenset({
     "by", "from", "under", "over", "beside", "against", "inside", "onto", "within", "up", "down", "out", "away",
     "all", "just", "right", "again", "unattended", "without", "after", "before", "when", "if", "lit", "plugged",
 })
+#: Words that open a line or a clause without naming anything: interjections, wh-words, sentence adverbs.
+NOT_NOUNS = frozenset({
+    "ugh", "oh", "oops", "hey", "wow", "argh", "yikes", "whoops", "um", "er", "hmm", "ah", "uh", "look", "honestly",
+    "seriously", "why", "how", "what", "who", "whose", "whom", "when", "where", "please", "again", "also", "yet",
+    "overnight", "along", "today", "tonight", "yesterday", "now", "then", "meanwhile", "apparently", "somehow",
+})
+#: Particles that, after a verb, say a state rather than a place ("left the heater on", "a plugged-in iron").
+PARTICLES = frozenset({"on", "in", "off", "open", "running", "up", "out", "down"})
+_PRONOUNS = frozenset({"it", "them", "all", "just", "right", "still"})
 #: Heads of noun phrases that are not objects at fault (places, people, time, generic words).
 NOT_OBJECTS = frozenset({
     "floor", "ground", "edge", "side", "corner", "middle", "top", "bottom", "front", "back", "reach", "height",
@@ -76,6 +86,8 @@ class Mention:
     words: str
     relation: str | None = None  # on / inside / near / under, from the preposition before it
     prep: str | None = None
+    called: str | None = None  # the user's word, when the name is a proxy shape of its kind (the lexicon)
+    kind: str | None = None  # the lexicon kind of ``called``
 
 
 @dataclass
@@ -88,12 +100,25 @@ class ParsedLine:
 
     @property
     def text(self) -> str:
-        return " " + " ".join(t for t in self.tokens if t.isalnum() or "'" in t) + " "
+        return " " + " ".join(t.rstrip("_") for t in self.tokens if t.rstrip("_").isalnum() or "'" in t) + " "
 
     def says(self, cue: str) -> bool:
-        """Does the line use the phrase (whole words, any case)?"""
-        words = " ".join(_WORD.findall(cue.lower()))
-        return bool(words) and f" {words} " in self.text
+        """Does the line use the phrase (whole words, any case)? A two-word verb and particle ("left on",
+        "switched off") is also said with its object between them ("left the heater on", up to four words)."""
+        words = _WORD.findall(cue.lower())
+        if not words:
+            return False
+        if f" {' '.join(words)} " in self.text:
+            return True
+        if len(words) == 2 and words[1] in PARTICLES and words[0] not in ("is", "are", "was", "were", "be"):
+            toks = self.text.split()
+            for i, t in enumerate(toks):
+                if t == words[0] and words[1] in toks[i + 2:i + 6]:
+                    j = toks.index(words[1], i + 2)
+                    if not any(w in STOP and w not in _PRONOUNS and w not in FILLER and w not in DETERMINERS
+                               for w in toks[i + 1:j]):
+                        return True
+        return False
 
     def said(self, cues) -> list[str]:
         return [c for c in cues if self.says(c)]
@@ -103,8 +128,40 @@ class ParsedLine:
         return [m for m in self.mentions if m.relation is None]
 
 
+_GLUED_PARTICLE = re.compile(r"\b([a-z]+(?:ed|en|ing))-(on|in|off|up|out)\b")
+
+
 def tokens_of(line: str) -> list[str]:
-    return _WORD.findall(line.lower().replace("’", "'"))
+    """Lower-case word tokens. A hyphenated participle and particle ("plugged-in", "switched-on") is
+    one state word: its particle is marked (``in_``) so it is never read as a preposition; ``text``
+    says it as two words again."""
+    text = _GLUED_PARTICLE.sub(r"\1 \2_", line.lower().replace("’", "'"))
+    return _uncontract(_WORD.findall(text))
+
+
+#: Words after "X's" that make it "X is" or "X has", not a possessive ("the oven's still on",
+#: "someone's left the tap running", "the gate's open"): states, particles, adverbs and participles.
+_AFTER_IS = frozenset({
+    "on", "off", "open", "still", "just", "not", "left", "been", "running", "lit", "up", "out", "hot", "full",
+    "empty", "gone", "got", "sitting", "lying", "standing", "burning", "boiling", "plugged", "switched", "turned",
+    "there", "here", "always", "now", "again", "wide", "ajar", "dropped", "put", "placed", "balanced", "propped",
+    "hanging", "leaning", "wedged", "perched", "stuck", "been", "spilling", "overflowing", "glowing", "unlocked",
+})
+
+
+def _uncontract(tokens: list[str]) -> list[str]:
+    out: list[str] = []
+    for i, t in enumerate(tokens):
+        nxt = tokens[i + 1] if i + 1 < len(tokens) else ""
+        if t.endswith("'s") and len(t) > 2 and nxt in _AFTER_IS:
+            out += [t[:-2], "is"]
+        elif t in ("there's", "here's", "that's", "it's", "what's", "where's", "why's", "how's"):
+            out += [t[:-2], "is"]
+        elif t.endswith(("'re", "'ve", "'ll", "'d")):
+            out.append(t.rsplit("'", 1)[0])
+        else:
+            out.append(t)
+    return out
 
 
 def relation_before(tokens: list[str], start: int) -> tuple[str | None, str | None]:
@@ -126,8 +183,10 @@ def _is_preposition_end(tokens: list[str], i: int) -> bool:
     return any(i - len(ph.split()) >= 0 and tokens[i - len(ph.split()):i] == ph.split() for ph, _ in RELATIONS)
 
 
-def parse_line(line: str, g: NameGrounder, *, longest: int = 4) -> ParsedLine:
-    """Mentions of catalogue objects (spelling and aliases), with relations; unknown noun phrases; rooms."""
+def parse_line(line: str, g: NameGrounder, *, longest: int = 4, lexicon: Lexicon | None = None,
+               buildable: set[str] | None = None) -> ParsedLine:
+    """Mentions of catalogue objects (spelling and aliases, then the household lexicon's words, each a
+    proxy shape of its kind under the user's word), with relations; unknown noun phrases; rooms."""
     tokens = tokens_of(line)
     words = [t.removesuffix("'s") for t in tokens]
     pool = set(g.kb.objects)
@@ -139,18 +198,43 @@ def parse_line(line: str, g: NameGrounder, *, longest: int = 4) -> ParsedLine:
                 continue
             phrase = " ".join(words[i:i + n])
             hit = g.objects.spelled(phrase, pool)
-            if hit is None:
+            if hit is not None:
+                found.append(Mention(i, i + n, hit[0], phrase))
+            elif lexicon is not None and (reading := lexicon.read(phrase, buildable)) is not None \
+                    and reading.proxy in pool:
+                found.append(Mention(i, i + n, reading.proxy, phrase, called=phrase, kind=reading.kind))
+            else:
                 continue
-            found.append(Mention(i, i + n, hit[0], phrase))
             taken[i:i + n] = [True] * n
     found.sort(key=lambda m: m.start)
     found = [_with_modifier(m, words, taken, g, pool) for m in found]
     found = _merge(found, words)
     for m in found:
         m.relation, m.prep = relation_before(words, m.start)
+    unknown = _unknown_phrases(words, taken, g)
+    if lexicon is not None and unknown:
+        found, unknown = _nearest_words(found, unknown, words, pool, buildable)
     parsed = ParsedLine(line, tokens, found, rooms=g.rooms.mentions(line))
-    parsed.unknown = _unknown_phrases(words, taken, g)
+    parsed.unknown = unknown
     return parsed
+
+
+def _nearest_words(found: list[Mention], unknown: list[tuple[int, str]], words: list[str], pool: set[str],
+                   buildable: set[str] | None) -> tuple[list[Mention], list[tuple[int, str]]]:
+    """Unknown noun phrases that are a lexicon word in other spelling or words ("tool box" for toolbox)
+    become mentions of its kind under the user's words (``knowledge.lexicon.nearest``)."""
+    from anomalygen.knowledge.lexicon import nearest
+
+    still: list[tuple[int, str]] = []
+    for at, phrase in unknown:
+        reading = nearest(phrase, buildable)
+        if reading is None or reading.proxy not in pool:
+            still.append((at, phrase))
+            continue
+        m = Mention(at, at + len(phrase.split()), reading.proxy, phrase, called=phrase, kind=reading.kind)
+        m.relation, m.prep = relation_before(words, m.start)
+        found.append(m)
+    return sorted(found, key=lambda m: m.start), still
 
 
 def gerund_compound(words: list[str], m: Mention, states: frozenset[str]) -> str | None:
@@ -188,6 +272,8 @@ def _merge(found: list[Mention], words: list[str]) -> list[Mention]:
         if prev is not None and m.name in PART_NAMES and m.start == prev.end:
             continue  # the fridge('s) door
         if prev is not None and m.start == prev.end:
+            if m.name in CONTAINER_WORDS and prev.name not in CONTAINER_WORDS:
+                continue  # 'a vitamin bottle', 'the bleach jug': the container of a thing is the thing
             out[-1] = m  # 'bread knife', 'glass vase': the last noun names the thing
             continue
         if prev is not None and prev.name in CONTAINER_WORDS and words[prev.end:prev.end + 1] == ["of"] \
@@ -202,6 +288,21 @@ def _merge(found: list[Mention], words: list[str]) -> list[Mention]:
                                                   and words[m.end:m.end + 1] == ["of"] and out[i + 1].start - m.end <= 3)]
 
 
+def word_classes(word: str) -> set[str]:
+    """The parts of speech a word can have (NOUN, VERB, ADJ, ADV, ...), from LemmInflect's lemma
+    tables (MIT; derived from the SPECIALIST Lexicon); empty for a word they do not hold."""
+    from lemminflect import getAllLemmas
+
+    return set(getAllLemmas(word))
+
+
+def _can_be_noun(word: str) -> bool:
+    """A word the tables hold only as another part of speech is no noun ('balanced', 'along'); a word
+    they do not hold ('worktop', 'paracetamol') may be one."""
+    classes = word_classes(word)
+    return not classes or "NOUN" in classes
+
+
 def _unknown_phrases(words: list[str], taken: list[bool], g: NameGrounder) -> list[tuple[int, str]]:
     """Noun phrases (after a determiner, or opening the line) that name no catalogue object."""
     out: list[tuple[int, str]] = []
@@ -210,9 +311,13 @@ def _unknown_phrases(words: list[str], taken: list[bool], g: NameGrounder) -> li
         chunk: list[int] = []
         i = s
         while i < len(words) and len(chunk) < 3 and words[i].isalnum() and words[i] not in STOP \
-                and words[i] not in DETERMINERS:
+                and words[i] not in DETERMINERS and words[i] not in NOT_NOUNS:
+            if chunk and words[chunk[-1]] in NOT_OBJECTS and word_classes(words[i]) & {"VERB"}:
+                break  # 'the toddler plays', 'where the kids play': a person and a verb, not a name
             chunk.append(i)
             i += 1
+        if chunk and not _can_be_noun(words[chunk[-1]]):
+            continue  # 'someone balanced', 'uncooked': no noun ends the phrase
         if not chunk or any(taken[k] for k in chunk):
             continue
         head = singular(words[chunk[-1]])

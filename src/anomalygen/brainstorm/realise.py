@@ -153,17 +153,17 @@ def _join(items: list[str], rng: np.random.Generator | None = None) -> str:
     return ", ".join(items[:-1]) + last + items[-1]
 
 
-def fix_phrase(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, part: str) -> str:
+def fix_phrase(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, part: str, say=nice) -> str:
     """The class's recipe in varied words, e.g. 'lift the pill and tuck it away in the medicine cabinet'."""
     hc = kb.hazard_classes[idea.class_id]
     names = {
-        "object": nice(idea.hazard),
+        "object": say(idea.hazard),
         "container": (
-            _pick(rng, ["", "", "nearby ", "closest ", "usual ", "proper ", "right "]) + nice(idea.container)
+            _pick(rng, ["", "", "nearby ", "closest ", "usual ", "proper ", "right "]) + say(idea.container)
         )
         if idea.container
         else "a safe place",
-        "support": nice(idea.support) if idea.support else "a raised surface",
+        "support": say(idea.support) if idea.support else "a raised surface",
     }
     pieces = []
     for step in hc.recipe:
@@ -242,7 +242,8 @@ def _name(slots: dict[str, str], frames: list[str], rng: np.random.Generator) ->
     return cap(f"{slots['Verb']} the {slots['obj']}")
 
 
-def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspective: bool = True) -> Texts:
+def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspective: bool = True,
+            called: dict[str, str] | None = None) -> Texts:
     """Words for an idea. ``perspective`` adds the agent's point of view (role-play modes).
 
     Every slot (opening, how the object/place/person are said, the harm, the role's concern, the fix
@@ -251,10 +252,14 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     """
     b = bank()
     hc = kb.hazard_classes[idea.class_id]
+
+    def say(name: str) -> str:  # an object the user called otherwise is said in the user's words
+        return (called or {}).get(name) or nice(name)
+
     room = _choice(rng, b["room_synonyms"].get(idea.room, [room_words(idea.room)]))
-    hazard = nice(idea.hazard)
-    container = nice(idea.container) if idea.container else "a safe place"
-    support = nice(idea.support) if idea.support else "a raised surface"
+    hazard = say(idea.hazard)
+    container = say(idea.container) if idea.container else "a safe place"
+    support = say(idea.support) if idea.support else "a raised surface"
     articulated = hc.articulation is not None and hc.about_target
     part = (kb.articulation_part(hc, idea.hazard) or DOOR) if articulated else ""
     state = hc.articulation.initial_state if hc.articulation else ""
@@ -271,9 +276,9 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     verbs = _VERBS.get(hc.id) or _ACTION_VERBS.get(hc.recipe[-1].action) or ["Fix"]
     verb = _choice(rng, verbs)
     risk = _choice(rng, class_bank(b, "risk_word", hc))
-    pshort = "" if articulated else place_phrase_bank(idea.placement, room, rng, fragment=_place_fragment(hc))
+    pshort = "" if articulated else place_phrase_bank(idea.placement, room, rng, fragment=_place_fragment(hc), say=say)
     beside = idea.placement.other  # already said by the place
-    co_names = [nice(c) for c in idea.co_objects if c not in (idea.hazard, idea.container, beside)]
+    co_names = [say(c) for c in idea.co_objects if c not in (idea.hazard, idea.container, beside)]
     if "co_objects" not in idea.borrowed and len(co_names) > 1:
         # background clutter is detail: name one piece, unless borrowing the setting is the idea's point
         co_names = [co_names[int(rng.integers(len(co_names)))]]
@@ -335,7 +340,7 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
         harm = re.sub(r"\{person\}'s (\w+)", r"the \1 of {person}", harm)
     harm = harm.format(person=person, obj=hazard)
     lead = _choice(rng, b["fix_lead"]) + " " if rng.random() < FIX_LEAD_P else ""
-    fix = f"{lead}{fix_phrase(idea, kb, rng, part)}."
+    fix = f"{lead}{fix_phrase(idea, kb, rng, part, say)}."
     opening = _choice(rng, b["opening"])
     role_sentence = ""
     if perspective and idea.agent and idea.agent in kb.roles and rng.random() < 0.75:
@@ -400,7 +405,8 @@ def _place_fragment(hc) -> str | None:
     return hc.composition.place if hc.composition is not None and not hc.composition.legacy else None
 
 
-def place_phrase_bank(placement: Placement, room: str, rng: np.random.Generator, *, fragment: str | None = None) -> str:
+def place_phrase_bank(placement: Placement, room: str, rng: np.random.Generator, *, fragment: str | None = None,
+                      say=nice) -> str:
     """Where the object is, from the phrase bank (containers/supports name the catalogue object); a
     composed class's place may have words of its own (a heavy pan 'on the top shelf', not any shelf)."""
     own = bank().get("place_by_fragment", {}).get(fragment or "")
@@ -408,7 +414,7 @@ def place_phrase_bank(placement: Placement, room: str, rng: np.random.Generator,
         return _choice(rng, own).format(room=room)
     holder = _HOLDER_PLACES.get(placement.relation) if placement.other is not None else None
     if holder:
-        return _choice(rng, holder).format(x=nice(placement.other))
+        return _choice(rng, holder).format(x=say(placement.other))
     options = bank()["place"].get(placement.key, ["in the {room}"])  # phrasing.json's "place", by compact word
     if room != "kitchen":  # sinks, hobs and kettles only stand in kitchens
         options = [o for o in options if not any(w in o for w in _KITCHEN_ONLY)] or options

@@ -84,7 +84,8 @@ def observation_text(graph: SceneGraph) -> str:
     for obj in graph.objects:
         props = f" [{', '.join(obj.properties)}]" if obj.properties else ""
         dims = "x".join(f"{v:.2f}" for v in obj.size)
-        lines.append(f"- {obj.name} ({obj.category}{props}), size {dims} m: " + "; ".join(object_facts(obj)))
+        kind = f"{obj.called}: {obj.category}" if obj.called else obj.category  # "oven cleaner: cleaning_spray"
+        lines.append(f"- {obj.name} ({kind}{props}), size {dims} m: " + "; ".join(object_facts(obj)))
     rels = [relation_phrase(r) for r in graph.relations if r.predicate != "on_floor"]
     if rels:
         lines.append("Relations:")

@@ -88,8 +88,23 @@ def _plan(task: TaskProposal, settings: Settings, rng, hints=None,
     set_initial_joints(sel)
     lay, placed, support = place(sel, settings)
     arrange_states(sel, lay, placed)
+    _name_as_called(task, sel, placed)
     placed, bindings = renumber_by_position(lay, placed, {} if hazard_free else bind_roles(sel, support))
     return lay, bindings, placed
+
+
+def _name_as_called(task: TaskProposal, sel, placed: dict[str, Placed]) -> None:
+    """The instance chosen for a catalogue name the user called otherwise keeps the user's name: an
+    "oven cleaner" built from the cleaning spray's shape is shown, perceived and reported as oven
+    cleaner. A name the scene does not hold fails the item rather than being dropped."""
+    from anomalygen.errors import ItemFailed
+    from anomalygen.scene.asset_choice import resolve_name
+
+    for name, words in task.scenario.called.items():
+        ch = sel.by_catalogue.get(resolve_name(name))
+        if ch is None or ch.name not in placed:
+            raise ItemFailed(f"the task calls {name} '{words}', but the scene holds no {name}")
+        placed[ch.name].called = words
 
 
 # ============================================================================ attempt
@@ -196,6 +211,7 @@ def _scene_spec(task, seed, lay: Layout, placed: dict[str, Placed], bindings, mo
                 fixed=p.fixed,
                 states=_states(ref.category, p.states),
                 cavities=cavities,
+                called=p.called,
             )
         )
     return SceneSpec(

@@ -64,6 +64,7 @@ class Placed:
     # stand in it, and it does not push the base back from the front
     swing: float = 0.0
     intent: object = None  # what the judgement mix meant it to be (a truth.manifest.Intent), for truth.json
+    called: str | None = None  # the user's name for it when its shape is a proxy of its kind (Scenario.called)
 
     def world_half(self) -> np.ndarray:
         c, s = abs(math.cos(self.yaw)), abs(math.sin(self.yaw))

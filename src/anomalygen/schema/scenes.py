@@ -123,6 +123,10 @@ class PlacedObject(Artefact):
     cavities: list[PlacedCavity] | None = Field(
         None, description="declared interiors ([]: nothing can be inside it; None: a scene built before they were recorded)"
     )
+    called: str | None = Field(
+        None, description="what the object is, in the user's words, when its shape is a proxy of its kind "
+        "(a bottle of 'oven cleaner' built from the cleaning spray's shape); None: its category says what it is",
+    )
 
 
 class ValidationCheck(Strict):
@@ -207,6 +211,7 @@ class GraphObject(Strict):
 
     name: str
     category: str
+    called: str | None = Field(None, description="what it is called, as its label reads, when its category is a proxy shape")
     properties: list[str] = Field(default_factory=list, description="sharp, choking_size, toxic, medication, ...")
     position: Vec3
     size: Vec3 = Field(description="axis-aligned extents in metres")

@@ -57,6 +57,11 @@ class Scenario(Strict):
         default_factory=dict,
         description="instance states the scene must show, by catalogue name: {'Sink': ['contains_water'], 'candle': ['lit']}",
     )
+    called: dict[str, str] = Field(
+        default_factory=dict,
+        description="the user's own name for an object built as a proxy shape of its kind, by catalogue name: "
+        "{'cleaning_spray': 'oven cleaner'}; the scene shows it under that name",
+    )
 
 
 class GroundingMatch(Strict):
@@ -73,10 +78,12 @@ class GroundingMatch(Strict):
     written: str
     grounded: str | None = Field(None, description="the knowledge-base name; None when the name was dropped")
     method: Literal[
-        "exact", "normalised", "alias", "retrieval", "class_default", "other", "dropped", "parsed", "composed", "refused"
+        "exact", "normalised", "alias", "retrieval", "class_default", "other", "dropped", "parsed", "composed", "refused",
+        "lexicon",
     ]
     similarity: float = 1.0
     alternatives: list[str] = Field(default_factory=list, description="the next retrieval candidates, best first")
+    kind: str | None = Field(None, description="the household lexicon's kind, when the name was read as a proxy of its kind")
 
 
 class TaskProposal(Artefact):

@@ -358,6 +358,7 @@ def scene_graph(model: mujoco.MjModel, data: mujoco.MjData, spec: SceneSpec) -> 
             GraphObject(
                 name=obj.name,
                 category=obj.asset.category,
+                called=obj.called,
                 properties=props[i],
                 position=[float(v) for v in center[i]],
                 size=[float(v) for v in (hi[i] - lo[i])],
