@@ -47,7 +47,7 @@ def test_a_category_word_is_composed_from_the_text_or_goes_back_to_the_model(scr
 def test_none_reads_as_empty_and_a_look_alike_object_is_not_taken(scripted_server, tmp_path):
     empty = {**BASE, "name": "Pills with no box", "container": "none", "co_objects": ["none", "book"],
              "description": "A pill bottle was left on the low coffee table."}
-    sofa = {**BASE, "name": "Sofa thing", "hazard_object": "sofa", "hazard_class": "reduce_tripping_hazards",
+    sofa = {**BASE, "name": "Sofa thing", "hazard_object": "chandelier", "hazard_class": "reduce_tripping_hazards",
             "category": "household_hazard", "placement": "walkway"}
     srv = scripted_server(lambda body: text(reply_json(empty if "idea 1 of 2" in body["messages"][1]["content"] else sofa)))
     engine = _engine(srv, tmp_path, repair_retries=0)
@@ -56,7 +56,25 @@ def test_none_reads_as_empty_and_a_look_alike_object_is_not_taken(scripted_serve
     assert task.scenario.co_objects == ["book"]
     assert any(m.written == "none" and m.method == "dropped" for m in task.grounding)
     [error] = engine.errors.values()
-    assert "'sofa' matches no catalogue name well enough" in error
+    assert "'chandelier' matches no catalogue name well enough" in error
+
+
+def test_a_lexicon_word_is_built_as_its_kind_under_the_models_word(scripted_server, tmp_path):
+    """The model may name a thing the catalogue lacks by its own word: a word of the household lexicon is
+    grounded to its kind's proxy shape and keeps the word (``Scenario.called``), as the offline reader does;
+    the grounding says so (method "lexicon", its kind)."""
+    from anomalygen.knowledge.lexicon import load_lexicon
+
+    reply = {**BASE, "name": "Cleaner out", "hazard_object": "oven cleaner", "hazard_class": "secure_chemicals",
+             "container": "StorageFurniture", "description": "The oven cleaner was left on the low coffee table."}
+    srv = scripted_server(lambda body: text(reply_json(reply)))
+    engine = _engine(srv, tmp_path, repair_retries=0)
+    [task] = engine.from_texts(["The oven cleaner was left on the low coffee table."])
+    reading = load_lexicon().read("oven cleaner")
+    assert task.scenario.hazard_object == reading.proxy
+    assert task.scenario.called == {reading.proxy: "oven cleaner"}
+    fault = next(m for m in task.grounding if m.field == "scenario.hazard_object")
+    assert (fault.method, fault.kind) == ("lexicon", reading.kind)
 
 
 def test_a_catalogue_object_written_as_target_stays_itself(scripted_server, tmp_path):

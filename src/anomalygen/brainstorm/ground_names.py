@@ -39,6 +39,7 @@ class GroundedNames:
     matches: list[GroundingMatch] = field(default_factory=list)
     problems: list[str] = field(default_factory=list)
     new_class: object | None = None  # a HazardClass the model proposed, validated
+    called: dict[str, str] = field(default_factory=dict)  # catalogue name -> the model's word, for lexicon proxies
 
 
 def _closest(m: GroundingMatch) -> str:
@@ -74,7 +75,8 @@ def ground_llm_names(raw: LLMProposal, g: NameGrounder, *, reader=None) -> Groun
         return m.grounded
 
     category = getattr(raw.category, "value", raw.category)
-    hazard = keep(g.object(raw.hazard_object, "scenario.hazard_object"))
+    hazard_match = g.object(raw.hazard_object, "scenario.hazard_object", lexicon=True)
+    hazard = keep(hazard_match)
     spelled_target = g.objects.spelled(raw.target_asset, set(kb.objects))
     target = None
     if spelled_target is not None and spelled_target[0] not in kb.targets:
@@ -113,8 +115,9 @@ def ground_llm_names(raw: LLMProposal, g: NameGrounder, *, reader=None) -> Groun
         name = keep(g.object(c, "scenario.co_objects"))
         if name not in co_objects:
             co_objects.append(name)
+    called = {hazard: raw.hazard_object.strip()} if hazard_match.method == "lexicon" else {}
     return GroundedNames(cls, hazard_other, target, hazard, room, placement, container, co_objects, matches, problems,
-                         new_class)
+                         new_class, called)
 
 
 def _hazard_class(raw: LLMProposal, g: NameGrounder, hazard: str, category: str, matches: list, problems: list,

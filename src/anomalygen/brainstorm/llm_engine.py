@@ -307,6 +307,8 @@ class LLMEngine:
             )
         except ValidationError as exc:
             return None, [format_validation_error(exc)]
+        if g.called:  # a word of the lexicon: built as its kind's proxy shape, under the model's word
+            proposal = proposal.model_copy(update={"scenario": proposal.scenario.model_copy(update={"called": g.called})})
         unresolved = {m.written for m in g.matches if m.grounded is None and m.method != "dropped"}
         rest = [p for p in proposal_problems(proposal, kb) if not any(f"'{w}'" in p for w in unresolved)]
         return proposal, g.problems + rest
