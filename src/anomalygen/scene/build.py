@@ -147,6 +147,8 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
 
         spec = spec.model_copy(update={"bindings": bind_others(hc, graph, spec.bindings)})
     report = val.validate(model, data, spec, graph, None if hazard_free else hc)
+    if task.source == "user_text" and not hazard_free and report.ok:
+        report = val.with_stated_checks(report, task, spec, graph)
     if hazard_free and report.ok:
         report = check_hazard_free(report, graph, task.hazard_class)
     report.checks = notes + report.checks

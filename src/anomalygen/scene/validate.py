@@ -146,3 +146,61 @@ def validate(model, data, spec: SceneSpec, graph, hc) -> ValidationReport:
             + (f" ({c.value:.4g} > {c.limit:.4g})" if c.value is not None and c.limit is not None else "")
         )
     return ValidationReport(ok=not failed, checks=checks, reason=reason)
+
+
+#: Edge placements ("at the edge of the counter") hold within this distance of the edge (m): the
+#: near_edge predicate's own default, so a line's edge is the mechanisms' edge.
+STATED_EDGE = 0.1
+
+
+def stated_checks(task, spec: SceneSpec, graph) -> list[ValidationCheck]:
+    """What a user's line said, checked in the settled scene: the object at fault is where the line put
+    it (in, on, near another object; on a support kind; at its edge), and every state the line gave an
+    object shows (a sink full of water, a burner lit). A line is built as stated or not at all."""
+    from anomalygen.scene.asset_choice import resolve_name
+
+    checks: list[ValidationCheck] = []
+    hazard = spec.bindings.get("$hazard")
+    by_category: dict[str, list[str]] = {}
+    for o in spec.objects:
+        by_category.setdefault(o.asset.category, []).append(o.name)
+    bound = set(spec.bindings.values())
+
+    def instance(catalogue: str) -> str | None:
+        names = by_category.get(resolve_name(catalogue), [])
+        return next((n for n in names if n in bound), names[0] if names else None)
+
+    rel = {(r.subject, r.predicate, r.object) for r in graph.relations}
+    p = task.scenario.placement
+    if hazard is not None and p.other is not None:
+        other = instance(p.other)
+        ok = other is not None and (
+            (hazard, p.relation, other) in rel
+            or (p.relation == "near" and ((other, "near", hazard) in rel))
+            or (p.relation == "on" and (hazard, "inside", other) in rel)  # on a stove's burner is in its top
+        )
+        checks.append(ValidationCheck(name=f"stated:{p.relation} {p.other}", passed=ok,
+                                      detail=f"{hazard} {p.relation} {other}" if ok else
+                                      f"the line puts {hazard} {p.relation} {p.other}, the scene does not"))
+    elif hazard is not None and p.relation == "at_edge":
+        d = graph.get(hazard).distance_to_edge
+        ok = d is not None and d <= STATED_EDGE
+        checks.append(ValidationCheck(name="stated:at the edge", passed=ok, value=d, limit=STATED_EDGE,
+                                      detail=f"{hazard} is {'not on a raised surface' if d is None else f'{d:.2f} m from the edge'}"))
+    for name, states in task.scenario.states.items():
+        inst = instance(name)
+        shown = set(graph.get(inst).states) if inst is not None else set()
+        for state in states:
+            ok = state in shown
+            checks.append(ValidationCheck(name=f"stated:{name} {state}", passed=ok,
+                                          detail=f"{inst} shows {', '.join(sorted(shown)) or 'no state'}"))
+    return checks
+
+
+def with_stated_checks(report: ValidationReport, task, spec: SceneSpec, graph) -> ValidationReport:
+    """``report`` with ``stated_checks`` added; the first that fails fails the build, naming what the
+    scene could not show."""
+    checks = stated_checks(task, spec, graph)
+    failed = next((c for c in checks if not c.passed), None)
+    return ValidationReport(ok=failed is None, checks=report.checks + checks,
+                            reason=f"{failed.name} failed: {failed.detail}" if failed else report.reason)
