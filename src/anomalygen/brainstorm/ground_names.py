@@ -56,6 +56,21 @@ def is_empty(value: str | None) -> bool:
     return value is None or normalise(str(value)) in EMPTY_WORDS
 
 
+def _object_or_lexicon(g: NameGrounder, written: str, where: str) -> GroundingMatch:
+    """The catalogue name for ``written`` by spelling and aliases; else a word of the household lexicon
+    as a proxy shape of its kind (``method="lexicon"``, its ``kind`` recorded: the caller keeps the
+    written word as the object's name); else Sentence-BERT retrieval."""
+    from anomalygen.knowledge.lexicon import load_lexicon
+
+    pool = set(g.objects.names)
+    if g.objects.spelled(written, pool) is None:
+        reading = load_lexicon().read(written)
+        if reading is not None and reading.proxy in pool:
+            return GroundingMatch(field=where, written=written, grounded=reading.proxy, method="lexicon",
+                                  kind=reading.kind)
+    return g.object(written, where)
+
+
 def ground_llm_names(raw: LLMProposal, g: NameGrounder, *, reader=None) -> GroundedNames:
     """Every name of ``raw`` grounded; unresolved ones keep their written form and add a problem.
 
@@ -75,7 +90,7 @@ def ground_llm_names(raw: LLMProposal, g: NameGrounder, *, reader=None) -> Groun
         return m.grounded
 
     category = getattr(raw.category, "value", raw.category)
-    hazard_match = g.object(raw.hazard_object, "scenario.hazard_object", lexicon=True)
+    hazard_match = _object_or_lexicon(g, raw.hazard_object, "scenario.hazard_object")
     hazard = keep(hazard_match)
     spelled_target = g.objects.spelled(raw.target_asset, set(kb.objects))
     target = None

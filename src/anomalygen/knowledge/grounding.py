@@ -217,19 +217,7 @@ class NameGrounder:
             class_threshold,
         )
 
-    def object(self, written: str, where: str, *, among: Sequence[str] | None = None, query: str | None = None,
-               lexicon: bool = False) -> GroundingMatch:
-        """The catalogue name for ``written``: spelling and aliases; then, with ``lexicon``, a word of the
-        household lexicon as a proxy shape of its kind (``method="lexicon"``, its ``kind`` recorded: the
-        caller keeps the written word as the object's name); then Sentence-BERT retrieval."""
-        pool = set(self.objects.names) if among is None else set(among)
-        if lexicon and self.objects.spelled(written, pool) is None:
-            from anomalygen.knowledge.lexicon import load_lexicon
-
-            reading = load_lexicon().read(written)
-            if reading is not None and reading.proxy in pool:
-                return GroundingMatch(field=where, written=written, grounded=reading.proxy, method="lexicon",
-                                      kind=reading.kind)
+    def object(self, written: str, where: str, *, among: Sequence[str] | None = None, query: str | None = None) -> GroundingMatch:
         return self.objects.ground(written, where, among=among, query=query)
 
     def instances(self, objects: Sequence[tuple[str, str]]) -> Vocabulary:
