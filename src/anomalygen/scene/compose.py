@@ -192,9 +192,7 @@ def latch_switched_on(model, placed: dict[str, Placed], mjspec) -> None:
             sj = mjspec.joint(f"{p.name}/{j.name}")
             sj.stiffness = [0.0] * len(sj.stiffness) if hasattr(sj.stiffness, "__len__") else 0.0
             sj.frictionloss = float(model.dof_frictionloss[dof])
-            body = int(model.jnt_bodyid[jid])
-            model.body_gravcomp[body] = 1.0
-            mjspec.body(model.body(body).name).gravcomp = 1.0
+            _compensate_weight(model, mjspec, int(model.jnt_bodyid[jid]))
 
 
 def _hold_switch_set_on(model, mjspec, p: Placed, j, jid: int) -> None:
@@ -205,7 +203,11 @@ def _hold_switch_set_on(model, mjspec, p: Placed, j, jid: int) -> None:
     Turned off, it rests on its limit as before; only on/off controls are held, never doors or lids."""
     if j.type != "hinge" or not part_labels.is_switch(j.label):
         return
-    body = int(model.jnt_bodyid[jid])
+    _compensate_weight(model, mjspec, int(model.jnt_bodyid[jid]))
+
+
+def _compensate_weight(model, mjspec, body: int) -> None:
+    """Gravity compensation on one body, in the compiled model and in the spec it is saved from."""
     model.body_gravcomp[body] = 1.0
     mjspec.body(model.body(body).name).gravcomp = 1.0
 
