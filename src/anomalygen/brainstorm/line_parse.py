@@ -145,7 +145,7 @@ _AFTER_IS = frozenset({
     "on", "off", "open", "still", "just", "not", "left", "been", "running", "lit", "up", "out", "hot", "full",
     "empty", "gone", "got", "sitting", "lying", "standing", "burning", "boiling", "plugged", "switched", "turned",
     "there", "here", "always", "now", "again", "wide", "ajar", "dropped", "put", "placed", "balanced", "propped",
-    "hanging", "leaning", "wedged", "perched", "stuck", "been", "spilling", "overflowing", "glowing", "unlocked",
+    "hanging", "leaning", "wedged", "perched", "stuck", "spilling", "overflowing", "glowing", "unlocked",
 })
 
 

@@ -13,10 +13,10 @@ import numpy as np
 
 from anomalygen.mjgeom import FLOOR_GEOM
 from anomalygen.robot.agent import Agent
-from anomalygen.schema import part_labels
 from anomalygen.scene import furniture, viewpoint, walls
 from anomalygen.scene.layout import Layout, Placed
 from anomalygen.scene.viewpoint import CAMERA_FOVY, FRAME_TOP
+from anomalygen.schema import part_labels
 from anomalygen.world.room import ROOM_CENTER
 from anomalygen.world.sensors import add_observation_sensors
 from anomalygen.world.states import geoms_below, show_states
