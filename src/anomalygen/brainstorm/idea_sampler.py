@@ -15,12 +15,16 @@ from typing import TypeVar
 
 import numpy as np
 
+from anomalygen.brainstorm.describe import people_for, person_fits
 from anomalygen.brainstorm.idea import Idea
 from anomalygen.knowledge import HazardClass, KnowledgeBase, RoleProfile
+from anomalygen.knowledge.households import load_households
 from anomalygen.schema import Placement
 
 #: Weight ratio between successive options of a typicality-ordered list for the role-less generator.
 TYPICAL_DECAY = 0.35
+#: Draws a fresh idea may take before giving up: a draw is retried when no room holds its fixtures.
+FRESH_TRIES = 200
 T = TypeVar("T")
 
 
@@ -70,6 +74,16 @@ def classes_for_target(kb: KnowledgeBase, target: str) -> list[HazardClass]:
 
 def usable_targets(kb: KnowledgeBase) -> list[str]:
     return [t for t in kb.targets if classes_for_target(kb, t)]
+
+
+def _scene_of(room: str, placement: Placement, names) -> dict:
+    """What ``person_fits`` looks at: the room, the placement's support and other object, the names."""
+    return {"room": room, "support": placement.support, "other": placement.other,
+            "names": [*names, placement.other]}
+
+
+def idea_scene(idea: Idea) -> dict:
+    return _scene_of(idea.room, idea.placement, [idea.hazard, idea.container, idea.support, *idea.co_objects])
 
 
 def secondary_variables(hc: HazardClass) -> list[str]:
@@ -140,9 +154,13 @@ class IdeaSampler:
         return self.kb.hazard_classes[chosen]
 
     def fresh(self, rng: np.random.Generator, *, agent: str | None, agent_index: int, round_: int) -> Idea:
-        target = self.pick_target(rng)
-        hc = self.pick_class(rng, target)
-        return self.idea_for(rng, hc, target, agent=agent, agent_index=agent_index, round_=round_)
+        for _ in range(FRESH_TRIES):
+            target = self.pick_target(rng)
+            hc = self.pick_class(rng, target)
+            idea = self.idea_for(rng, hc, target, agent=agent, agent_index=agent_index, round_=round_)
+            if idea is not None:
+                return idea
+        raise RuntimeError(f"no plausible home for any of {FRESH_TRIES} draws: check data/knowledge/households.json")
 
     def idea_for(
         self,
@@ -154,7 +172,7 @@ class IdeaSampler:
         agent_index: int,
         round_: int,
         avoid_hazard: str | None = None,
-    ) -> Idea:
+    ) -> Idea | None:
         from anomalygen.brainstorm.drawable import (
             containers_for,
             harmless_first,
@@ -178,23 +196,45 @@ class IdeaSampler:
         placements = placements_for(kb, hc, hazard)
         parents = harmless_first(kb, [p.other for p in placements if p.other is not None])
         placements = [p for p in placements if p.other is None or p.other in parents]
-        placement = weighted(rng, placements, self._w("placement", placements))
-        rooms = [r for r in hc.rooms if r in kb.objects[hazard].rooms] or list(hc.rooms)
-        room = weighted(rng, rooms, self._w("room", rooms))
         # the fix the text promises must end the hazard, and the hazard must fit in
         containers = containers_for(kb, hc, hazard) if hc.default_containers else kb.safe_containers_for(hc, hazard)
+        related = relation_variable(hc)
+        secondary = {var: harmless_first(kb, self.kb.static_candidates(hc, var))
+                     for var in secondary_variables(hc) if not (var == related)}
+        # a plausible home: every fixture the idea names belongs in its room (data/knowledge/households.json)
+        homes = load_households()
+        usual = [r for r in hc.rooms if r in (homes.rooms_of(hazard) or kb.objects[hazard].rooms)] or list(hc.rooms)
+
+        def rooms_with(p: Placement) -> list[str]:
+            rooms = homes.rooms_for([hazard, p.support, p.other], usual)
+            if hc.default_supports:
+                rooms = [r for r in rooms if any(homes.belongs(b, r) for b in hc.default_supports)]
+            if containers:
+                rooms = [r for r in rooms if any(homes.belongs(c, r) for c in containers)]
+            return [r for r in rooms if all(any(homes.belongs(c, r) for c in opts) for opts in secondary.values() if opts)]
+
+        placements = [p for p in placements if rooms_with(p)]
+        if not placements:  # no room holds every fixture this hazard needs: not a home anyone lives in
+            return None
+        placement = weighted(rng, placements, self._w("placement", placements))
+        rooms = rooms_with(placement)
+        room = weighted(rng, rooms, self._w("room", rooms))
+        containers = [c for c in containers if homes.belongs(c, room)]
         container = (target if target in containers else weighted(rng, containers)) if containers else None
         support = None
         if hc.default_supports:
-            support = target if target in hc.default_supports else weighted(rng, list(hc.default_supports))
-        person = hc.people[int(rng.integers(len(hc.people)))] if (self.rich and hc.people) else hc.at_risk
+            supports = [b for b in hc.default_supports if homes.belongs(b, room)]
+            support = target if target in supports else weighted(rng, supports)
         co: list[str] = []
-        related = relation_variable(hc)
         for var in secondary_variables(hc):
             if var == related and placement.other is not None:  # the burner the towel is on: the placement's object
                 co.append(placement.other)
             else:
-                co.append(weighted(rng, harmless_first(kb, self.kb.static_candidates(hc, var))))
+                options = secondary.get(var) or harmless_first(kb, self.kb.static_candidates(hc, var))
+                co.append(weighted(rng, [c for c in options if homes.belongs(c, room)] or options))
+        # the person at risk fits the scene: the cook in a kitchen, a child in the bath beside a bathtub
+        people = people_for(hc, _scene_of(room, placement, [hazard, container, support, *co]))
+        person = people[int(rng.integers(len(people)))] if (self.rich and people) else hc.at_risk
         if self.rich:
             fitting = [b for b in self.benign if room in kb.objects[b].rooms and b not in co]
             for _ in range(int(rng.integers(0, 3))):
@@ -273,12 +313,15 @@ class IdeaSampler:
             targets = [t for t in class_targets(kb, hc) if t in self.targets] or class_targets(kb, hc)
             target = weighted(rng, targets, self._w("object", targets))
             idea = self.idea_for(rng, hc, target, agent=agent, agent_index=agent_index, round_=round_, avoid_hazard=mech.hazard)
+            if idea is None:
+                return None
         else:
             idea = self.fresh(rng, agent=agent, agent_index=agent_index, round_=round_)
         hc = kb.hazard_classes[idea.class_id]
         for _, aspect, src in plan:
             if aspect == "location":
-                rooms_ok = src.room in hc.rooms or src.room in kb.objects[idea.hazard].rooms
+                rooms_ok = (src.room in hc.rooms or src.room in kb.objects[idea.hazard].rooms) and not load_households().misplaced(
+                    replace(idea, room=src.room))
                 place_ok = src.placement in placements_for(kb, hc, idea.hazard) and not relation_variable(hc)
                 if not (rooms_ok or place_ok):
                     return None
@@ -292,6 +335,10 @@ class IdeaSampler:
                 if src.person not in hc.people:
                     return None
                 idea = replace(idea, person=src.person)
+        if load_households().misplaced(idea):  # a borrowed place or room that this idea's fixtures do not fit
+            return None
+        if idea.person in hc.people and not person_fits(idea.person, **idea_scene(idea)):
+            return None  # a borrowed room where this person makes no sense (the cook in a bedroom)
         return replace(
             idea,
             builds_on=tuple(dict.fromkeys(sid for sid, _, _ in plan)),
