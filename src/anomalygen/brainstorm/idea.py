@@ -48,9 +48,10 @@ class Idea:
     borrowed: tuple[str, ...] = ()
 
     def key(self) -> tuple:
-        """What makes two ideas the same scenario (texts aside). The person at risk counts: an open
-        fridge matters differently to a parent storing baby milk than to a teenager."""
-        return (self.class_id, self.hazard, self.placement, self.room, self.person)
+        """What makes two ideas the same scenario (texts aside): the mechanism, the object at fault, its
+        place and the room. The person at risk does not: the same open fridge told for a teenager
+        rather than a parent is the same scene for the robot, and a benchmark would count it twice."""
+        return (self.class_id, self.hazard, self.placement, self.room)
 
 
 @dataclass

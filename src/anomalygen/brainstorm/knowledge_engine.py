@@ -26,6 +26,11 @@ from anomalygen.knowledge import KnowledgeBase, load_kb
 from anomalygen.rng import item_rng
 from anomalygen.schema import BrainstormMode, Engine, Placement, TaskProposal
 
+#: The most of a brainstorm's tasks one room may hold; kitchens otherwise take nearly half (issue 39).
+ROOM_SHARE = 0.30
+#: Below this many tasks a room cap would only starve small draws (a 3-task demo may be all kitchen).
+MIN_N_FOR_ROOM_CAP = 20
+
 EmbedFn = Callable[[list[str]], np.ndarray]
 
 
@@ -97,9 +102,15 @@ class KnowledgeEngine:
         self.accepted: list[Accepted] = []
         self.rejected_near_duplicates = 0
         self.rejected_same_scenario = 0
+        self.rejected_room_full = 0
+        self.room_cap: int | None = None
+        #: set once every composed scene is taken: then a scene may recur for another person at risk
+        self.told_apart = False
 
     # ------------------------------------------------------------------ public
     def run(self, n: int) -> list[TaskProposal]:
+        # no room holds more than ROOM_SHARE of the tasks (issue 39): a kitchen-heavy draw is redrawn
+        self.room_cap = max(1, int(ROOM_SHARE * n)) if self.mode == BrainstormMode.BRAINSTORM and n >= MIN_N_FOR_ROOM_CAP else None
         quotas = split_quota(n, self.rounds)
         carry = 0
         r = 0
@@ -115,7 +126,20 @@ class KnowledgeEngine:
             carry = want - got
             if r >= self.rounds and carry <= 0:
                 break
+        if self.unique and len(self.accepted) < n and not self.told_apart:
+            # every scene the knowledge base composes is taken: the rest may repeat a scene for another
+            # person at risk, as the old key allowed, rather than return fewer tasks than asked
+            self.told_apart = True
+            for _extra in range(self.max_extra_rounds + 1):
+                previous = [a for a in self.accepted if a.idea.round == r]
+                r += 1
+                self._round(r, n - len(self.accepted), previous)
+                if len(self.accepted) >= n:
+                    break
         return [self._proposal(a) for a in self.accepted]
+
+    def _key(self, idea: Idea) -> tuple:
+        return (*idea.key(), idea.person) if self.told_apart else idea.key()
 
     # ------------------------------------------------------------------ rounds
     def _round(self, r: int, want: int, previous: list[Accepted]) -> int:
@@ -170,17 +194,17 @@ class KnowledgeEngine:
         """
         if not self.unique:
             return drafts
-        keys = {a.idea.key() for a in self.accepted}
+        keys = {self._key(a.idea) for a in self.accepted}
         names = {a.texts.name.lower() for a in self.accepted}
         kept: list[tuple[int, Idea, Texts]] = []
         per_agent: dict[int, int] = {}
         for i, idea, texts in drafts:
-            if idea.key() in keys or texts.name.lower() in names:
+            if self._key(idea) in keys or (texts.name.lower() in names and not self.told_apart):
                 self.rejected_same_scenario += 1
                 continue
             if per_agent.get(i, 0) >= needs[i] + 1:
                 continue
-            keys.add(idea.key())
+            keys.add(self._key(idea))
             names.add(texts.name.lower())
             per_agent[i] = per_agent.get(i, 0) + 1
             kept.append((i, idea, texts))
@@ -202,11 +226,14 @@ class KnowledgeEngine:
 
     def _accept(self, idea: Idea, texts: Texts, vec: np.ndarray | None) -> bool:
         if self.unique:
-            keys = {a.idea.key() for a in self.accepted}
+            keys = {self._key(a.idea) for a in self.accepted}
             names = {a.texts.name.lower() for a in self.accepted}
-            if idea.key() in keys or texts.name.lower() in names:
+            if self._key(idea) in keys or (texts.name.lower() in names and not self.told_apart):
                 self.rejected_same_scenario += 1
                 return False
+        if self.room_cap is not None and sum(a.idea.room == idea.room for a in self.accepted) >= self.room_cap:
+            self.rejected_room_full += 1
+            return False
         if vec is not None and self.accepted:
             pool = np.stack([a.vector for a in self.accepted if a.vector is not None])
             if float((pool @ vec).max()) >= self.threshold:
