@@ -202,12 +202,12 @@ def test_the_derived_views_come_from_the_one_list_of_relations():
 def test_the_tables_keyed_by_the_compact_word_cover_every_support_placement():
     """Phrase tables keyed by the word (grounding's meanings, the phrase bank's places, the alias table's
     targets) name exactly the placements the schema knows; the support kinds are the knowledge base's."""
-    from anomalygen.brainstorm.realise import bank
+    from anomalygen.brainstorm.describe import words as describing
     from anomalygen.knowledge import SUPPORT_HEIGHTS
     from anomalygen.knowledge.grounding import PLACEMENT_TEXTS, _aliases
 
     words = {p.key for p in S.SUPPORT_PLACEMENTS}
-    assert set(PLACEMENT_TEXTS) == words == set(bank()["place"])
+    assert set(PLACEMENT_TEXTS) == words == set(describing()["place"])
     assert set(_aliases()["placements"].values()) <= words
     assert set(SUPPORT_HEIGHTS) == set(S.SUPPORT_KINDS)
 

@@ -92,12 +92,16 @@ def test_existing_tasks_are_kept_unless_forced(run111, tmp_path):
     assert (out / "tasks.jsonl").read_bytes() == before
 
 
-def test_texts_vary(run111):
-    out = run111
-    tasks = read_jsonl(out / "tasks.jsonl", TaskProposal)
-    openings = {" ".join(t.description.split()[:3]) for t in tasks}
-    name_shapes = {t.name.split()[0] for t in tasks}
-    assert len(openings) >= 25 and len(name_shapes) >= 15
+def test_scenarios_cover_the_composed_space(run111):
+    """Diversity is counted where it matters (issue 39): at seed 0, at least 105 of 111 tasks are distinct
+    (class, object at fault, placement, room) scenarios, and no room holds more than 30 % of them."""
+    import collections
+
+    tasks = read_jsonl(run111 / "tasks.jsonl", TaskProposal)
+    keys = {(t.hazard_class, t.scenario.hazard_object, t.scenario.placement, t.scenario.room) for t in tasks}
+    assert len(keys) >= 105
+    rooms = collections.Counter(t.scenario.room for t in tasks)
+    assert max(rooms.values()) <= 0.30 * len(tasks), rooms
 
 
 def test_bring_your_own_tasks(run111, tmp_path):
@@ -124,24 +128,23 @@ def test_bring_your_own_tasks(run111, tmp_path):
         load_user_tasks(broken)
 
 
-def test_texts_are_diverse_and_well_formed(run111):
-    """Self-BLEU (name + description, NLTK method 1) of the seeded 111 run stays well below the 0.80 the
-    single-frame realiser had; names stay short and descriptions stay 1-3 sentences."""
+def test_texts_are_well_formed(run111):
+    """Names stay short; a description is the situation, the danger, who is at risk and the fix (3-6
+    plain sentences), and it names the object at fault and the room. There is no Self-BLEU target for
+    the offline engine (issue 39): the text says the task, it does not buy a metric."""
     import re
 
-    from anomalygen.brainstorm.realise import bank, nice, room_words
-    from anomalygen.evaluate.selfbleu import self_bleu
+    from anomalygen.brainstorm.realise import nice, room_words
 
     def room_names(room: str) -> list[str]:
-        return bank()["room_synonyms"].get(room, [room_words(room)])
+        return [room_words(room)]
 
     out = run111
     tasks = read_jsonl(out / "tasks.jsonl", TaskProposal)
-    assert self_bleu([f"{t.name} {t.description}" for t in tasks]) < 0.55  # 0.493 at seed 0, 0.48-0.49 at seeds 1-3
     for t in tasks:
         assert 3 <= len(t.name.split()) <= 8, t.name
         sentences = [s for s in re.split(r"(?<=[.!?])\s+", t.description) if s]
-        assert 1 <= len(sentences) <= 3, t.description
+        assert 3 <= len(sentences) <= 6, t.description
         assert "{" not in t.description and "[" not in t.description and "  " not in t.description
         text = f"{t.name} {t.description}".lower()
         assert nice(t.scenario.hazard_object).lower() in text, text

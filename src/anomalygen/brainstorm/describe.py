@@ -1,0 +1,176 @@
+"""A task's name and description in plain sentences, each fragment tagged with what it fits.
+
+Why: the phrase banks of ``realise`` drew every slot independently to buy Self-BLEU, and a blind
+reader found the price: persona remarks that had nothing to do with the hazard, spill words for pills,
+"scorch what lies under it" for a pan handle, a counter "next to the hob" in a bathroom, a fridge
+"in the doorway gap" (issue 39). Here a description is three sentences, the situation, the danger
+with who is at risk, and the fix, and every fragment is drawn from a list kept for exactly one
+thing: a place phrase for one placement key, a state phrase for one joint state, the danger and the
+fix from the hazard class's own knowledge-base text. ``fragments`` returns each fragment with its
+tag, and a test checks that every tag agrees with the task it was drawn for. A role chooses *what*
+is proposed (provenance records it); its remarks are not in the text.
+
+The data is ``data/knowledge/describing.json``. Every choice comes from the caller's generator.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from anomalygen.knowledge.base import KNOWLEDGE_DIR
+from anomalygen.knowledge.households import load_households
+
+
+@dataclass(frozen=True)
+class Fragment:
+    """One piece of a generated text and what it was written for: ``kind`` is the slot (place, state,
+    danger, fix, room, object), ``fits`` the value of the task it must agree with."""
+
+    text: str
+    kind: str
+    fits: str
+
+
+@lru_cache(maxsize=1)
+def words() -> dict:
+    """The tagged phrase lists (data/knowledge/describing.json), loaded once."""
+    return json.loads((KNOWLEDGE_DIR / "describing.json").read_text(encoding="utf-8"))
+
+
+def person_fits(person: str, *, room: str, support: str | None, other: str | None, names) -> bool:
+    """Whether a person at risk makes sense in this scene ('people_fit' in describing.json): the cook
+    belongs in a kitchen, a child in the bath needs a bathtub, whoever irons next needs an iron."""
+    need = words()["people_fit"].get(person)
+    if need is None:
+        return True
+    if room in need.get("rooms", ()):
+        return True
+    if any(p in (support, other) for p in need.get("places", ())):
+        return True
+    said = " ".join(str(n).lower() for n in names if n)
+    return any(o in said for o in need.get("objects", ()))
+
+
+def people_for(hc, idea_like: dict) -> list[str]:
+    """The class's people at risk who fit this scene (``person_fits``)."""
+    return [p for p in hc.people if person_fits(p, **idea_like)]
+
+
+def pick(rng: np.random.Generator, options: list[str]) -> str:
+    return str(options[int(rng.integers(len(options)))])
+
+
+def place_fragment(key: str, fragment: str | None, other: str | None, relation: str, rng: np.random.Generator,
+                   say) -> Fragment:
+    """Where the object is: words for its composed place (the top shelf), its placement key (the edge of
+    the counter) or its relation to another object (beside the crib). Never a detail the scene lacks."""
+    w = words()
+    if fragment and fragment in w["place_by_fragment"]:
+        return Fragment(pick(rng, w["place_by_fragment"][fragment]), "place_fragment", fragment)
+    if other is not None:
+        return Fragment(pick(rng, w["place_by_relation"][relation]).format(x=say(other)), "relation", relation)
+    return Fragment(pick(rng, w["place"][key]), "place", key)
+
+
+def state_fragment(state: str, rng: np.random.Generator) -> Fragment:
+    return Fragment(pick(rng, words()["state"][state]), "state", state)
+
+
+def left_verb(rng: np.random.Generator, plural: bool) -> str:
+    return pick(rng, words()["left_plural" if plural else "left"])
+
+
+def _head(phrase: str) -> str:
+    """The noun a phrase is about: 'box' in 'box of leftovers', 'scissors' in 'kitchen scissors'."""
+    before = phrase.split(" of ")[0].split()
+    return before[-1].lower() if before else ""
+
+
+def _plural(phrase: str) -> bool:
+    last = _head(phrase)
+    return last.endswith("s") and not last.endswith(("ss", "us", "is"))
+
+
+def _a(phrase: str) -> str:
+    """'a' or 'an' by sound, 'some' for plurals and mass nouns (some mouldy bread, a USB stick)."""
+    words_ = phrase.split()
+    if not words_:
+        return phrase
+    if _plural(phrase) or _head(phrase) in words()["mass_nouns"]:
+        return f"some {phrase}"
+    first = words_[0]
+    if len(first) > 1 and first.isupper():  # an initialism is said letter by letter: an HDMI cable, a USB stick
+        return ("an " if first[0] in "AEFHILMNORSX" else "a ") + phrase
+    return ("an " if first[:1].lower() in "aeiou" else "a ") + phrase
+
+
+def _place_in_room(place: str, room: str) -> str:
+    """'on the low table in the bedroom, at a child's height': the room goes before a trailing remark."""
+    if room in place:
+        return place
+    head, comma, tail = place.partition(",")
+    return f"{head} in the {room}{comma}{tail}"
+
+
+def _them(text: str) -> str:
+    """A class's fix says 'it'; a plural object at fault is 'them' (put the pliers away, lock them in)."""
+    return re.sub(r"\bit\b", "them", text)
+
+
+def _cap(text: str) -> str:
+    return text[:1].upper() + text[1:] if text else text
+
+
+def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, part: str, state: str, room: str,
+                       container: str, support: str) -> list[Fragment]:
+    """The description as tagged fragments: the tagged pieces (place, state, danger, fix, person),
+    then the sentences built from them (kind ``sentence``, in order)."""
+    from anomalygen.brainstorm.idea_sampler import secondary_variables
+
+    hc = kb.hazard_classes[idea.class_id]
+    w = words()
+    hazard = say(idea.hazard)
+    articulated = hc.articulation is not None and hc.about_target
+    # a fixture whose own state is the hazard (a baby gate left open) is said by its state, not by
+    # where it lies: fixtures stand where they belong (data/knowledge/households.json)
+    own_state = hc.articulation is not None and hc.articulation.variable == hc.hazard_variable
+    fixture = own_state and idea.hazard in load_households().fixtures
+    out: list[Fragment] = []
+    if articulated or fixture:
+        st = state_fragment(state, rng)
+        owner = f"the {hazard}" if part in hazard or not part else f"the {part} of the {hazard}"
+        situation = f"{_cap(owner)} in the {room} {st.text}."
+        out.append(st)
+    else:
+        composed = hc.composition.place if hc.composition is not None and not hc.composition.legacy else None
+        p = idea.placement
+        pl = place_fragment(p.key, composed, p.other, p.relation, rng, say)
+        out.append(pl)
+        verb = left_verb(rng, _plural(hazard))
+        where = _place_in_room(pl.text, room)
+        situation = f"{_cap(_a(hazard))} {verb} {where}."
+        if own_state:
+            st = state_fragment(state, rng)  # an iron left on, as well as where it lies
+            out.append(st)
+            situation += f" It {st.text}."
+    out.append(Fragment(room, "room", idea.room))
+    # objects the hazard needs besides its own (the candle whose fumes fill a shut room): said, never clutter
+    needed = [c for c, var in zip(idea.co_objects, secondary_variables(hc), strict=False)
+              if c not in (idea.hazard, idea.placement.other)]
+    extra = f" There is {_a(say(needed[0]))} in the room too." if needed else ""
+    danger = Fragment(hc.why, "danger", hc.id)
+    at_risk = Fragment(pick(rng, w["at_risk"]).format(person=person, Person=_cap(person)), "person", person)
+    fix_text = hc.solution.format(hazard=hazard, container=container, support=support) if hc.solution else ""
+    if _plural(hazard):
+        fix_text = _them(fix_text)
+    fix = Fragment(fix_text, "fix", hc.id)
+    out += [danger, at_risk, fix]
+    for text in (situation + extra, danger.text, at_risk.text, fix.text):
+        if text.strip():
+            out.append(Fragment(text.strip(), "sentence", idea.class_id))
+    return out
