@@ -5,7 +5,10 @@ For each seed, drafts ``--n`` tasks with the knowledge engine and reports:
   piece of furniture a task names: the object at fault, its support, the placement's other object,
   the container and the co-objects), with examples;
 - ``distinct``: distinct (class, object at fault, placement, room) scenarios;
-- ``top_room_share``: the largest share of tasks in one room.
+- ``top_room_share``: the largest share of tasks in one room;
+- ``unusual``: portable objects a task names (the object at fault, the placement's other object, the
+  co-objects) outside the rooms ``objects.json`` keeps them in (a toaster in a bathroom);
+- ``classes``: distinct hazard classes drawn.
 
 Run: ``.venv/bin/python benchmarks/bench_task_plausibility.py --seeds 0-9 --n 111 [--big 1000]``.
 Building (``--build``: the share of tasks the scene builder makes) is measured by
@@ -28,7 +31,11 @@ def _seeds(text: str) -> list[int]:
 
 def measure(seed: int, n: int) -> dict:
     from anomalygen.brainstorm.knowledge_engine import KnowledgeEngine
-    from anomalygen.knowledge.households import misplaced_objects
+    from anomalygen.knowledge import load_kb
+    from anomalygen.knowledge.households import load_households, misplaced_objects
+
+    kb, homes = load_kb(), load_households()
+    unusual = 0
 
     tasks = KnowledgeEngine(seed=seed).run(n)
     keys = collections.Counter()
@@ -40,6 +47,9 @@ def measure(seed: int, n: int) -> dict:
         rooms[s.room] += 1
         for name in misplaced_objects(t):
             bad.append(f"{t.id}: {name} in {s.room}")
+        for name in [s.hazard_object, s.placement.other, *s.co_objects]:
+            if name and name not in homes.fixtures and name in kb.objects and kb.objects[name].rooms:
+                unusual += s.room not in kb.objects[name].rooms
     room, top = rooms.most_common(1)[0]
     return {
         "seed": seed,
@@ -48,6 +58,8 @@ def measure(seed: int, n: int) -> dict:
         "top_room": room,
         "top_room_share": round(top / len(tasks), 3),
         "misplaced": len(bad),
+        "unusual": unusual,
+        "classes": len({t.hazard_class for t in tasks}),
         "examples": bad[:5],
     }
 

@@ -82,8 +82,9 @@ def test_the_person_at_risk_fits_the_scene(drawn):
     _, out = drawn
     for idea, _, _ in out:
         assert person_fits(idea.person, **idea_scene(idea)), (idea.person, idea.room, idea.placement)
-    assert not person_fits("the cook", room="bedroom", support="table", other=None, names=["iron"])
-    assert person_fits("a child in the bath", room="bathroom", support=None, other="Bathtub", names=["hair_dryer"])
+    assert not person_fits("the cook", room="bedroom", names=["iron", "table"])
+    assert person_fits("a child in the bath", room="bathroom", names=["hair_dryer", "Bathtub"])
+    assert not person_fits("a child in the bath", room="bathroom", names=["hair_dryer", "Sink"])
 
 
 def test_fixture_place_phrases_say_nothing_the_scene_may_lack():

@@ -42,18 +42,20 @@ def words() -> dict:
     return json.loads((KNOWLEDGE_DIR / "describing.json").read_text(encoding="utf-8"))
 
 
-def person_fits(person: str, *, room: str, support: str | None, other: str | None, names) -> bool:
+def person_fits(person: str, *, room: str, names) -> bool:
     """Whether a person at risk makes sense in this scene ('people_fit' in describing.json): the cook
-    belongs in a kitchen, a child in the bath needs a bathtub, whoever irons next needs an iron."""
+    belongs in a kitchen, a child in the bath needs a bathtub, the family asleep upstairs is not in the
+    bedroom. Every condition a row lists must hold: ``rooms`` (the room is one of them), ``not_rooms``,
+    ``objects`` (one of the scene's names contains one of them)."""
     need = words()["people_fit"].get(person)
     if need is None:
         return True
-    if room in need.get("rooms", ()):
-        return True
-    if any(p in (support, other) for p in need.get("places", ())):
-        return True
+    if "rooms" in need and room not in need["rooms"]:
+        return False
+    if room in need.get("not_rooms", ()):
+        return False
     said = " ".join(str(n).lower() for n in names if n)
-    return any(o in said for o in need.get("objects", ()))
+    return "objects" not in need or any(o in said for o in need["objects"])
 
 
 def people_for(hc, idea_like: dict) -> list[str]:
@@ -126,6 +128,27 @@ def _cap(text: str) -> str:
     return text[:1].upper() + text[1:] if text else text
 
 
+def fix_words(hc, *, hazard: str, container: str, support: str, part: str) -> str:
+    """The class's own fix in this task's words ({part}: the door or drawer that is open)."""
+    if not hc.solution:
+        return ""
+    return hc.solution.format(hazard=hazard, container=container, support=support, part=part or "door")
+
+
+def hot_word(kb, obj: str, hc, said: str) -> str:
+    """'lit' or 'hot' for a hot object when the class's danger is a burn or a fire and its name does
+    not say so already (a lit candle, a hot iron): the danger sentence then has its cause in the scene."""
+    info = kb.objects.get(obj)
+    if info is None or "hot" not in info.properties:
+        return ""
+    if not any(w in hc.why.lower() for w in ("burn", "scald", "fire", "hot", "heat")):
+        return ""
+    if any(w in said.split() for w in ("hot", "lit", "burning", "warm")):
+        return ""
+    table = words()["hot_said"]
+    return table.get(obj, table["default"])
+
+
 def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, part: str, state: str, room: str,
                        container: str, support: str) -> list[Fragment]:
     """The description as tagged fragments: the tagged pieces (place, state, danger, fix, person),
@@ -143,10 +166,17 @@ def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, 
     out: list[Fragment] = []
     if articulated or fixture:
         st = state_fragment(state, rng)
-        owner = f"the {hazard}" if part in hazard or not part else f"the {part} of the {hazard}"
+        part = part or (hc.articulation.part.split("|")[0] if hc.articulation else "")
+        # a switched appliance is on, not its knob; a tap or a door is the part that is open or running
+        whole = not part or part in hazard or (state == "on" and part in w["control_parts"])
+        owner = f"the {hazard}" if whole else f"the {part} of the {hazard}"
         situation = f"{_cap(owner)} in the {room} {st.text}."
         out.append(st)
     else:
+        quality = hot_word(kb, idea.hazard, hc, hazard)
+        if quality:
+            out.append(Fragment(quality, "quality", "hot"))
+            hazard = f"{quality} {hazard}"
         composed = hc.composition.place if hc.composition is not None and not hc.composition.legacy else None
         p = idea.placement
         pl = place_fragment(p.key, composed, p.other, p.relation, rng, say)
@@ -162,10 +192,16 @@ def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, 
     # objects the hazard needs besides its own (the candle whose fumes fill a shut room): said, never clutter
     needed = [c for c, var in zip(idea.co_objects, secondary_variables(hc), strict=False)
               if c not in (idea.hazard, idea.placement.other)]
-    extra = f" There is {_a(say(needed[0]))} in the room too." if needed else ""
+    extra = ""
+    if needed:
+        quality = hot_word(kb, needed[0], hc, say(needed[0]))
+        if quality:
+            out.append(Fragment(quality, "quality", "hot"))
+        extra = f" There is {_a(' '.join(x for x in (quality, say(needed[0])) if x))} in the room too."
     danger = Fragment(hc.why, "danger", hc.id)
     at_risk = Fragment(pick(rng, w["at_risk"]).format(person=person, Person=_cap(person)), "person", person)
-    fix_text = hc.solution.format(hazard=hazard, container=container, support=support) if hc.solution else ""
+    hazard = say(idea.hazard)  # the fix names the object plainly
+    fix_text = fix_words(hc, hazard=hazard, container=container, support=support, part=part)
     if _plural(hazard):
         fix_text = _them(fix_text)
     fix = Fragment(fix_text, "fix", hc.id)

@@ -77,9 +77,8 @@ def usable_targets(kb: KnowledgeBase) -> list[str]:
 
 
 def _scene_of(room: str, placement: Placement, names) -> dict:
-    """What ``person_fits`` looks at: the room, the placement's support and other object, the names."""
-    return {"room": room, "support": placement.support, "other": placement.other,
-            "names": [*names, placement.other]}
+    """What ``person_fits`` looks at: the room and every name in the scene, the placement's included."""
+    return {"room": room, "names": [*names, placement.support, placement.other]}
 
 
 def idea_scene(idea: Idea) -> dict:
@@ -182,7 +181,12 @@ class IdeaSampler:
         )
 
         kb = self.kb
-        candidates = hazards_for(kb, hc)
+        homes = load_households()
+        # an object is drawn only in a room it is found in: a frying pan in a kitchen, a razor in a
+        # bathroom (its rooms in households.json for a fixture, objects.json for anything else)
+        candidates = [c for c in hazards_for(kb, hc) if self.usual_rooms(hc, c)]
+        if not (self.usual_rooms(hc, target) if hc.about_target else candidates):
+            return None
         if hc.about_target:
             # the class is about the target itself (its door is open, it is on): a safe named beside a
             # table would be built as the table's open drawer, so the object at fault is the target
@@ -202,16 +206,17 @@ class IdeaSampler:
         secondary = {var: harmless_first(kb, self.kb.static_candidates(hc, var))
                      for var in secondary_variables(hc) if not (var == related)}
         # a plausible home: every fixture the idea names belongs in its room (data/knowledge/households.json)
-        homes = load_households()
-        usual = [r for r in hc.rooms if r in (homes.rooms_of(hazard) or kb.objects[hazard].rooms)] or list(hc.rooms)
+        usual = self.usual_rooms(hc, hazard)
 
         def rooms_with(p: Placement) -> list[str]:
             rooms = homes.rooms_for([hazard, p.support, p.other], usual)
+            if p.other is not None and p.other not in homes.fixtures and kb.objects[p.other].rooms:
+                rooms = [r for r in rooms if r in kb.objects[p.other].rooms]  # a blanket is not kept in a bathroom
             if hc.default_supports:
                 rooms = [r for r in rooms if any(homes.belongs(b, r) for b in hc.default_supports)]
             if containers:
                 rooms = [r for r in rooms if any(homes.belongs(c, r) for c in containers)]
-            return [r for r in rooms if all(any(homes.belongs(c, r) for c in opts) for opts in secondary.values() if opts)]
+            return [r for r in rooms if all(any(self.found_in(c, r) for c in opts) for opts in secondary.values() if opts)]
 
         placements = [p for p in placements if rooms_with(p)]
         if not placements:  # no room holds every fixture this hazard needs: not a home anyone lives in
@@ -231,7 +236,7 @@ class IdeaSampler:
                 co.append(placement.other)
             else:
                 options = secondary.get(var) or harmless_first(kb, self.kb.static_candidates(hc, var))
-                co.append(weighted(rng, [c for c in options if homes.belongs(c, room)] or options))
+                co.append(weighted(rng, [c for c in options if self.found_in(c, room)] or options))
         # the person at risk fits the scene: the cook in a kitchen, a child in the bath beside a bathtub
         people = people_for(hc, _scene_of(room, placement, [hazard, container, support, *co]))
         person = people[int(rng.integers(len(people)))] if (self.rich and people) else hc.at_risk
@@ -256,6 +261,25 @@ class IdeaSampler:
             agent_index=agent_index,
             round=round_,
         )
+
+    def found_in(self, obj: str, room: str) -> bool:
+        """Is ``obj`` found in ``room``: a fixture where it belongs, anything else where it is kept
+        (a toaster in a kitchen, not a bathroom)."""
+        homes = load_households()
+        if obj in homes.fixtures:
+            return homes.belongs(obj, room)
+        rooms = self.kb.objects[obj].rooms if obj in self.kb.objects else ()
+        return not rooms or room in rooms
+
+    def usual_rooms(self, hc: HazardClass, obj: str) -> list[str]:
+        """The class's rooms that the object is found in. A fixture has no others; a portable thing
+        whose usual rooms the class never names is out of place by the class's own nature (a bleach
+        bottle beside a crib) and takes the class's rooms."""
+        homes = load_households()
+        if obj in homes.fixtures:
+            return [r for r in hc.rooms if homes.belongs(obj, r)]
+        found = self.kb.objects[obj].rooms
+        return [r for r in hc.rooms if r in found] or list(hc.rooms) if found else list(hc.rooms)
 
     # ---------------------------------------------------------------- recombination
     def recombine(
@@ -320,7 +344,7 @@ class IdeaSampler:
         hc = kb.hazard_classes[idea.class_id]
         for _, aspect, src in plan:
             if aspect == "location":
-                rooms_ok = (src.room in hc.rooms or src.room in kb.objects[idea.hazard].rooms) and not load_households().misplaced(
+                rooms_ok = src.room in self.usual_rooms(hc, idea.hazard) and not load_households().misplaced(
                     replace(idea, room=src.room))
                 place_ok = src.placement in placements_for(kb, hc, idea.hazard) and not relation_variable(hc)
                 if not (rooms_ok or place_ok):
@@ -337,6 +361,10 @@ class IdeaSampler:
                 idea = replace(idea, person=src.person)
         if load_households().misplaced(idea):  # a borrowed place or room that this idea's fixtures do not fit
             return None
+        # clutter borrowed from another room, or left behind by a borrowed room, stays only where it is kept
+        needed = len(secondary_variables(hc))
+        idea = replace(idea, co_objects=idea.co_objects[:needed]
+                       + tuple(c for c in idea.co_objects[needed:] if self.found_in(c, idea.room)))
         if idea.person in hc.people and not person_fits(idea.person, **idea_scene(idea)):
             return None  # a borrowed room where this person makes no sense (the cook in a bedroom)
         return replace(

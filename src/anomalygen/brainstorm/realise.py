@@ -14,7 +14,7 @@ import re
 
 import numpy as np
 
-from anomalygen.brainstorm.describe import describe_fragments, words
+from anomalygen.brainstorm.describe import describe_fragments, fix_words, words
 from anomalygen.brainstorm.idea import Idea, Texts
 from anomalygen.knowledge import KnowledgeBase
 from anomalygen.schema import DOOR
@@ -39,11 +39,13 @@ _NICE_NAMES = {
     "leftover_container": "box of leftovers",
     "spoiled_milk_carton": "carton of sour milk",
     "medicine_cabinet": "medicine cabinet",
+    "Safe": "lockable box",  # a small lockable store (households.json): 'the safe' reads oddly for a coin or a toy
 }
 
 _ROOM_WORDS = {"living_room": "living room", "laundry_room": "laundry room"}
 
 _VERBS = {
+    "turn_off_running_tap": ["Turn off", "Shut off"],
     "dispose_spoiled_food": ["Throw out", "Bin", "Dispose of", "Get rid of", "Discard"],
     "store_perishable_food": ["Refrigerate", "Chill", "Put away", "Cool down"],
     "pick_up_floor_litter": ["Pick up", "Clear", "Bin", "Collect"],
@@ -197,7 +199,7 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
         "Obj": cap(hazard),
         "room": room,
         "place": place,
-        "part": part,
+        "part": "" if state == "on" and part in words()["control_parts"] else part,  # the kettle is on, not its knob
         "state_word": {"on": "on", "open": "open", "closed": "shut"}.get(state, state),
     }
     said_by_state = articulated or not any(f.kind in ("place", "relation", "place_fragment") for f in frags)
@@ -206,7 +208,7 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     description = _tidy(" ".join(f.text for f in frags if f.kind == "sentence"))
     name = _tidy(name)
 
-    solution = hc.solution.format(hazard=hazard, container=container, support=support) if hc.solution else ""
+    solution = fix_words(hc, hazard=hazard, container=container, support=support, part=part)
     success = (
         hc.success_text.format(hazard=hazard, container=container, support=support) if hc.success_text else ""
     )

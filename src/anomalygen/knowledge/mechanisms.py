@@ -90,6 +90,8 @@ class Composition(KBModel):
     severity: float | None = None
     why: str | None = Field(None, description="why this combination is dangerous, where the mechanism's "
                             "own text speaks of other objects (default: the mechanism's)")
+    people: list[str] = Field(default_factory=list, description="the people at risk, where the mechanism's "
+                              "own list names some this combination does not endanger (default: the mechanism's)")
     containers: list[str] = Field(default_factory=list)
     supports: list[str] = Field(default_factory=list)
     targets: list[str] = Field(default_factory=list)
@@ -212,7 +214,7 @@ def compose(ms: MechanismSet, m: Mechanism, c: Composition, kind_id: str) -> Haz
         category=m.category,
         paper_class=False,
         at_risk=m.at_risk,
-        people=list(m.people),
+        people=list(c.people or m.people),
         why=c.why or m.why,
         severity=c.severity if c.severity is not None else m.severity,
         variables=variables,
