@@ -131,21 +131,23 @@ def test_near_placements_build_the_composed_hazard_and_bind_its_other_object(tmp
 
 def test_the_bin_added_for_the_second_hazard_is_the_kind_the_planner_looks_for():
     """One rule: the builder adds a bin unless the scene holds a kind ``containers_for`` (the planner's
-    choice for that very object) names; a bucket is no bin for a plastic bag, a trash can is."""
+    choice for that very object) names. Litter goes in a bin, never a bucket (issue 39: a reader took
+    'drop it into the bucket' for a slip), so a scene with only a bucket is given a trash can and a
+    scene with a trash can is given none."""
     kb = load_kb()
     hc = kb.hazard_classes[SECOND_HAZARD_CLASS]
     on = Settings(build={"near_misses": 0, "multi_hazard": 1.0})
-    assert "Bucket" in hc.default_containers and "Bucket" not in kb.containers_for(hc, "plastic_bag")
-    seen = set()
-    for t in range(60):
-        items = choose_judgement_items(f"t{t}", "store_sharp_objects", {"Bucket"}, kb, on)
-        if items.second_hazard is None:
-            continue
-        wanted = kb.containers_for(hc, items.second_hazard)
-        assert items.bin_kinds == wanted
-        assert items.bin == (None if "Bucket" in wanted else wanted[0])
-        seen.add(items.bin)
-    assert seen == {None, "TrashCan"}  # both cases were drawn
+    assert hc.default_containers == ["TrashCan"]
+    seen = {}
+    for present in ({"Bucket"}, {"TrashCan"}):
+        for t in range(60):
+            items = choose_judgement_items(f"t{t}", "store_sharp_objects", present, kb, on)
+            if items.second_hazard is None:
+                continue
+            wanted = kb.containers_for(hc, items.second_hazard)
+            assert items.bin_kinds == wanted == ["TrashCan"]
+            seen.setdefault(frozenset(present), set()).add(items.bin)
+    assert seen == {frozenset({"Bucket"}): {"TrashCan"}, frozenset({"TrashCan"}): {None}}
 
 
 @pytest.mark.slow

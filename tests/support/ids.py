@@ -9,11 +9,15 @@ from anomalygen.schema import Relation, TaskProposal
 
 ID_PATTERN = re.compile(r"t\d{4}-[0-9a-f]{8}")
 MIN_WORD = 4  # letters: shorter words ("on", "the", "a") say nothing about a task
+# longer function words say nothing either; an observation's own prose may hold them ("from the edge")
+FUNCTION_WORDS = frozenset({"from", "with", "into", "onto", "over", "away", "that", "this", "there", "their",
+                            "them", "they", "have", "been", "were", "what", "when", "where", "which", "some",
+                            "than", "then", "also", "each", "every"})
 
 
 def words(text: str) -> set[str]:
     """Lower-case alphabetic tokens of at least ``MIN_WORD`` letters (underscores split words)."""
-    return {w for w in re.split(r"[^a-z]+", text.lower()) if len(w) >= MIN_WORD}
+    return {w for w in re.split(r"[^a-z]+", text.lower()) if len(w) >= MIN_WORD and w not in FUNCTION_WORDS}
 
 
 def task_text(task: TaskProposal) -> str:

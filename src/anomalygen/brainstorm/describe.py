@@ -22,8 +22,10 @@ from functools import lru_cache
 
 import numpy as np
 
+from anomalygen.brainstorm.idea import secondary_variables
 from anomalygen.knowledge.base import KNOWLEDGE_DIR
 from anomalygen.knowledge.households import load_households
+from anomalygen.schema import DOOR
 
 
 @dataclass(frozen=True)
@@ -132,7 +134,7 @@ def fix_words(hc, *, hazard: str, container: str, support: str, part: str) -> st
     """The class's own fix in this task's words ({part}: the door or drawer that is open)."""
     if not hc.solution:
         return ""
-    return hc.solution.format(hazard=hazard, container=container, support=support, part=part or "door")
+    return hc.solution.format(hazard=hazard, container=container, support=support, part=part or DOOR)
 
 
 def hot_word(kb, obj: str, hc, said: str) -> str:
@@ -153,8 +155,6 @@ def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, 
                        container: str, support: str) -> list[Fragment]:
     """The description as tagged fragments: the tagged pieces (place, state, danger, fix, person),
     then the sentences built from them (kind ``sentence``, in order)."""
-    from anomalygen.brainstorm.idea_sampler import secondary_variables
-
     hc = kb.hazard_classes[idea.class_id]
     w = words()
     hazard = say(idea.hazard)

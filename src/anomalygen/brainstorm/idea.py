@@ -217,3 +217,9 @@ def build_proposal(
         ),
         grounding=grounding or [],
     )
+
+
+def secondary_variables(hc) -> list[str]:
+    """Precondition variables other than the hazard's (e.g. the fume source of ventilate_room): the
+    objects an idea needs besides the one at fault."""
+    return [v for v in hc.variable_names() if v != hc.hazard_variable]

@@ -16,7 +16,7 @@ from typing import TypeVar
 import numpy as np
 
 from anomalygen.brainstorm.describe import people_for, person_fits
-from anomalygen.brainstorm.idea import Idea
+from anomalygen.brainstorm.idea import Idea, secondary_variables
 from anomalygen.knowledge import HazardClass, KnowledgeBase, RoleProfile
 from anomalygen.knowledge.households import load_households
 from anomalygen.schema import Placement
@@ -83,11 +83,6 @@ def _scene_of(room: str, placement: Placement, names) -> dict:
 
 def idea_scene(idea: Idea) -> dict:
     return _scene_of(idea.room, idea.placement, [idea.hazard, idea.container, idea.support, *idea.co_objects])
-
-
-def secondary_variables(hc: HazardClass) -> list[str]:
-    """Precondition variables other than the hazard's (e.g. the fume source of ventilate_room)."""
-    return [v for v in hc.variable_names() if v != hc.hazard_variable]
 
 
 class IdeaSampler:
@@ -272,14 +267,9 @@ class IdeaSampler:
         return not rooms or room in rooms
 
     def usual_rooms(self, hc: HazardClass, obj: str) -> list[str]:
-        """The class's rooms that the object is found in. A fixture has no others; a portable thing
-        whose usual rooms the class never names is out of place by the class's own nature (a bleach
-        bottle beside a crib) and takes the class's rooms."""
-        homes = load_households()
-        if obj in homes.fixtures:
-            return [r for r in hc.rooms if homes.belongs(obj, r)]
-        found = self.kb.objects[obj].rooms
-        return [r for r in hc.rooms if r in found] or list(hc.rooms) if found else list(hc.rooms)
+        """The class's rooms that the object is found in (none: the two never meet in a home, as a
+        frying pan and a living room's low table do not)."""
+        return [r for r in hc.rooms if self.found_in(obj, r)]
 
     # ---------------------------------------------------------------- recombination
     def recombine(

@@ -67,8 +67,14 @@ _ACTION_VERBS = {
     "push_to": ["Push aside", "Slide away", "Move"],
     "take_off": ["Take down", "Clear", "Lift off", "Move"],
     "move_away": ["Move away", "Shift", "Clear"],
-    "close_lid": ["Close", "Shut", "Lower the lid of"],
+    "close_lid": ["Close", "Shut"],
+    "open_lid": ["Open"],
     "place_on": ["Put away", "Lift up", "Pick up"],
+    "place_inside": ["Put away", "Store", "Tidy away"],
+    "pick": ["Pick up", "Collect"],
+    "take_out_of": ["Take out", "Lift out"],
+    "rotate_inward": ["Turn in", "Turn"],
+    "stand_upright": ["Stand up", "Set upright"],
 }
 
 _EXPLANATION_FRAMES = [
