@@ -17,6 +17,7 @@ import numpy as np
 from anomalygen.brainstorm.describe import describe_fragments, fix_words, words
 from anomalygen.brainstorm.idea import Idea, Texts
 from anomalygen.knowledge import KnowledgeBase
+from anomalygen.knowledge.households import load_households
 from anomalygen.schema import DOOR
 
 _NICE_NAMES = {
@@ -191,6 +192,9 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     support = say(idea.support) if idea.support else "a raised surface"
     articulated = hc.articulation is not None and hc.about_target
     part = (kb.articulation_part(hc, idea.hazard) or DOOR) if articulated else ""
+    if not part and hc.articulation is not None and hc.articulation.variable == hc.hazard_variable \
+            and idea.hazard in load_households().fixtures:  # the tap of a sink left running, in the title too
+        part = hc.articulation.part.split("|")[0]
     state = hc.articulation.initial_state if hc.articulation else ""
     person = person_at_risk(idea, hc)
     verbs = _VERBS.get(hc.id) or _ACTION_VERBS.get(hc.recipe[-1].action) or ["Fix"]
