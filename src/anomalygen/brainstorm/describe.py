@@ -3,8 +3,8 @@
 Why: the phrase banks of ``realise`` drew every slot independently to buy Self-BLEU, and a blind
 reader found the price: persona remarks that had nothing to do with the hazard, spill words for pills,
 "scorch what lies under it" for a pan handle, a counter "next to the hob" in a bathroom, a fridge
-"in the doorway gap" (issue 39). Here a description is three sentences, the situation, the danger
-with who is at risk, and the fix, and every fragment is drawn from a list kept for exactly one
+"in the doorway gap" (issue 39). Here a description is plain sentences: the situation, the danger,
+who is at risk, and the fix, and every fragment is drawn from a list kept for exactly one
 thing: a place phrase for one placement key, a state phrase for one joint state, the danger and the
 fix from the hazard class's own knowledge-base text. ``fragments`` returns each fragment with its
 tag, and a test checks that every tag agrees with the task it was drawn for. A role chooses *what*
@@ -30,8 +30,9 @@ from anomalygen.schema import DOOR
 
 @dataclass(frozen=True)
 class Fragment:
-    """One piece of a generated text and what it was written for: ``kind`` is the slot (place, state,
-    danger, fix, room, object), ``fits`` the value of the task it must agree with."""
+    """One piece of a generated text and what it was written for: ``kind`` is the slot (place, relation,
+    place_fragment, state, quality, room, danger, person, fix, or a whole sentence), ``fits`` the value
+    of the task it must agree with."""
 
     text: str
     kind: str
@@ -121,9 +122,15 @@ def _place_in_room(place: str, room: str) -> str:
     return f"{head} in the {room}{comma}{tail}"
 
 
-def _them(text: str) -> str:
-    """A class's fix says 'it'; a plural object at fault is 'them' (put the pliers away, lock them in)."""
-    return re.sub(r"\bit\b", "them", text)
+def _them(text: str, until: str) -> str:
+    """A class's fix says 'it'; a plural object at fault is 'they'/'them' (put the pliers away, until
+    they rest), up to where the container or support is named: the 'it' after that is the container's
+    ('where a child cannot open it')."""
+    cut = text.find(until) if until and until in text else len(text)
+    head, tail = text[:cut], text[cut:]
+    head = re.sub(r"\bit is\b", "they are", head)
+    head = re.sub(r"\bit (rests|stands|lies|sits)\b", lambda m: "they " + m.group(1)[:-1], head)
+    return re.sub(r"\bit\b", "them", head) + tail
 
 
 def _cap(text: str) -> str:
@@ -134,7 +141,10 @@ def fix_words(hc, *, hazard: str, container: str, support: str, part: str) -> st
     """The class's own fix in this task's words ({part}: the door or drawer that is open)."""
     if not hc.solution:
         return ""
-    return hc.solution.format(hazard=hazard, container=container, support=support, part=part or DOOR)
+    text = hc.solution.format(hazard=hazard, container=container, support=support, part=part or DOOR)
+    if _plural(hazard):
+        text = _them(text, container if "{container}" in hc.solution else support)
+    return text
 
 
 def hot_word(kb, obj: str, hc, said: str) -> str:
@@ -173,7 +183,7 @@ def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, 
         situation = f"{_cap(owner)} in the {room} {st.text}."
         out.append(st)
     else:
-        quality = hot_word(kb, idea.hazard, hc, hazard)
+        quality = "" if own_state else hot_word(kb, idea.hazard, hc, hazard)  # an iron left on: said next
         if quality:
             out.append(Fragment(quality, "quality", "hot"))
             hazard = f"{quality} {hazard}"
@@ -192,18 +202,12 @@ def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, 
     # objects the hazard needs besides its own (the candle whose fumes fill a shut room): said, never clutter
     needed = [c for c, var in zip(idea.co_objects, secondary_variables(hc), strict=False)
               if c not in (idea.hazard, idea.placement.other)]
-    extra = ""
-    if needed:
-        quality = hot_word(kb, needed[0], hc, say(needed[0]))
-        if quality:
-            out.append(Fragment(quality, "quality", "hot"))
-        extra = f" There is {_a(' '.join(x for x in (quality, say(needed[0])) if x))} in the room too."
+    # (not said hot: nothing in the task says it is switched on)
+    extra = f" There is {_a(say(needed[0]))} in the room too." if needed else ""
     danger = Fragment(hc.why, "danger", hc.id)
     at_risk = Fragment(pick(rng, w["at_risk"]).format(person=person, Person=_cap(person)), "person", person)
     hazard = say(idea.hazard)  # the fix names the object plainly
     fix_text = fix_words(hc, hazard=hazard, container=container, support=support, part=part)
-    if _plural(hazard):
-        fix_text = _them(fix_text)
     fix = Fragment(fix_text, "fix", hc.id)
     out += [danger, at_risk, fix]
     for text in (situation + extra, danger.text, at_risk.text, fix.text):

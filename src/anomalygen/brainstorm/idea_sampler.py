@@ -205,8 +205,8 @@ class IdeaSampler:
 
         def rooms_with(p: Placement) -> list[str]:
             rooms = homes.rooms_for([hazard, p.support, p.other], usual)
-            if p.other is not None and p.other not in homes.fixtures and kb.objects[p.other].rooms:
-                rooms = [r for r in rooms if r in kb.objects[p.other].rooms]  # a blanket is not kept in a bathroom
+            if p.other is not None:
+                rooms = [r for r in rooms if self.found_in(p.other, r)]  # a blanket is not kept in a bathroom
             if hc.default_supports:
                 rooms = [r for r in rooms if any(homes.belongs(b, r) for b in hc.default_supports)]
             if containers:

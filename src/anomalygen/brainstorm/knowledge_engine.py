@@ -109,8 +109,10 @@ class KnowledgeEngine:
 
     # ------------------------------------------------------------------ public
     def run(self, n: int) -> list[TaskProposal]:
-        # no room holds more than ROOM_SHARE of the tasks (issue 39): a kitchen-heavy draw is redrawn
-        self.room_cap = max(1, int(ROOM_SHARE * n)) if self.mode == BrainstormMode.BRAINSTORM and n >= MIN_N_FOR_ROOM_CAP else None
+        # no room holds more than ROOM_SHARE of the tasks (issue 39): a kitchen-heavy draw is redrawn.
+        # Only over the open catalogue: a run given a few targets (a fridge, a stove) may need one room.
+        self.room_cap = (max(1, int(ROOM_SHARE * n)) if self.mode == BrainstormMode.BRAINSTORM and n >= MIN_N_FOR_ROOM_CAP
+                         and self.targets is None else None)
         quotas = split_quota(n, self.rounds)
         carry = 0
         r = 0
@@ -127,9 +129,10 @@ class KnowledgeEngine:
             if r >= self.rounds and carry <= 0:
                 break
         if self.unique and len(self.accepted) < n and not self.told_apart:
-            # every scene the knowledge base composes is taken: the rest may repeat a scene for another
-            # person at risk, as the old key allowed, rather than return fewer tasks than asked
+            # the rounds ran out (every composed scene taken, or the room cap full): the rest may repeat
+            # a scene for another person at risk, in any room, rather than return fewer tasks than asked
             self.told_apart = True
+            self.room_cap = None
             for _extra in range(self.max_extra_rounds + 1):
                 previous = [a for a in self.accepted if a.idea.round == r]
                 r += 1
@@ -234,7 +237,8 @@ class KnowledgeEngine:
         if self.room_cap is not None and sum(a.idea.room == idea.room for a in self.accepted) >= self.room_cap:
             self.rejected_room_full += 1
             return False
-        if vec is not None and self.accepted:
+        # a scene told apart by its person says the same situation in nearly the same words by design
+        if vec is not None and self.accepted and not self.told_apart:
             pool = np.stack([a.vector for a in self.accepted if a.vector is not None])
             if float((pool @ vec).max()) >= self.threshold:
                 self.rejected_near_duplicates += 1

@@ -14,6 +14,7 @@ import re
 
 import numpy as np
 
+from anomalygen.brainstorm.describe import _a as indefinite
 from anomalygen.brainstorm.describe import describe_fragments, fix_words, words
 from anomalygen.brainstorm.idea import Idea, Texts
 from anomalygen.knowledge import KnowledgeBase
@@ -97,15 +98,9 @@ def nice(name: str) -> str:
 
 
 def article(phrase: str) -> str:
+    """The phrase with its article (describe's rule: a USB stick, some mouldy bread), kept if it has one."""
     first = phrase.split()[0] if phrase else ""
-    if (
-        first.lower() in {"some", "the"}
-        or phrase.endswith("s")
-        and not phrase.endswith("ss")
-        and first not in ("a", "an")
-    ):
-        return phrase if first.lower() in {"some", "the"} else f"some {phrase}"
-    return ("an " if phrase[:1].lower() in "aeiou" else "a ") + phrase
+    return phrase if first.lower() in {"some", "the", "a", "an"} else indefinite(phrase)
 
 
 def cap(text: str) -> str:
@@ -233,7 +228,9 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
         "Hazard_a": cap(article(hazard)),
         "place": place if not articulated else f"in the {room}",
     }
-    explanation = _choice(rng, _EXPLANATION_FRAMES).format(**ex_slots)
+    # a fixture said by its state has no place to leave it in ("leaving the sink in the kitchen")
+    frames = [f for f in _EXPLANATION_FRAMES if "{place}" not in f] if said_by_state else _EXPLANATION_FRAMES
+    explanation = _choice(rng, frames).format(**ex_slots)
     return Texts(
         name=name,
         explanation=explanation,

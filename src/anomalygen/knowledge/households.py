@@ -5,8 +5,9 @@ rim could be drawn in a kitchen and a toy beside a crib in a living room (issue 
 fixtures in 1,000 tasks). A bathtub is not clutter: it stands against a bathroom wall and nowhere
 else. ``data/knowledge/households.json`` lists, per fixture and piece of furniture, its rooms, how it
 stands (against a wall, free, on a counter) and what its top is for. The generator draws only rooms
-that every fixture a task names belongs to; a name the table does not hold is portable and keeps its
-usual rooms from ``objects.json`` as a preference, not a rule.
+that every fixture a task names belongs to; a name the table does not hold is portable, and the
+sampler draws it only in the rooms ``objects.json`` keeps it in (``IdeaSampler.found_in``). ``mount``
+and ``top`` are recorded for the builder (fixtures against the walls of their room: not built yet).
 """
 
 from __future__ import annotations
