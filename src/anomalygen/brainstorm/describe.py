@@ -133,7 +133,7 @@ def _them(text: str, until: str) -> str:
     return re.sub(r"\bit\b", "them", head) + tail
 
 
-def _cap(text: str) -> str:
+def cap(text: str) -> str:
     return text[:1].upper() + text[1:] if text else text
 
 
@@ -176,11 +176,10 @@ def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, 
     out: list[Fragment] = []
     if articulated or fixture:
         st = state_fragment(state, rng)
-        part = part or (hc.articulation.part.split("|")[0] if hc.articulation else "")
         # a switched appliance is on, not its knob; a tap or a door is the part that is open or running
         whole = not part or part in hazard or (state == "on" and part in w["control_parts"])
         owner = f"the {hazard}" if whole else f"the {part} of the {hazard}"
-        situation = f"{_cap(owner)} in the {room} {st.text}."
+        situation = f"{cap(owner)} in the {room} {st.text}."
         out.append(st)
     else:
         quality = "" if own_state else hot_word(kb, idea.hazard, hc, hazard)  # an iron left on: said next
@@ -193,7 +192,7 @@ def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, 
         out.append(pl)
         verb = left_verb(rng, _plural(hazard))
         where = _place_in_room(pl.text, room)
-        situation = f"{_cap(_a(hazard))} {verb} {where}."
+        situation = f"{cap(_a(hazard))} {verb} {where}."
         if own_state:
             st = state_fragment(state, rng)  # an iron left on, as well as where it lies
             out.append(st)
@@ -205,7 +204,7 @@ def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, 
     # (not said hot: nothing in the task says it is switched on)
     extra = f" There is {_a(say(needed[0]))} in the room too." if needed else ""
     danger = Fragment(hc.why, "danger", hc.id)
-    at_risk = Fragment(pick(rng, w["at_risk"]).format(person=person, Person=_cap(person)), "person", person)
+    at_risk = Fragment(pick(rng, w["at_risk"]).format(person=person, Person=cap(person)), "person", person)
     hazard = say(idea.hazard)  # the fix names the object plainly
     fix_text = fix_words(hc, hazard=hazard, container=container, support=support, part=part)
     fix = Fragment(fix_text, "fix", hc.id)

@@ -104,7 +104,7 @@ class TextGrounder:
         idea = Idea(class_id=hc.id, target=target, hazard=hazard, placement=placement, room=room, person=hc.at_risk,
                     container=container, support=support, co_objects=tuple(others))
         called = {m.name: m.called for m in (comp.fault, comp.other) if m is not None and m.called}
-        words = realise(idea, kb, rng, perspective=False, called=called)
+        words = realise(idea, kb, rng, called=called)
         texts = Texts(words.name, words.explanation, line, words.solution, words.success_condition)
         proposal = to_proposal(idea, texts, index, kb, engine=Engine.KNOWLEDGE, mode=BrainstormMode.PLAIN, seed=self.seed)
         if called:

@@ -91,7 +91,7 @@ class IdeaSampler:
     def __init__(self, kb: KnowledgeBase, role: RoleProfile | None, *, targets: list[str] | None = None, rich: bool = True):
         self.kb = kb
         self.role = role
-        self.rich = rich  # role-play modes add people, co-objects and perspective
+        self.rich = rich  # role-play modes add people and co-objects
         self.targets = [t for t in (targets or usable_targets(kb)) if classes_for_target(kb, t)]
         #: With the whole catalogue open, agents think hazard-first (every class gets a fair share of
         #: targets); when a protocol hands them a fixed set of targets (the ablation), they pick

@@ -7,7 +7,7 @@ co-objects or a person at risk) with its own interests. A Sentence-BERT novelty 
 near-duplicates of what the group has already proposed.
 
 Ablation modes (same realiser for all, so differences come from the method, not the wording code):
-- ``plain``: one role-less generator, one pass; uniform choices, no people, co-objects or perspective.
+- ``plain``: one role-less generator, one pass; uniform choices, no people or co-objects.
 - ``roleplay``: the role agents, one pass, no rounds and no novelty filter.
 - ``brainstorm``: role agents, R rounds of recombination, novelty filter.
 """
@@ -171,7 +171,7 @@ class KnowledgeEngine:
                         idea = sampler.fresh(rng, agent=self.agents[i], agent_index=i, round_=r)
                     # wording draws from its own stream, so changing phrase banks never changes scenarios
                     words = item_rng(self.seed, "realise", self.mode.value, r, i, attempt, len(drafts))
-                    texts = realise(idea, self.kb, words, perspective=self.mode != BrainstormMode.PLAIN)
+                    texts = realise(idea, self.kb, words)
                     drafts.append((i, idea, texts))
             drafts = self._prefilter(drafts, needs)
             if not drafts:

@@ -15,7 +15,7 @@ import re
 import numpy as np
 
 from anomalygen.brainstorm.describe import _a as indefinite
-from anomalygen.brainstorm.describe import describe_fragments, fix_words, words
+from anomalygen.brainstorm.describe import cap, describe_fragments, fix_words, pick, words
 from anomalygen.brainstorm.idea import Idea, Texts
 from anomalygen.knowledge import KnowledgeBase
 from anomalygen.knowledge.households import load_households
@@ -103,27 +103,8 @@ def article(phrase: str) -> str:
     return phrase if first.lower() in {"some", "the", "a", "an"} else indefinite(phrase)
 
 
-def cap(text: str) -> str:
-    return text[:1].upper() + text[1:] if text else text
-
-
 def room_words(room: str) -> str:
     return _ROOM_WORDS.get(room, room.replace("_", " "))
-
-
-_ALTERNATIVES = re.compile(r"\[([^\[\]]*)\]")
-
-
-def _choice(rng: np.random.Generator, options: list[str]) -> str:
-    """One option; any ``[a|b|c]`` inside it is a further independent choice (phrase-bank syntax)."""
-    text = str(options[int(rng.integers(len(options)))])
-    while "[" in text:
-        text = _ALTERNATIVES.sub(lambda m: _pick(rng, m.group(1).split("|")), text, count=1)
-    return text
-
-
-def _pick(rng: np.random.Generator, options: list[str]) -> str:
-    return options[int(rng.integers(len(options)))]
 
 
 def _tidy(text: str) -> str:
@@ -139,7 +120,7 @@ def _words(text: str) -> int:
 def _name(slots: dict[str, str], frames: list[str], rng: np.random.Generator) -> str:
     """A 3-8 word title; frames that come out too long or short are redrawn, then a plain fallback."""
     for _ in range(4):
-        name = cap(_choice(rng, frames).format(**slots)).rstrip(".")
+        name = cap(pick(rng, frames).format(**slots)).rstrip(".")
         if 3 <= _words(name) <= 8:
             return name
     return cap(f"{slots['Verb']} the {slots['obj']}")
@@ -160,43 +141,43 @@ def person_at_risk(idea: Idea, hc) -> str:
     return person
 
 
-def fragments(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, called: dict[str, str] | None = None):
-    """The description's tagged fragments (``describe.describe_fragments``) with this idea's words."""
+def _task_words(idea: Idea, kb: KnowledgeBase, called: dict[str, str] | None) -> dict:
+    """How this idea's objects, part, state and person are said: one computation for the name, the
+    description and the fix alike."""
     hc = kb.hazard_classes[idea.class_id]
     say = _sayer(called)
-    articulated = hc.articulation is not None and hc.about_target
-    return describe_fragments(
-        idea, kb, rng, say=say, person=person_at_risk(idea, hc),
-        part=(kb.articulation_part(hc, idea.hazard) or DOOR) if articulated else "",
-        state=hc.articulation.initial_state if hc.articulation else "", room=room_words(idea.room),
-        container=say(idea.container) if idea.container else "a safe place",
-        support=say(idea.support) if idea.support else "a raised surface",
-    )
-
-
-def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspective: bool = True,
-            called: dict[str, str] | None = None) -> Texts:
-    """Words for an idea: a name, and a description of the situation, the danger with who is at risk,
-    and the fix (``describe_fragments``). ``perspective`` is kept for the callers: a role chooses what
-    is proposed and provenance records it, but its remarks are not in the text (issue 39)."""
-    hc = kb.hazard_classes[idea.class_id]
-    frags = fragments(idea, kb, rng, called=called)  # first: the same generator state gives the same words
-    say = _sayer(called)
-    hazard = say(idea.hazard)
-    container = say(idea.container) if idea.container else "a safe place"
-    support = say(idea.support) if idea.support else "a raised surface"
     articulated = hc.articulation is not None and hc.about_target
     part = (kb.articulation_part(hc, idea.hazard) or DOOR) if articulated else ""
     if not part and hc.articulation is not None and hc.articulation.variable == hc.hazard_variable \
-            and idea.hazard in load_households().fixtures:  # the tap of a sink left running, in the title too
+            and idea.hazard in load_households().fixtures:  # the tap of a sink left running
         part = hc.articulation.part.split("|")[0]
-    state = hc.articulation.initial_state if hc.articulation else ""
-    person = person_at_risk(idea, hc)
+    return {
+        "say": say, "person": person_at_risk(idea, hc), "part": part,
+        "state": hc.articulation.initial_state if hc.articulation else "", "room": room_words(idea.room),
+        "container": say(idea.container) if idea.container else "a safe place",
+        "support": say(idea.support) if idea.support else "a raised surface",
+    }
+
+
+def fragments(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, called: dict[str, str] | None = None):
+    """The description's tagged fragments (``describe.describe_fragments``) with this idea's words."""
+    return describe_fragments(idea, kb, rng, **_task_words(idea, kb, called))
+
+
+def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, called: dict[str, str] | None = None) -> Texts:
+    """Words for an idea: a name, and a description of the situation, the danger with who is at risk,
+    and the fix (``describe_fragments``). A role chooses what is proposed and provenance records it;
+    its remarks are not in the text (issue 39)."""
+    hc = kb.hazard_classes[idea.class_id]
+    w = _task_words(idea, kb, called)
+    frags = describe_fragments(idea, kb, rng, **w)  # first: the same generator state gives the same words
+    hazard, container, support, part, state, person, room = (
+        w["say"](idea.hazard), w["container"], w["support"], w["part"], w["state"], w["person"], w["room"])
+    articulated = hc.articulation is not None and hc.about_target
     verbs = _VERBS.get(hc.id) or _ACTION_VERBS.get(hc.recipe[-1].action) or ["Fix"]
-    verb = _choice(rng, verbs)
+    verb = pick(rng, verbs)
 
     # ---- name and description: plain sentences, every fragment drawn for this task (describe.py)
-    room = room_words(idea.room)
     place = next((f.text for f in frags if f.kind in ("place", "relation", "place_fragment")), f"in the {room}")
     slots = {
         "Verb": verb,
@@ -230,7 +211,7 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, perspect
     }
     # a fixture said by its state has no place to leave it in ("leaving the sink in the kitchen")
     frames = [f for f in _EXPLANATION_FRAMES if "{place}" not in f] if said_by_state else _EXPLANATION_FRAMES
-    explanation = _choice(rng, frames).format(**ex_slots)
+    explanation = pick(rng, frames).format(**ex_slots)
     return Texts(
         name=name,
         explanation=explanation,

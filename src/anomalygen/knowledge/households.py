@@ -47,11 +47,15 @@ class Households(BaseModel):
         rooms = self.rooms_of(name)
         return rooms is None or room in rooms
 
+    def misplaced_among(self, names, room: str) -> list[str]:
+        """Those of ``names`` (once each, None skipped) that are fixtures not belonging in ``room``."""
+        return [n for n in dict.fromkeys(names) if n and not self.belongs(n, room)]
+
     def misplaced(self, idea) -> list[str]:
         """The fixtures a brainstormed idea names that do not belong in its room."""
         p = idea.placement
-        names = [idea.hazard, p.support, p.other, idea.container, idea.support, *idea.co_objects]
-        return [n for n in dict.fromkeys(names) if n and not self.belongs(n, idea.room)]
+        return self.misplaced_among([idea.hazard, p.support, p.other, idea.container, idea.support,
+                                     *idea.co_objects], idea.room)
 
     def rooms_for(self, names, rooms) -> list[str]:
         """Those of ``rooms`` that every fixture among ``names`` belongs to, in the given order."""
@@ -79,6 +83,4 @@ def named_objects(scenario) -> list[str]:
 
 def misplaced_objects(task) -> list[str]:
     """The fixtures a task names that do not belong in its room (an empty list for a plausible home)."""
-    table = load_households()
-    s = task.scenario
-    return [n for n in named_objects(s) if not table.belongs(n, s.room)]
+    return load_households().misplaced_among(named_objects(task.scenario), task.scenario.room)
