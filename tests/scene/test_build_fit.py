@@ -204,3 +204,35 @@ def test_an_object_put_in_through_a_front_door_lies_in_the_front_half():
         assert depth <= (hi[k] - lo[k]) / 2 + 1e-6, f"seed {seed}: the pod's centre lies {depth:.2f} m past the opening"
         depths.append(depth)
     assert len({round(d, 3) for d in depths}) > 1  # still drawn, not pinned to one spot
+
+
+def test_a_trash_can_named_for_a_plastic_bag_is_drawn_roomy_enough():
+    """A 0.30 m bag fits only the roomiest trash cans (about 0.7 m tall). The generator checks that
+    size exists; the builder draws it: a cramped draw makes the next aim at the size whose room holds
+    the bag, so the bin task builds at every attempt instead of failing "does not fit"."""
+    task = _litter("plastic_bag", "TrashCan", "TrashCan")
+    outcomes = _outcomes(task)
+    _assert_fits_or_says_so(outcomes)
+    assert all(o[0] == "fit" for o in outcomes), outcomes
+
+
+def test_a_repair_draws_the_object_at_fault_smaller():
+    """Attempt k draws the object at fault from the lower 1/(k+1)^2 of its range: a cord too long for
+    the table it lies on is drawn shorter, not again at random."""
+    from anomalygen.knowledge import load_kb
+
+    kb = load_kb()
+    lo, hi = asset_choice.size_bounds(kb, "extension_cord")
+    task = TaskProposal(
+        id="t-fit-cord", name="cord", explanation="test", description="An extension cord lies across the hall.",
+        category="household_hazard", hazard_class="clear_cable_from_walkway", target_asset="extension_cord",
+        scenario=dict(hazard_object="extension_cord", room="hallway", placement="walkway", co_objects=[]),
+        provenance=dict(engine="knowledge", mode="brainstorm"))
+    from anomalygen.scene.casting import select_objects
+
+    sizes = []
+    for attempt in range(ATTEMPTS):
+        sel = select_objects(task, item_rng(0, task.id, attempt), repair=attempt)
+        sizes.append(float(sel.hazard.size))
+        assert lo - 1e-9 <= sizes[-1] <= lo + (hi - lo) / (attempt + 1) ** 2 + 1e-9, (attempt, sizes)
+    assert sizes[-1] < lo + 0.1 * (hi - lo)

@@ -15,6 +15,7 @@ from __future__ import annotations
 import functools
 
 from anomalygen.knowledge import HazardClass, KnowledgeBase
+from anomalygen.knowledge.households import load_households
 from anomalygen.schema import Placement, part_labels
 
 
@@ -126,12 +127,44 @@ def fits_inside(kb: KnowledgeBase, hazard: str, holder: str) -> bool:
     return size_bounds(kb, hazard)[0] <= _roomiest(kb, holder, cavity_cap)
 
 
+def _largest_surface(kb: KnowledgeBase, obj: str) -> float:
+    """The longest side of any top ``obj``'s variants offer at its largest size (a stair tread, a hob)."""
+    from anomalygen.assets.core import generate
+    from anomalygen.scene.asset_choice import size_bounds
+
+    largest = size_bounds(kb, obj)[1]
+    assets = [generate(obj, seed, size=largest) for seed in range(INTERIOR_VARIANTS)]
+    return max((2 * float(max(s.half_size)) for a in assets for s in a.surfaces), default=0.0)
+
+
+_SURFACES: dict[str, float] = {}
+TOP_MARGIN = 0.9  # of a top's longest side a thing may span: the layout keeps clear of its rims
+
+
+def fits_on(kb: KnowledgeBase, hazard: str, placement: Placement) -> bool:
+    """Can the smallest ``hazard`` lie on the top the placement puts it on? A 1 m extension cord fits
+    no side table or stair tread, and a task drawn that way fails every build. Placements on the
+    floor, or in or near another object, are left to the layout."""
+    from anomalygen.scene.asset_choice import size_bounds
+    from anomalygen.scene.furniture import TOPS, largest_top
+
+    least = size_bounds(kb, hazard)[0]
+    if placement.relation in ("on", "at_edge") and placement.support in TOPS:
+        return least <= TOP_MARGIN * largest_top(placement.support)[0]
+    if placement.relation == "on" and placement.other is not None and placement.other in catalogue():
+        if placement.other not in _SURFACES:
+            _SURFACES[placement.other] = _largest_surface(kb, placement.other)
+        return _SURFACES[placement.other] == 0.0 or least <= TOP_MARGIN * _SURFACES[placement.other]
+    return True
+
+
 def hazards_for(kb: KnowledgeBase, hc: HazardClass) -> list[str]:
     """The class's hazard candidates that have an asset, can show the states asked of them and, when
     the fix puts them away, fit one of its containers."""
     states = needed_states(kb, hc).get(hc.hazard_variable, [])
     stored = bool(hc.default_containers) and any("$container" in str(step.args) for step in hc.recipe)
-    return [o for o in kb.hazard_candidates(hc) if o in catalogue() and all(state_shown(kb, o, s) for s in states)
+    return [o for o in kb.hazard_candidates(hc) if o in catalogue() and o not in hc.not_drawn
+            and all(state_shown(kb, o, s) for s in states)
             and _part_ok(hc, hc.hazard_variable, o) and (not stored or containers_for(kb, hc, o))]
 
 
@@ -177,6 +210,10 @@ def placements_for(kb: KnowledgeBase, hc: HazardClass, hazard: str) -> list[Plac
             continue
         parent = p.other
         if p.relation == "inside" and not fits_inside(kb, hazard, parent):
+            continue
+        if p.relation == "on" and parent is not None and not load_households().holds_on_top(parent):
+            continue  # a space heater's grille holds no towel: the builder finds no top to set it on
+        if not fits_on(kb, hazard, p):
             continue
         if parent is not None and var is not None and not (all(state_shown(kb, parent, s) for s in states)
                                                            and _part_ok(hc, var, parent)):

@@ -6,8 +6,9 @@ fixtures in 1,000 tasks). A bathtub is not clutter: it stands against a bathroom
 else. ``data/knowledge/households.json`` lists, per fixture and piece of furniture, its rooms, how it
 stands (against a wall, free, on a counter) and what its top is for. The generator draws only rooms
 that every fixture a task names belongs to; a name the table does not hold is portable, and the
-sampler draws it only in the rooms ``objects.json`` keeps it in (``IdeaSampler.found_in``). ``mount``
-and ``top`` are recorded for the builder (fixtures against the walls of their room: not built yet).
+sampler draws it only in the rooms ``objects.json`` keeps it in (``IdeaSampler.found_in``). A ``top``
+of "none" keeps the generator from drawing anything on that fixture (``holds_on_top``); ``mount`` is
+recorded for the builder (fixtures against the walls of their room: not built yet).
 """
 
 from __future__ import annotations
@@ -56,6 +57,12 @@ class Households(BaseModel):
         p = idea.placement
         return self.misplaced_among([idea.hazard, p.support, p.other, idea.container, idea.support,
                                      *idea.co_objects], idea.room)
+
+    def holds_on_top(self, name: str) -> bool:
+        """Can something be set on ``name``? A fixture whose top is for nothing (a space heater's grille,
+        a curtain) holds nothing on it; a portable thing or a support kind is left to the builder."""
+        f = self.fixtures.get(name)
+        return f is None or f.top != "none"
 
     def rooms_for(self, names, rooms) -> list[str]:
         """Those of ``rooms`` that every fixture among ``names`` belongs to, in the given order."""

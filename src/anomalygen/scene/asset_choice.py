@@ -22,6 +22,7 @@ from anomalygen.errors import ItemFailed
 from anomalygen.schema import SWITCH_LABELS, ArticulationUse, ObjectRole, TaskProposal, part_labels
 
 TARGET_CANDIDATES = 3  # generated variants ranked per target
+ROOM_MARGIN = 1.05  # aim a redrawn container this much roomier than the thing it must hold
 EXTRA_DRAWS_FOR_PARTS = 8  # further variants drawn when none so far has the part the task needs
 FIXED_SIZE = 0.55  # m: assets at least this big are furniture (welded), smaller ones are loose
 MIN_OPEN_HINGE = math.radians(50)  # "fridge door open >= 45 deg", with a margin
@@ -263,7 +264,7 @@ def pick_asset(
     A category with real (packaged) models draws those (``real``: ``build.real_assets``); a real
     candidate that does not fit here (too big for the space, without the part the task needs, an
     interior too small for the ``room_for`` m thing to go in it) gives way to the procedural one
-    drawn with the same seed and size. ``stores``: the least size of what the task puts away in
+    drawn with the same seed and size; a procedural one still too small is drawn again, bigger. ``stores``: the least size of what the task puts away in
     it; a container with less room gives way to one with enough (more are drawn), and when none
     has it the roomiest is returned, for the caller to say what does not fit."""
     from anomalygen.assets.core import draw, generate
@@ -274,12 +275,13 @@ def pick_asset(
     seeds = [int(s) for s in rng.integers(0, 2**31 - 1, size=n)]
     candidates, problems, cramped = [], [], []
     drawn = 0
+    roomier: float | None = None  # after a cramped container: the size whose room would hold ``stores``
     # a needed part may be on only some variants (one table in three has a drawer): draw on, up to
     # EXTRA_DRAWS_FOR_PARTS more, until one has it; a scene whose first draws pass is unchanged
-    while drawn < n or ((parts or stores) and not candidates and drawn < n + EXTRA_DRAWS_FOR_PARTS):
+    while drawn < n or ((parts or stores or room_for) and not candidates and drawn < n + EXTRA_DRAWS_FOR_PARTS):
         s = seeds[drawn] if drawn < n else int(rng.integers(0, 2**31 - 1))
         drawn += 1
-        want = choose_size(kb, catalogue, rng, cap=cap, preferred=size)
+        want = choose_size(kb, catalogue, rng, cap=cap, preferred=size if roomier is None else roomier)
         asset = draw(catalogue, s, size=want, real=real)
         problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap, states=states)
         if problem is None and asset.package is not None and room_for and asset.cavities \
@@ -289,8 +291,15 @@ def pick_asset(
             problems.append(f"real model {asset.asset_id}: {problem}")
             asset = generate(catalogue, s, size=want)
             problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap, states=states)
+        if problem is None and room_for and asset.cavities and cavity_cap(asset) < room_for:
+            cramped.append(asset)  # a sink too small for the kettle the line puts in it: draw it bigger
+            roomier = max(roomier or 0.0, asset.size * room_for / max(cavity_cap(asset), 1e-6) * ROOM_MARGIN)
+            continue
         if problem is None and stores and asset.cavities and container_room(asset) < stores:
             cramped.append(asset)
+            # a container's room grows with its size: the next draws aim where this one would hold it
+            # (the generator checked the roomiest size; a uniform draw rarely lands there)
+            roomier = max(roomier or 0.0, asset.size * stores / max(container_room(asset), 1e-6) * ROOM_MARGIN)
             continue
         if problem is None:
             candidates.append(asset)

@@ -79,11 +79,11 @@ class Built:
 
 
 def _plan(task: TaskProposal, settings: Settings, rng, hints=None,
-          hazard_free: bool = False) -> tuple[Layout, dict[str, str], dict[str, Placed]]:
+          hazard_free: bool = False, attempt: int = 0) -> tuple[Layout, dict[str, str], dict[str, Placed]]:
     """Choose and place every object; returns the layout, bindings and instances by name.
 
     A hazard-free scene has no bindings: there is nothing to fix, and the oracle plans nothing."""
-    sel = select_objects(task, rng, hints, real_assets=settings.build.real_assets)
+    sel = select_objects(task, rng, hints, real_assets=settings.build.real_assets, repair=attempt)
     sel.hazard_free = hazard_free
     set_initial_joints(sel)
     lay, placed, support = place(sel, settings)
@@ -119,7 +119,7 @@ def _attempt(task: TaskProposal, seed: int, settings: Settings, attempt: int, hi
 
     rng = item_rng(seed, task.id, attempt)
     hints = hints.model_copy(deep=True) if hints is not None else None  # each attempt records its own
-    lay, bindings, placed = _plan(task, settings, rng, hints, hazard_free)
+    lay, bindings, placed = _plan(task, settings, rng, hints, hazard_free, attempt)
     notes = _hint_notes(hints, lay)
     mjspec, views = compose_scene(lay, placed, settings, rng)
     model = mjspec.compile()

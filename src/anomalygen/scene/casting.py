@@ -71,6 +71,7 @@ class Selection:
     hints: object | None = None  # scene/hints.py: sizes, positions and auxiliaries from the LLM engine
     hazard_free: bool = False  # build the task's hazard in its safe state (scene/mix.py)
     real_assets: bool = True  # draw a category's real (packaged) models where it has any (build.real_assets)
+    repair: int = 0  # the build attempt: a repair draws the object at fault from the small end of its range
 
     @property
     def placement(self) -> Placement:
@@ -113,15 +114,28 @@ class Selection:
         self.used.discard(ch.name)
 
 
-def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = True) -> Selection:
+def _repair_cap(sel: Selection, raw: str, cap: float | None) -> float | None:
+    """The largest size a repair draws the object at fault in: the lower ``1 / (repair + 1)**2`` of its
+    range. Most failed attempts are a thing too big for where it goes (a 2 m cord on a table, a
+    stair tread or between furniture); drawing it again at random fails the same way."""
+    if sel.repair <= 0:
+        return cap
+    lo, hi = asset_choice.size_bounds(sel.kb, asset_choice.resolve_name(raw))
+    shrunk = lo + (hi - lo) / (sel.repair + 1) ** 2
+    return shrunk if cap is None else min(cap, shrunk)
+
+
+def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = True, repair: int = 0) -> Selection:
     """Choose an asset for every role the task needs (target, hazard, container, supports, co-objects).
 
     ``hints`` (scene/hints.py, from the LLM engine) supply sizes, floor positions and the auxiliary
     objects instead of the random draws; every correction is noted in them or in the layout.
-    ``real_assets`` False builds every object from the procedural generators (a comparison run)."""
+    ``real_assets`` False builds every object from the procedural generators (a comparison run).
+    ``repair``: the attempt number; a repair draws the object at fault smaller (``_repair_cap``)."""
     kb = load_kb()
     sc = task.scenario
-    sel = Selection(task, rng, kb, kb.hazard_classes.get(task.hazard_class), hints=hints, real_assets=real_assets)
+    sel = Selection(task, rng, kb, kb.hazard_classes.get(task.hazard_class), hints=hints, real_assets=real_assets,
+                    repair=repair)
     relation, parent_raw = sel.placement.relation, sel.parent_raw
     hc, variables = sel.hc, sel.variables
     sel.hazard_is_target = asset_choice.resolve_name(sc.hazard_object) == asset_choice.resolve_name(task.target_asset)
@@ -142,6 +156,7 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
         task.target_asset, ObjectRole.HAZARD if sel.hazard_is_target else ObjectRole.TARGET, rank=True,
         room_for=room_for if asset_choice.resolve_name(task.target_asset) == holder else None,
         stores=least_hazard if stores_hazard else None,
+        cap=_repair_cap(sel, task.target_asset, None) if sel.hazard_is_target else None,
     )
     parent = sel.parent = sel.choose(parent_raw, ObjectRole.AUXILIARY, room_for=room_for) if parent_raw else None
     cap = None
@@ -149,7 +164,7 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
         if not parent.asset.cavities:
             raise ItemFailed(f"placement {sel.placement} but {parent.catalogue} has no interior")
         cap = asset_choice.cavity_cap(parent.asset)
-    hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=cap)
+    hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=_repair_cap(sel, sc.hazard_object, cap))
     if hazard is target:
         target.role = ObjectRole.HAZARD
 
@@ -158,7 +173,8 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
         _first_known(hc.default_containers) if "$container" in variables else None
     )
     if container_name:
-        container = sel.choose(container_name, ObjectRole.CONTAINER)
+        container = sel.choose(container_name, ObjectRole.CONTAINER,
+                               stores=hazard.size if container_name != sc.hazard_object else None)
         if container is not hazard and container.asset.cavities:
             # The hazard must be able to go in: a 0.5 m plastic bag does not fit a 0.3 m bucket.
             # Draw the container again (other sizes), then a smaller hazard, before giving up.
@@ -167,7 +183,7 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
                 if hazard.size <= container_room(container.asset):
                     break
                 sel.forget(container)
-                container = sel.choose(container_name, ObjectRole.CONTAINER)
+                container = sel.choose(container_name, ObjectRole.CONTAINER, stores=hazard.size)
             # Another kind only when the task left the container open: a named bucket stays a bucket.
             if hazard.size > container_room(container.asset) and container is not target and not sc.container:
                 container = _roomier_kind(sel, hc, container, container_name, hazard.size)

@@ -54,24 +54,30 @@ class Support:
         )
 
 
+#: Half extents (depth, width ranges, m) and board thickness of each support kind's top.
+TOPS: dict[str, tuple[tuple[float, float], tuple[float, float], float]] = {
+    "shelf": ((0.13, 0.18), (0.35, 0.5), 0.03),
+    "counter": ((0.28, 0.32), (0.5, 0.7), 0.04),
+    "low_table": ((0.25, 0.35), (0.35, 0.5), 0.03),
+    "table": ((0.35, 0.45), (0.45, 0.6), 0.035),
+}
+
+
+def largest_top(kind: str) -> tuple[float, float]:
+    """The largest (width, depth) a support kind's top is drawn with (m): what brainstorming may
+    put on it (``brainstorm/drawable.py``)."""
+    (_, dhi), (_, whi), _ = TOPS.get(kind, TOPS["table"])
+    return 2 * whi, 2 * dhi
+
+
 def sample_support(kind: str, rng: np.random.Generator) -> Support:
     lo, hi = _heights().get(kind, DEFAULT_HEIGHTS[kind])
     if kind == "shelf":
         hi = min(hi, DEFAULT_HEIGHTS["shelf"][1])
         lo = min(lo, hi)
     top = float(rng.uniform(lo, hi))
-    if kind == "shelf":
-        half = (float(rng.uniform(0.13, 0.18)), float(rng.uniform(0.35, 0.5)))
-        thickness = 0.03
-    elif kind == "counter":
-        half = (float(rng.uniform(0.28, 0.32)), float(rng.uniform(0.5, 0.7)))
-        thickness = 0.04
-    elif kind == "low_table":
-        half = (float(rng.uniform(0.25, 0.35)), float(rng.uniform(0.35, 0.5)))
-        thickness = 0.03
-    else:
-        half = (float(rng.uniform(0.35, 0.45)), float(rng.uniform(0.45, 0.6)))
-        thickness = 0.035
+    (dlo, dhi), (wlo, whi), thickness = TOPS.get(kind, TOPS["table"])
+    half = (float(rng.uniform(dlo, dhi)), float(rng.uniform(wlo, whi)))
     return Support(kind, half, top, thickness)
 
 
