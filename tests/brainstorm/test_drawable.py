@@ -91,3 +91,31 @@ def test_the_text_names_the_object_beside_the_hazard_once():
             situation = p.description.replace(kb.hazard_classes[p.hazard_class].why, "").replace(p.solution, "")
             # the danger and the fix may name it; the situation says it once
             assert situation.lower().count(name) <= 1, (place, p.description)
+
+
+def test_nothing_is_drawn_on_a_top_that_holds_nothing_or_is_too_small():
+    """A space heater's grille holds no towel (households.json: its top is for nothing), and a 1 m
+    extension cord fits no side table or stair tread: such draws failed every build."""
+    from anomalygen.brainstorm.drawable import fits_on
+    from anomalygen.knowledge.households import load_households
+
+    kb = load_kb()
+    assert not load_households().holds_on_top("SpaceHeater") and load_households().holds_on_top("Stove")
+    for hc in kb.hazard_classes.values():
+        for hazard in kb.hazard_candidates(hc):
+            for p in placements_for(kb, hc, hazard):
+                assert not (p.relation == "on" and p.other == "SpaceHeater"), (hc.id, hazard)
+    assert not fits_on(kb, "extension_cord", Placement(relation="on", support="low_table"))
+    assert not fits_on(kb, "extension_cord", Placement(relation="on", other="Stairs"))
+    assert fits_on(kb, "extension_cord", Placement(relation="on", support="table"))
+    assert fits_on(kb, "book", Placement(relation="on", other="Stairs"))
+
+
+def test_objects_a_kind_does_not_draw_yet_are_still_read_and_judged():
+    """A kettle by a full sink is electricity near water: the truth and a user's line hold it, though
+    brainstorming does not draw it yet (``not_drawn``)."""
+    from anomalygen.brainstorm.drawable import hazards_for
+
+    kb = load_kb()
+    hc = kb.hazard_classes["move_electrical_away_from_water"]
+    assert "Kettle" in kb.hazard_candidates(hc) and "Kettle" not in hazards_for(kb, hc)

@@ -135,10 +135,10 @@ class TextGrounder:
                 container, mentioned) -> list[GroundingMatch]:
         hc = comp.hc
         out = [GroundingMatch(field="scenario.hazard_object", written=comp.fault.words, grounded=comp.fault.name,
-                              method="lexicon" if comp.fault.called else "parsed", kind=comp.fault.kind)]
+                              method="lexicon" if comp.fault.kind else "parsed", kind=comp.fault.kind)]
         if comp.other is not None:
             out.append(GroundingMatch(field=f"relation.{comp.other.relation}", written=f"{comp.other.prep} {comp.other.words}",
-                                      grounded=comp.other.name, method="lexicon" if comp.other.called else "parsed",
+                                      grounded=comp.other.name, method="lexicon" if comp.other.kind else "parsed",
                                       kind=comp.other.kind))
         if comp.condition_words:
             out.append(GroundingMatch(field="state", written=", ".join(comp.condition_words),

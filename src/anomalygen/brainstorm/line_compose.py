@@ -26,6 +26,11 @@ from anomalygen.schema import RELATION_KINDS, Placement
 #: Evidence weights (unitless scores): a relation to a fitting object outweighs cue words, which
 #: outweigh a place or condition the class needs no words for.
 RELATION_EVIDENCE = 3.0
+FAMILY_DISCOUNT = 0.5  # a relation of the place's family (on the rim of a filled bath is near its water)
+#: Relations that imply another: what lies on or in a thing is near it (a hair dryer on the edge of a
+#: filled basin, a battery in a cot). A place keyed to "near" is met by them, a little less strongly
+#: than by "near" itself, so a place keyed to "on" or "inside" wins where the line says exactly that.
+RELATION_FAMILY: dict[str, tuple[str, ...]] = {"near": ("on", "inside", "at"), "on": ("at",), "inside": ("at",)}
 CUE_EVIDENCE = 2.0
 DEFAULT_EVIDENCE = 0.3
 FIRST_SUBJECT_BONUS = 1.0
@@ -37,7 +42,8 @@ MAX_EXTRA_CUES = 3
 SURFACE_WORDS: tuple[tuple[tuple[str, ...], Placement], ...] = (
     (("coffee table", "side table", "low table", "nightstand", "bedside table", "bedside", "footstool", "ottoman",
       "sofa table", "end table"), Placement(relation="on", support="low_table")),
-    (("counter", "countertop", "worktop", "benchtop", "kitchen counter", "work surface", "draining board"),
+    (("counter", "countertop", "worktop", "benchtop", "kitchen counter", "work surface", "draining board",
+      "breakfast bar", "kitchen island"),
      Placement(relation="on", support="counter")),
     (("table", "desk", "dining table", "kitchen table", "workbench"), Placement(relation="on", support="table")),
     (("shelf", "shelves", "bookshelf", "bookcase", "top shelf", "high shelf"), Placement(relation="on", support="shelf")),
@@ -74,7 +80,7 @@ def compose_line(p: ParsedLine, kb: KnowledgeBase, ms: MechanismSet, g: NameGrou
     subjects = p.subjects() or p.mentions[:1]
     _refuse_unknown_subject(p, subjects, g)
     beneath = next((m for m in p.mentions if m.relation == "under" and m is not subjects[0]
-                    and "soft" in kb.objects[m.name].properties), None)
+                    and "soft" in kb.objects[m.name].properties and not _hangs(m.name)), None)
     if beneath is not None:  # under a table is on the floor; nothing is built under a rug or a blanket
         raise Refused(f"no mechanism for {subjects[0].name} {beneath.prep} {beneath.name}: nothing can be built under another object")
     options: list[Composition] = []
@@ -92,6 +98,14 @@ def compose_line(p: ParsedLine, kb: KnowledgeBase, ms: MechanismSet, g: NameGrou
     if not options:
         raise Refused(_no_mechanism(p, subjects, near_misses, kb))
     return max(options, key=lambda c: (c.score, c.hc.severity, c.hc.id))
+
+
+def _hangs(name: str) -> bool:
+    """A soft thing that hangs on a wall (curtains): under it is beside it, not beneath a cover."""
+    from anomalygen.knowledge.households import load_households
+
+    f = load_households().fixtures.get(name)
+    return f is not None and f.mount == "wall"
 
 
 def _refuse_unknown_subject(p: ParsedLine, subjects: list[Mention], g: NameGrounder) -> None:
@@ -134,14 +148,14 @@ def _evidence(p: ParsedLine, kb: KnowledgeBase, ms: MechanismSet, hc: HazardClas
     place = ms.places[comp.place]
     score, other, place_words = 0.0, None, []
     if place.relation is not None:
-        other = _related(p, kb, hc, fault, place.relation)
+        other, exact = _related(p, kb, hc, fault, place.relation)
         if other is None:
             target = place.relation.category or place.relation.variable or "?"
             return None, f"{place.relation.type} {target.lstrip('$')}"
-        score += RELATION_EVIDENCE
+        score += RELATION_EVIDENCE - (0.0 if exact else FAMILY_DISCOUNT)
         place_words = [other.words]
     elif place.cues:
-        place_words = p.said(place.cues)
+        place_words = p.said(place.cues) or _placed_as(p, fault, place)
         if not place_words:
             return None, place.words or comp.place
         score += CUE_EVIDENCE + EXTRA_CUE * min(len(place_words) - 1, MAX_EXTRA_CUES)
@@ -163,20 +177,41 @@ def _evidence(p: ParsedLine, kb: KnowledgeBase, ms: MechanismSet, hc: HazardClas
             return None, cond.words or comp.condition
     used = {id(other)} if other is not None else set()
     unused = [m for m in p.mentions if m.relation in ("on", "inside", "near") and m is not fault and id(m) not in used
-              and m.name not in ("counter", "Table", "shelf")]
+              and m.name not in ("counter", "Table", "shelf") and m.words not in place_words]
     score -= UNUSED_RELATION_PENALTY * len(unused)
     return Composition(hc, fault, other, score, place_words, cond_words, assumed), ""
 
 
-def _related(p: ParsedLine, kb: KnowledgeBase, hc: HazardClass, fault: Mention, relation) -> Mention | None:
-    """The named object the line relates the fault to in the way the place needs, fitting its variable."""
+def _related(p: ParsedLine, kb: KnowledgeBase, hc: HazardClass, fault: Mention,
+             relation) -> tuple[Mention | None, bool]:
+    """The named object the line relates the fault to in the way the place needs, fitting its
+    variable, and whether the line said that very relation (False: one of its family, RELATION_FAMILY)."""
     fits = set(kb.static_candidates(hc, relation.variable)) if relation.variable else {relation.category}
+    wanted = relation.type.split("|")
+    family = {r for w in wanted for r in RELATION_FAMILY.get(w, ())} - set(wanted)
+    loose = None
     for m in p.mentions:
         if m is fault or m.name not in fits:
             continue
-        if m.relation in relation.type.split("|"):
-            return m
-    return None
+        if m.relation in wanted:
+            return m, True
+        if loose is None and (m.relation in family or ("near" in wanted and m.relation == "under" and _hangs(m.name))):
+            loose = m  # (under the curtains is beside them: they hang)
+    return loose, False
+
+
+def _placed_as(p: ParsedLine, fault: Mention, place) -> list[str]:
+    """The words of a named object the line puts the fault on or in as one of the place's own placements
+    ("a pot on the stovetop" states the hob of ``on:Stove``), when no cue word says the place."""
+    from anomalygen.schema import Placement
+
+    out = []
+    for m in p.mentions:
+        if m is fault or m.relation not in ("on", "inside"):
+            continue
+        if any(isinstance(t, Placement) and t.relation == m.relation and t.other == m.name for t in place.placements):
+            out.append(m.words)
+    return out
 
 
 def _no_mechanism(p: ParsedLine, subjects: list[Mention], near: list, kb: KnowledgeBase) -> str:

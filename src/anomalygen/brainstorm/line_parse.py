@@ -22,12 +22,18 @@ _WORD = re.compile(r"[a-z0-9]+_|[a-z0-9]+(?:'[a-z]+)?|[,.;:!?]")
 RELATIONS: tuple[tuple[str, str], ...] = (
     ("on top of", "on"), ("right on", "on"), ("draped over", "on"), ("resting on", "on"), ("lying on", "on"),
     ("sitting on", "on"), ("on", "on"), ("onto", "on"), ("atop", "on"), ("over", "on"), ("across", "on"),
-    ("at the bottom of", "inside"), ("inside", "inside"), ("into", "inside"), ("in", "inside"), ("within", "inside"),
+    ("in the same cupboard as", "near"), ("in the same cabinet as", "near"), ("on the same shelf as", "near"),
+    ("in the same drawer as", "near"), ("same shelf as", "near"), ("same cupboard as", "near"),
+    ("at the bottom of", "at"), ("at the top of", "at"), ("at the foot of", "at"), ("at the head of", "at"),
+    ("inside", "inside"), ("into", "inside"), ("in", "inside"), ("within", "inside"),
     ("next to", "near"), ("close to", "near"), ("near to", "near"), ("right by", "near"), ("up against", "near"),
     ("beside", "near"), ("besides", "near"), ("by", "near"), ("near", "near"), ("against", "near"), ("alongside", "near"),
     ("touching", "near"), ("around", "near"), ("from", "near"), ("under", "under"), ("underneath", "under"),
-    ("beneath", "under"), ("below", "under"), ("behind", "near"),
+    ("beneath", "under"), ("below", "under"), ("behind", "near"), ("right above", "near"), ("just above", "near"),
+    ("above", "near"),
 )
+#: ^ "at the bottom of" a bucket is in it and at the top of the stairs is on them: "at" is met by the
+#: place's own relation through ``line_compose.RELATION_FAMILY``. Above a heater is near it.
 #: Words that may stand between a preposition and the name it governs ("on the old kitchen stove").
 FILLER = frozenset({
     "the", "a", "an", "my", "our", "your", "his", "her", "their", "its", "this", "that", "these", "those", "some",
@@ -69,7 +75,15 @@ NOT_OBJECTS = frozenset({
     "hazard", "danger", "level", "area", "spot", "place", "position", "wall", "window sill", "sill", "handle",
     part_labels.LID, part_labels.DOOR, part_labels.DRAWER, part_labels.KNOB, part_labels.SWITCH, part_labels.TAP, "plug", "outlet", "socket", "cord", "cable", "shelf", "one", "ones",
     "inch", "inches", "foot", "feet", "metre", "metres", "meter", "meters", "cm", "little",
+    *("mum", "mom", "mummy", "mommy", "mother", "dad", "daddy", "father", "granny", "gran", "nan", "nana", "nanna",
+      "grandad", "granddad", "grandpa", "gramps", "grandmother", "grandfather", "grandparent", "grandparents",
+      "grandkids", "grandchild", "grandchildren", "son", "daughter", "brother", "sister", "husband", "wife",
+      "partner", "aunt", "auntie", "uncle", "cousin", "nephew", "niece", "carer", "caregiver", "nanny", "babysitter",
+      "resident", "tenant", "landlord", "flatmate", "roommate", "housemate", "neighbour", "neighbor", "visitor",
+      "visitors", "toddlers", "teenager", "teen", "boy", "girl", "boys", "girls", "man", "woman", "men", "women",
+      "patient", "elderly", "year", "years", "month", "months", "smell", "sound", "noise", "half", "quarter"),
 })
+#: ^ people, kin and carers (a possessor, "Mum's mug", or the person at risk) and amounts, never a thing at fault
 #: Catalogue names that, right after another name, are a part of it ("fridge door", "toilet lid").
 PART_NAMES = frozenset({"Door", "Window"})
 #: Catalogue containers whose "X of Y" names Y as the thing ("a bottle of bleach", "a box of matches").
@@ -88,6 +102,7 @@ class Mention:
     prep: str | None = None
     called: str | None = None  # the user's word, when the name is a proxy shape of its kind (the lexicon)
     kind: str | None = None  # the lexicon kind of ``called``
+    method: str | None = None  # how the words matched the name: exact, normalised, alias (None: the lexicon)
 
 
 @dataclass
@@ -199,7 +214,9 @@ def parse_line(line: str, g: NameGrounder, *, longest: int = 4, lexicon: Lexicon
             phrase = " ".join(words[i:i + n])
             hit = g.objects.spelled(phrase, pool)
             if hit is not None:
-                found.append(Mention(i, i + n, hit[0], phrase))
+                # an alias is another word for the shape ("bags" for the backpack): the user's word stays
+                called = phrase if hit[1] == "alias" and n > 0 and _own_words(hit[0]) != singular(phrase) else None
+                found.append(Mention(i, i + n, hit[0], phrase, method=hit[1], called=called))
             elif lexicon is not None and (reading := lexicon.read(phrase, buildable)) is not None \
                     and reading.proxy in pool:
                 found.append(Mention(i, i + n, reading.proxy, phrase, called=phrase, kind=reading.kind))
@@ -208,15 +225,24 @@ def parse_line(line: str, g: NameGrounder, *, longest: int = 4, lexicon: Lexicon
             taken[i:i + n] = [True] * n
     found.sort(key=lambda m: m.start)
     found = [_with_modifier(m, words, taken, g, pool) for m in found]
-    found = _merge(found, words)
+    found, compounds = _merge(found, words, {i for i, t in enumerate(tokens) if t.endswith("'s")})
+    for at, end in compounds:
+        taken[at:end] = [False] * (end - at)  # a compound of two names is neither: read as unknown words below
     for m in found:
         m.relation, m.prep = relation_before(words, m.start)
     unknown = _unknown_phrases(words, taken, g)
+    unknown = sorted(set(unknown) | {(at, " ".join(words[at:end])) for at, end in compounds})
     if lexicon is not None and unknown:
         found, unknown = _nearest_words(found, unknown, words, pool, buildable)
     parsed = ParsedLine(line, tokens, found, rooms=g.rooms.mentions(line))
     parsed.unknown = unknown
     return parsed
+
+
+def _own_words(name: str) -> str:
+    """A catalogue name as words ('toy_block' -> 'toy block', 'PaperTowels' -> 'paper towel')."""
+    spaced = re.sub(r"(?<=[a-z])(?=[A-Z])", " ", name).replace("_", " ").lower()
+    return singular(spaced)
 
 
 def _nearest_words(found: list[Mention], unknown: list[tuple[int, str]], words: list[str], pool: set[str],
@@ -264,9 +290,14 @@ def _with_modifier(m: Mention, words: list[str], taken: list[bool], g: NameGroun
     return m
 
 
-def _merge(found: list[Mention], words: list[str]) -> list[Mention]:
-    """'bottle of bleach' -> the bleach; 'fridge door' -> the fridge; a name said twice -> once."""
+def _merge(found: list[Mention], words: list[str],
+           possessive: frozenset[int] | set[int] = frozenset()) -> tuple[list[Mention], list[tuple[int, int]]]:
+    """'bottle of bleach' -> the bleach; 'fridge door' -> the fridge; a name said twice -> once.
+
+    Also returns the spans of compounds that name neither of their parts: a one-word alias after
+    another name ('knife block': a block only by alias) is another thing, not the alias's object."""
     out: list[Mention] = []
+    compounds: list[tuple[int, int]] = []
     for m in found:
         prev = out[-1] if out else None
         if prev is not None and m.name in PART_NAMES and m.start == prev.end:
@@ -274,6 +305,11 @@ def _merge(found: list[Mention], words: list[str]) -> list[Mention]:
         if prev is not None and m.start == prev.end:
             if m.name in CONTAINER_WORDS and prev.name not in CONTAINER_WORDS:
                 continue  # 'a vitamin bottle', 'the bleach jug': the container of a thing is the thing
+            if m.method == "alias" and m.end - m.start == 1 and prev.kind is None and m.kind is None \
+                    and prev.end - 1 not in possessive:  # 'the iron's cord' is the iron's own cord
+                out.pop()  # 'knife block', 'shoe rack': the head is the alias's object only in name
+                compounds.append((prev.start, m.end))
+                continue
             out[-1] = m  # 'bread knife', 'glass vase': the last noun names the thing
             continue
         if prev is not None and prev.name in CONTAINER_WORDS and words[prev.end:prev.end + 1] == ["of"] \
@@ -285,7 +321,7 @@ def _merge(found: list[Mention], words: list[str]) -> list[Mention]:
         out.append(m)
     # "the door of the oven": the part goes, the owner stays
     return [m for i, m in enumerate(out) if not (m.name in PART_NAMES and i + 1 < len(out)
-                                                  and words[m.end:m.end + 1] == ["of"] and out[i + 1].start - m.end <= 3)]
+                                                  and words[m.end:m.end + 1] == ["of"] and out[i + 1].start - m.end <= 3)], compounds
 
 
 def word_classes(word: str) -> set[str]:

@@ -63,6 +63,8 @@ class Fragment(KBModel):
     params: dict[str, str] = Field(default_factory=dict, description="values a fix may use, e.g. {label}")
     placements: list[Placement] = Field(default_factory=list, description="scenario placements that set it up; '{other}' = the related object")
     hazard_objects: list[str] = Field(default_factory=list, description="a kind's curated objects (empty: any that fits)")
+    not_drawn: list[str] = Field(default_factory=list, description="of those, objects the generator does not draw "
+                                 "yet (a user's line, the truth and the detector still hold them)")
     articulation: PartState | None = None
     states: dict[str, list[str]] = Field(default_factory=dict, description="instance states a scene must show, by variable")
     relation: Relation | None = None
@@ -226,6 +228,7 @@ def compose(ms: MechanismSet, m: Mechanism, c: Composition, kind_id: str) -> Haz
         default_containers=list(c.containers),
         default_supports=list(c.supports),
         hazard_objects=list(kind.hazard_objects),
+        not_drawn=list(kind.not_drawn),
         target_assets=list(c.targets),
         rooms=list(c.rooms),
         articulation=articulation,

@@ -179,6 +179,10 @@ class HazardClass(KBModel):
         default_factory=list,
         description="curated catalogue names for the hazard variable; empty = every object meeting its intrinsic preconditions",
     )
+    not_drawn: list[str] = Field(
+        default_factory=list,
+        description="hazard objects brainstorming does not draw yet; a user's line, the truth and the detector hold them",
+    )
     target_assets: list[str] = Field(description="target categories a proposal of this class may name")
     rooms: list[str] = Field(default_factory=list)
     articulation: ArticulationTemplate | None = None
