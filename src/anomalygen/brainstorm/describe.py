@@ -161,6 +161,17 @@ def hot_word(kb, obj: str, hc, said: str) -> str:
     return table.get(obj, table["default"])
 
 
+def _condition_words(hc) -> str | None:
+    """A composed class's dangerous state in words that follow a place ("with its handle sticking
+    out"), when the object's own state is not said otherwise: the danger sentence relies on it."""
+    if hc.composition is None or not hc.composition.condition:
+        return None
+    from anomalygen.knowledge.mechanisms import load_mechanisms
+
+    cond = load_mechanisms().conditions.get(hc.composition.condition)
+    return cond.words if cond is not None and cond.words.startswith("with ") else None
+
+
 def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, part: str, state: str, room: str,
                        container: str, support: str) -> list[Fragment]:
     """The description as tagged fragments: the tagged pieces (place, state, danger, fix, person),
@@ -181,6 +192,12 @@ def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, 
         owner = f"the {hazard}" if whole else f"the {part} of the {hazard}"
         situation = f"{cap(owner)} in the {room} {st.text}."
         out.append(st)
+        p = idea.placement
+        if p.other is not None and p.relation == "near" and p.other != idea.hazard:
+            # the heater left on beside the curtains: the danger sentence is about what it stands by
+            near = Fragment(f"It is right next to the {say(p.other)}.", "relation", "near")
+            out.append(near)
+            situation += f" {near.text}"
     else:
         quality = "" if own_state else hot_word(kb, idea.hazard, hc, hazard)  # an iron left on: said next
         if quality:
@@ -197,6 +214,9 @@ def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, 
             st = state_fragment(state, rng)  # an iron left on, as well as where it lies
             out.append(st)
             situation += f" It {st.text}."
+        elif (cond := _condition_words(hc)) is not None:
+            out.append(Fragment(cond, "state", hc.composition.condition))  # a pot with its handle sticking out
+            situation = f"{situation[:-1]} {cond}."
     out.append(Fragment(room, "room", idea.room))
     # objects the hazard needs besides its own (the candle whose fumes fill a shut room): said, never clutter
     needed = [c for c, var in zip(idea.co_objects, secondary_variables(hc), strict=False)
