@@ -30,7 +30,7 @@ FAMILY_DISCOUNT = 0.5  # a relation of the place's family (on the rim of a fille
 #: Relations that imply another: what lies on or in a thing is near it (a hair dryer on the edge of a
 #: filled basin, a battery in a cot). A place keyed to "near" is met by them, a little less strongly
 #: than by "near" itself, so a place keyed to "on" or "inside" wins where the line says exactly that.
-RELATION_FAMILY: dict[str, tuple[str, ...]] = {"near": ("on", "inside", "at"), "on": ("at",), "inside": ("at",)}
+RELATION_FAMILY: dict[str, tuple[str, ...]] = {"near": ("on", "inside", "at", "under"), "on": ("at",), "inside": ("at",)}
 CUE_EVIDENCE = 2.0
 DEFAULT_EVIDENCE = 0.3
 FIRST_SUBJECT_BONUS = 1.0

@@ -22,7 +22,8 @@ from anomalygen.errors import ItemFailed
 from anomalygen.schema import SWITCH_LABELS, ArticulationUse, ObjectRole, TaskProposal, part_labels
 
 TARGET_CANDIDATES = 3  # generated variants ranked per target
-ROOM_MARGIN = 1.05  # aim a redrawn container this much roomier than the thing it must hold
+ROOM_MARGIN = 1.4  # aim a redrawn container this much roomier than the thing it must hold: a tight fit
+# builds but the robot cannot drop or slide the thing in (a milk carton over a bin just its size)
 EXTRA_DRAWS_FOR_PARTS = 8  # further variants drawn when none so far has the part the task needs
 FIXED_SIZE = 0.55  # m: assets at least this big are furniture (welded), smaller ones are loose
 MIN_OPEN_HINGE = math.radians(50)  # "fridge door open >= 45 deg", with a margin
