@@ -241,6 +241,9 @@ def why_not_drawable(kb: KnowledgeBase, hc: HazardClass) -> str | None:
 def _why_not(kb: KnowledgeBase, hc: HazardClass) -> str | None:
     from anomalygen.plan.planner import plannable
 
+    if hc.undrawn_because:
+        return f"{hc.id} is not drawn yet: {hc.undrawn_because}"
+
     missing = [step.action for step in hc.recipe if not plannable(step.action)]
     if missing:
         return f"no skill for {missing[0]} yet: {hc.id}'s fix needs it"

@@ -183,6 +183,8 @@ class HazardClass(KBModel):
         default_factory=list,
         description="hazard objects brainstorming does not draw yet; a user's line, the truth and the detector hold them",
     )
+    undrawn_because: str | None = Field(
+        None, description="why brainstorming does not draw this class yet (None: it does); users' lines still compose it")
     target_assets: list[str] = Field(description="target categories a proposal of this class may name")
     rooms: list[str] = Field(default_factory=list)
     articulation: ArticulationTemplate | None = None
