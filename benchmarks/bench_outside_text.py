@@ -72,6 +72,8 @@ def judge(row: dict, kb, tg) -> dict:
         _, comp = tg.compose(row["line"])
     except Refused as exc:
         out.update(outcome="refused", reason=str(exc), verdict="faithful" if expect_refusal else "wrong_refusal")
+        if not expect_refusal:
+            out["refusal_type"] = _refusal_type(str(exc))
         return out
     mech = comp.hc.composition.mechanism
     called = normalise(comp.fault.called) if getattr(comp.fault, "called", None) else None  # (older readers lack it)
@@ -84,12 +86,28 @@ def judge(row: dict, kb, tg) -> dict:
     task = tg.proposal(row["line"], 1)
     built_on = task.target_asset if comp.hc.about_target else task.scenario.hazard_object
     ok = ok and built_on == comp.fault.name
+    if not ok:
+        out["substitution_type"] = ("out of scope, composed" if expect_refusal else
+                                    "the task's object is not the one read" if right_object and mech in row["danger"] else
+                                    "another danger" if right_object else
+                                    "another object" if mech in row["danger"] else "another object and danger")
     out.update(outcome="composed", hazard_class=comp.hc.id, mechanism=mech, object=comp.fault.name,
                called=getattr(comp.fault, "called", None), other=comp.other.name if comp.other else None, built_on=built_on,
                verdict="faithful" if ok else "substitution")
     missing = [n for n in (comp.fault.name, comp.other.name if comp.other else None) if n and n not in tg_catalogue()]
     out["needs_assets"] = missing
     return out
+
+
+def _refusal_type(reason: str) -> str:
+    """A refusal's reason as a type (what was missing), so a half is described without its lines."""
+    if reason.startswith("no object"):
+        return "a word neither the catalogue nor the lexicon holds"
+    if reason.startswith("no mechanism puts"):
+        return "no mechanism for the object's kinds"
+    if reason.startswith("no mechanism for") and "(needs " in reason:
+        return "a mechanism's place or state not read: needs " + reason.rsplit("(needs ", 1)[1].rstrip(")")
+    return "other: " + reason.split(" (the line says")[0].split(":")[0][:60]
 
 
 def reading(line: str, tg) -> tuple:
@@ -171,6 +189,9 @@ def table(results: list[dict]) -> dict:
         "in_scope_faithful": sum(r["in_scope"] and r["verdict"] == "faithful" for r in results),
         "out_of_scope": sum(not r["in_scope"] for r in results),
         "out_of_scope_refused": sum(not r["in_scope"] and r["outcome"] == "refused" for r in results),
+        "substitution_types": dict(Counter(r["substitution_type"] for r in results if "substitution_type" in r
+                                           and r["verdict"] == "substitution").most_common()),
+        "wrong_refusal_types": dict(Counter(r["refusal_type"] for r in results if "refusal_type" in r).most_common()),
     }
 
 
@@ -277,6 +298,9 @@ def main() -> None:
               f"refused {t['refused']:2d}  composed {t['composed']:2d} (needing assets {t['composed_needing_assets']})")
         print(f"{'':9s} in scope {t['in_scope']:3d}: {t['in_scope_faithful']:3d} faithful; out of scope "
               f"{t['out_of_scope']:2d}: {t['out_of_scope_refused']:2d} refused")
+    for name, t in report["halves"].items():
+        print(f"{name:9s} substitutions by type: {t['substitution_types']}")
+        print(f"{'':9s} wrong refusals by type: {t['wrong_refusal_types']}")
     print("per source:")
     for s, t in report["sources"].items():
         print(f"  {s:40s} {t['faithful']:2d}/{t['lines']:2d} faithful, {t['substitutions']} substituted, "
