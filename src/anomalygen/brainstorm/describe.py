@@ -223,7 +223,8 @@ def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, 
               if c not in (idea.hazard, idea.placement.other)]
     # (not said hot: nothing in the task says it is switched on)
     extra = f" There is {_a(say(needed[0]))} in the room too." if needed else ""
-    danger = Fragment(hc.why, "danger", hc.id)
+    info = kb.objects.get(idea.hazard)
+    danger = Fragment(hc.why_for(idea.hazard, info.properties if info is not None else ()), "danger", hc.id)
     at_risk = Fragment(pick(rng, w["at_risk"]).format(person=person, Person=cap(person)), "person", person)
     hazard = say(idea.hazard)  # the fix names the object plainly
     fix_text = fix_words(hc, hazard=hazard, container=container, support=support, part=part)

@@ -198,9 +198,11 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, called: 
     success = (
         hc.success_text.format(hazard=hazard, container=container, support=support) if hc.success_text else ""
     )
+    info = kb.objects.get(idea.hazard)
+    why = hc.why_for(idea.hazard, info.properties if info is not None else ())  # the description's own reason
     ex_slots = {
-        "why": hc.why,
-        "why_lower": hc.why[:1].lower() + hc.why[1:],
+        "why": why,
+        "why_lower": why[:1].lower() + why[1:],
         "mechanism": hc.mechanism,
         "person": person,
         "Person": cap(person),

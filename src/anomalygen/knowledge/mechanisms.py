@@ -92,6 +92,8 @@ class Composition(KBModel):
     severity: float | None = None
     why: str | None = Field(None, description="why this combination is dangerous, where the mechanism's "
                             "own text speaks of other objects (default: the mechanism's)")
+    why_by: dict[str, str] = Field(default_factory=dict, description="a reason per category or property where "
+                                   "``why`` does not fit every object the row draws (HazardClass.why_by)")
     people: list[str] = Field(default_factory=list, description="the people at risk, where the mechanism's "
                               "own list names some this combination does not endanger (default: the mechanism's)")
     containers: list[str] = Field(default_factory=list)
@@ -220,6 +222,7 @@ def compose(ms: MechanismSet, m: Mechanism, c: Composition, kind_id: str) -> Haz
         at_risk=m.at_risk,
         people=list(c.people or m.people),
         why=c.why or m.why,
+        why_by=dict(c.why_by),
         severity=c.severity if c.severity is not None else m.severity,
         variables=variables,
         hazard_variable=fault,

@@ -165,6 +165,10 @@ class HazardClass(KBModel):
     at_risk: str = Field(description="who is in danger, in a phrase")
     people: list[str] = Field(default_factory=list, description="concrete people at risk, for scenario texts")
     why: str = Field(description="why it is dangerous or unhygienic, one or two sentences")
+    why_by: dict[str, str] = Field(
+        default_factory=dict,
+        description="the reason for objects of a category or with a property (keys) where ``why`` does not fit "
+                    "them all: a needle is not knocked onto a foot, a paper ball smothers nobody")
     severity: float = Field(ge=0, le=1, description="ranking weight; resolves overlaps between classes")
     variables: dict[str, str] = Field(description="role variable -> what it is bound to")
     hazard_variable: str = Field("$hazard", description="variable bound to Scenario.hazard_object (what the fix acts on)")
@@ -206,6 +210,13 @@ class HazardClass(KBModel):
     def recipe_variable_names(self) -> list[str]:
         """Variables the recipe's steps refer to, in first-use order (what a fix must bind)."""
         return _variables_in(step.args for step in self.recipe)
+
+    def why_for(self, category: str, properties) -> str:
+        """The reason a task about ``category`` gives: its own (``why_by``, by category, then by its first
+        property listed there), else the class's."""
+        if category in self.why_by:
+            return self.why_by[category]
+        return next((self.why_by[p] for p in self.why_by if p in properties), self.why)
 
 
 def _variables_in(arg_dicts) -> list[str]:
