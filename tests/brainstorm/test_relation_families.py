@@ -64,11 +64,30 @@ def test_a_place_is_stated_by_its_own_placement(reader, line):
 
 
 def test_a_compound_of_two_names_is_neither(reader):
-    """'knife block' names no toy block (the alias 'block'), and no knife is read into it."""
+    """'knife block' (a holder of knives) names no toy block (the alias 'block'), and no knife is read
+    into it; a cable named by what it serves is still a cable, and so is a possessive's."""
     with pytest.raises(Refused):
         reader.compose("The toddler has dragged a kitchen chair over to the counter where the knife block is.")
-    p, _ = reader.compose("The iron's cord is stretched across the doorway.")  # a possessive is no compound
-    assert any(m.name == "power_cable" for m in p.mentions)
+    for line in ("The iron's cord is stretched across the doorway.", "The toaster cable runs across the walkway."):
+        p, comp = reader.compose(line)
+        assert comp.fault.name == "power_cable", line
+
+
+@pytest.mark.parametrize("line", [
+    "A knife is on the kitchen counter behind the sofa.",
+    "A hair dryer is in the cupboard under the sink.",
+    "A toy car is at the bottom of the stairs.",
+    "A knife is in the crib.",
+])
+def test_a_mention_nearby_is_not_a_place(reader, line):
+    """A sofa mentioned as a landmark does not make the counter a low place; in or under a thing is
+    not near it; the bottom of the stairs is not on them (a review found each built elsewhere)."""
+    try:
+        _, comp = reader.compose(line)
+    except Refused:
+        return
+    place = comp.hc.composition.place
+    assert place not in ("low", "near_water", "on_stairs", "near_crib"), (line, comp.hc.id)
 
 
 @pytest.mark.parametrize("who", ["Mum's", "Grandad's", "My sister's", "The carer's"])
@@ -87,7 +106,7 @@ def test_what_cannot_be_built_is_refused(reader, line):
 
 
 @pytest.mark.parametrize(("line", "kind"), [
-    ("Nail polish remover is on the low shelf where the toddler can reach it.", "chemical_bottle"),
+    ("Rat poison is on the low shelf where the toddler can reach it.", "chemical_any"),
     ("Dishwasher tablets are on the floor where the baby crawls.", "detergent_pod"),
     ("The mouthwash has been left on the coffee table within the kids' reach.", "chemical_bottle"),
 ])

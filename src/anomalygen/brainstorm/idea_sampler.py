@@ -49,7 +49,8 @@ def class_targets(kb: KnowledgeBase, hc: HazardClass) -> list[str]:
 def _class_targets(kb: KnowledgeBase, hc: HazardClass) -> list[str]:
     targets = set(kb.targets)
     out = list(hc.target_assets)
-    for name in [*kb.hazard_candidates(hc), *hc.default_containers, *hc.default_supports]:
+    drawn = [h for h in kb.hazard_candidates(hc) if h not in hc.not_drawn]  # a kettle by the sink is not drawn yet
+    for name in [*drawn, *hc.default_containers, *hc.default_supports]:
         if name in targets and name not in out:
             out.append(name)
     # a class whose preconditions name the target's category (the microwave metal is left in) is built

@@ -27,10 +27,11 @@ from anomalygen.schema import RELATION_KINDS, Placement
 #: outweigh a place or condition the class needs no words for.
 RELATION_EVIDENCE = 3.0
 FAMILY_DISCOUNT = 0.5  # a relation of the place's family (on the rim of a filled bath is near its water)
-#: Relations that imply another: what lies on or in a thing is near it (a hair dryer on the edge of a
-#: filled basin, a battery in a cot). A place keyed to "near" is met by them, a little less strongly
-#: than by "near" itself, so a place keyed to "on" or "inside" wins where the line says exactly that.
-RELATION_FAMILY: dict[str, tuple[str, ...]] = {"near": ("on", "inside", "at", "under"), "on": ("at",), "inside": ("at",)}
+#: Relations that imply another: what lies on a thing, or at its top, is near it (a hair dryer on the
+#: edge of a filled basin). A place keyed to "near" is met by them, a little less strongly than by
+#: "near" itself, so a place keyed to "on" wins where the line says exactly that. "In" and "under" are
+#: not near: a knife in the crib or a dryer in the cupboard under the sink would be built elsewhere.
+RELATION_FAMILY: dict[str, tuple[str, ...]] = {"near": ("on", "at"), "on": ("at",)}
 CUE_EVIDENCE = 2.0
 DEFAULT_EVIDENCE = 0.3
 FIRST_SUBJECT_BONUS = 1.0
@@ -195,7 +196,8 @@ def _related(p: ParsedLine, kb: KnowledgeBase, hc: HazardClass, fault: Mention,
             continue
         if m.relation in wanted:
             return m, True
-        if loose is None and (m.relation in family or ("near" in wanted and m.relation == "under" and _hangs(m.name))):
+        if loose is None and (m.relation in family or ("near" in wanted and m.relation == "under"
+                                                    and "soft" in kb.objects[m.name].properties and _hangs(m.name))):
             loose = m  # (under the curtains is beside them: they hang)
     return loose, False
 

@@ -24,16 +24,15 @@ RELATIONS: tuple[tuple[str, str], ...] = (
     ("sitting on", "on"), ("on", "on"), ("onto", "on"), ("atop", "on"), ("over", "on"), ("across", "on"),
     ("in the same cupboard as", "near"), ("in the same cabinet as", "near"), ("on the same shelf as", "near"),
     ("in the same drawer as", "near"), ("same shelf as", "near"), ("same cupboard as", "near"),
-    ("at the bottom of", "at"), ("at the top of", "at"), ("at the foot of", "at"), ("at the head of", "at"),
+    ("at the bottom of", "inside"), ("at the top of", "at"),
     ("inside", "inside"), ("into", "inside"), ("in", "inside"), ("within", "inside"),
     ("next to", "near"), ("close to", "near"), ("near to", "near"), ("right by", "near"), ("up against", "near"),
     ("beside", "near"), ("besides", "near"), ("by", "near"), ("near", "near"), ("against", "near"), ("alongside", "near"),
     ("touching", "near"), ("around", "near"), ("from", "near"), ("under", "under"), ("underneath", "under"),
-    ("beneath", "under"), ("below", "under"), ("behind", "near"), ("right above", "near"), ("just above", "near"),
-    ("above", "near"),
+    ("beneath", "under"), ("below", "under"), ("behind", "near"),
 )
-#: ^ "at the bottom of" a bucket is in it and at the top of the stairs is on them: "at" is met by the
-#: place's own relation through ``line_compose.RELATION_FAMILY``. Above a heater is near it.
+#: ^ "at the bottom of" a bucket is in it; at the top of the stairs is on them ("at" is met by an "on"
+#: place through ``line_compose.RELATION_FAMILY``). The bottom of the stairs is the floor: not on them.
 #: Words that may stand between a preposition and the name it governs ("on the old kitchen stove").
 FILLER = frozenset({
     "the", "a", "an", "my", "our", "your", "his", "her", "their", "its", "this", "that", "these", "those", "some",
@@ -86,6 +85,9 @@ NOT_OBJECTS = frozenset({
 #: ^ people, kin and carers (a possessor, "Mum's mug", or the person at risk) and amounts, never a thing at fault
 #: Catalogue names that, right after another name, are a part of it ("fridge door", "toilet lid").
 PART_NAMES = frozenset({"Door", "Window"})
+#: Heads that name a holder of the thing before them ('knife block', 'shoe rack', 'cup holder'): such a
+#: compound is neither the thing nor what the head alone is an alias for (a block is a toy block).
+HOLDER_HEADS = frozenset({"block", "blocks", "rack", "racks", "stand", "stands", "holder", "holders", "tray", "trays"})
 #: Catalogue containers whose "X of Y" names Y as the thing ("a bottle of bleach", "a box of matches").
 CONTAINER_WORDS = frozenset({"Bottle", "Box", "Bucket", "bowl", "cup", "mug", "glass", "basket", "storage_box", "plate"})
 
@@ -294,8 +296,8 @@ def _merge(found: list[Mention], words: list[str],
            possessive: frozenset[int] | set[int] = frozenset()) -> tuple[list[Mention], list[tuple[int, int]]]:
     """'bottle of bleach' -> the bleach; 'fridge door' -> the fridge; a name said twice -> once.
 
-    Also returns the spans of compounds that name neither of their parts: a one-word alias after
-    another name ('knife block': a block only by alias) is another thing, not the alias's object."""
+    Also returns the spans of compounds that name neither of their parts: a holder word matched as a
+    one-word alias after another name ('knife block': a block only by alias) is another thing."""
     out: list[Mention] = []
     compounds: list[tuple[int, int]] = []
     for m in found:
@@ -306,7 +308,7 @@ def _merge(found: list[Mention], words: list[str],
             if m.name in CONTAINER_WORDS and prev.name not in CONTAINER_WORDS:
                 continue  # 'a vitamin bottle', 'the bleach jug': the container of a thing is the thing
             if m.method == "alias" and m.end - m.start == 1 and prev.kind is None and m.kind is None \
-                    and prev.end - 1 not in possessive:  # 'the iron's cord' is the iron's own cord
+                    and words[m.start] in HOLDER_HEADS and prev.end - 1 not in possessive:
                 out.pop()  # 'knife block', 'shoe rack': the head is the alias's object only in name
                 compounds.append((prev.start, m.end))
                 continue
