@@ -127,17 +127,34 @@ def fits_inside(kb: KnowledgeBase, hazard: str, holder: str) -> bool:
     return size_bounds(kb, hazard)[0] <= _roomiest(kb, holder, cavity_cap)
 
 
-def _largest_surface(kb: KnowledgeBase, obj: str) -> float:
-    """The longest side of any top ``obj``'s variants offer at its largest size (a stair tread, a hob)."""
+@functools.cache
+def _largest_surface(kb: KnowledgeBase, obj: str) -> tuple[float, float]:
+    """(long, short) sides of the roomiest top ``obj``'s variants offer at its largest size (a stair
+    tread, a hob); (0, 0) without one."""
     from anomalygen.assets.core import generate
     from anomalygen.scene.asset_choice import size_bounds
 
     largest = size_bounds(kb, obj)[1]
     assets = [generate(obj, seed, size=largest) for seed in range(INTERIOR_VARIANTS)]
-    return max((2 * float(max(s.half_size)) for a in assets for s in a.surfaces), default=0.0)
+    tops = [tuple(sorted((2 * float(h) for h in s.half_size), reverse=True)) for a in assets for s in a.surfaces]
+    return max(tops, key=lambda t: t[0] * t[1], default=(0.0, 0.0))
 
 
-_SURFACES: dict[str, float] = {}
+@functools.cache
+def _least_footprint(kb: KnowledgeBase, obj: str) -> tuple[float, float]:
+    """(long, short) footprint of ``obj`` at its smallest size, the most compact of a few variants: a
+    cord wanders, so its footprint is not its length alone."""
+    import numpy as np
+
+    from anomalygen.assets.core import generate
+    from anomalygen.scene.asset_choice import size_bounds
+
+    least = size_bounds(kb, obj)[0]
+    feet = []
+    for seed in range(INTERIOR_VARIANTS):
+        lo, hi = (np.asarray(v, dtype=float) for v in generate(obj, seed, size=least).aabb)
+        feet.append(tuple(sorted((float(hi[0] - lo[0]), float(hi[1] - lo[1])), reverse=True)))
+    return min(feet, key=lambda f: f[1])
 TOP_MARGIN = 0.9  # of a top's longest side a thing may span: the layout keeps clear of its rims
 
 
@@ -145,17 +162,18 @@ def fits_on(kb: KnowledgeBase, hazard: str, placement: Placement) -> bool:
     """Can the smallest ``hazard`` lie on the top the placement puts it on? A 1 m extension cord fits
     no side table or stair tread, and a task drawn that way fails every build. Placements on the
     floor, or in or near another object, are left to the layout."""
-    from anomalygen.scene.asset_choice import size_bounds
     from anomalygen.scene.furniture import TOPS, largest_top
 
-    least = size_bounds(kb, hazard)[0]
     if placement.relation in ("on", "at_edge") and placement.support in TOPS:
-        return least <= TOP_MARGIN * largest_top(placement.support)[0]
-    if placement.relation == "on" and placement.other is not None and placement.other in catalogue():
-        if placement.other not in _SURFACES:
-            _SURFACES[placement.other] = _largest_surface(kb, placement.other)
-        return _SURFACES[placement.other] == 0.0 or least <= TOP_MARGIN * _SURFACES[placement.other]
-    return True
+        top = largest_top(placement.support)
+    elif placement.relation == "on" and placement.other is not None and placement.other in catalogue():
+        top = _largest_surface(kb, placement.other)
+        if top[0] == 0.0:
+            return True  # no surface recorded: the layout decides
+    else:
+        return True
+    long, short = _least_footprint(kb, hazard)
+    return long <= TOP_MARGIN * top[0] and short <= TOP_MARGIN * top[1]
 
 
 def hazards_for(kb: KnowledgeBase, hc: HazardClass) -> list[str]:

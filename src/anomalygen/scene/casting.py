@@ -173,8 +173,7 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
         _first_known(hc.default_containers) if "$container" in variables else None
     )
     if container_name:
-        container = sel.choose(container_name, ObjectRole.CONTAINER,
-                               stores=hazard.size if container_name != sc.hazard_object else None)
+        container = sel.choose(container_name, ObjectRole.CONTAINER)
         if container is not hazard and container.asset.cavities:
             # The hazard must be able to go in: a 0.5 m plastic bag does not fit a 0.3 m bucket.
             # Draw the container again (other sizes), then a smaller hazard, before giving up.
@@ -183,7 +182,7 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
                 if hazard.size <= container_room(container.asset):
                     break
                 sel.forget(container)
-                container = sel.choose(container_name, ObjectRole.CONTAINER, stores=hazard.size)
+                container = sel.choose(container_name, ObjectRole.CONTAINER)
             # Another kind only when the task left the container open: a named bucket stays a bucket.
             if hazard.size > container_room(container.asset) and container is not target and not sc.container:
                 container = _roomier_kind(sel, hc, container, container_name, hazard.size)
@@ -193,9 +192,19 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
                 try:
                     hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=min(cap or room, room))
                 except ItemFailed as exc:
-                    others = [c for c in hc.default_containers if c != container_name]
-                    raise ItemFailed(f"{exc}: the task names the {container_name}"
-                                     + (f" (the class's other containers: {', '.join(others)})" if others else "")) from exc
+                    # no smaller hazard fits either: draw the container at the size whose room holds the
+                    # smallest hazard (the generator checked the roomiest; random redraws rarely land
+                    # there). Scenes the redraws or a smaller hazard built stay exactly as they were.
+                    least = asset_choice.size_bounds(sel.kb, asset_choice.resolve_name(sc.hazard_object))[0]
+                    if container is not target:
+                        sel.forget(container)
+                        container = sel.choose(container_name, ObjectRole.CONTAINER, stores=least)
+                        room = container_room(container.asset)
+                    if least > room:
+                        others = [c for c in hc.default_containers if c != container_name]
+                        raise ItemFailed(f"{exc}: the task names the {container_name}"
+                                         + (f" (the class's other containers: {', '.join(others)})" if others else "")) from exc
+                    hazard = sel.choose(sc.hazard_object, ObjectRole.HAZARD, cap=min(cap or room, room))
             if hazard.size > room:
                 raise ItemFailed(f"{hazard.catalogue} ({hazard.size:.2f} m) does not fit {container.catalogue} "
                                  f"(room for {room:.2f} m)")

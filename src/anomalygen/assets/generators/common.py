@@ -99,21 +99,13 @@ def open_box(part: Part, hx, hy, hz, t, rgba, density, *, z0=0.0, top=False, fro
         part.box((hx, hy, t / 2), (cx, cy, z0 + 2 * hz - t / 2), rgba, density)
 
 
-CABLE_TURN_SD = 0.25  # rad: the turn between segments
-CABLE_MAX_TURN = 0.45  # rad: the most a cable's heading strays from its run
-
-
 def cable_path(rng: np.random.Generator, length: float, n: int, r: float):
-    """Points of a flat, gently wandering cable on the floor (a random walk with smooth turns).
-
-    The heading stays within CABLE_MAX_TURN of the cable's run, so a cord lies along a table, a stair
-    tread or a walkway as one does when pulled across it; a free random walk coiled it into a square
-    footprint nearly as wide as long, which fit no tread and few tables (issue 39)."""
+    """Points of a flat, gently wandering cable on the floor (a random walk with smooth turns)."""
     step = length / n
     pts = [np.zeros(3)]
     ang = 0.0
     for _ in range(n):
-        ang += float(rng.normal(0, CABLE_TURN_SD))
-        ang = float(np.clip(ang, -CABLE_MAX_TURN, CABLE_MAX_TURN))
+        ang += float(rng.normal(0, 0.45))
+        ang = float(np.clip(ang, -1.2, 1.2))
         pts.append(pts[-1] + step * np.array([math.cos(ang), math.sin(ang), 0.0]))
     return [p + np.array([0, 0, r]) for p in pts]
