@@ -112,7 +112,7 @@ def test_the_situation_says_what_the_danger_sentence_relies_on(drawn):
     situation, not only assumed by the danger sentence (a blind reading of seed 8 found both missing)."""
     kb, out = drawn
     checked = 0
-    for idea, frags, text in out:
+    for idea, frags, _text in out:
         hc = kb.hazard_classes[idea.class_id]
         situation = next(f.text for f in frags if f.kind == "sentence")
         if hc.composition is not None and hc.composition.condition == "handle_out":

@@ -161,6 +161,12 @@ def hot_word(kb, obj: str, hc, said: str) -> str:
     return table.get(obj, table["default"])
 
 
+def reason(kb, hc, obj: str) -> str:
+    """The class's reason for a task about ``obj`` (``HazardClass.why_for``: its own where one is kept)."""
+    info = kb.objects.get(obj)
+    return hc.why_for(obj, info.properties if info is not None else ())
+
+
 def _condition_words(hc) -> str | None:
     """A composed class's dangerous state in words that follow a place ("with its handle sticking
     out"), when the object's own state is not said otherwise: the danger sentence relies on it."""
@@ -223,8 +229,7 @@ def describe_fragments(idea, kb, rng: np.random.Generator, *, say, person: str, 
               if c not in (idea.hazard, idea.placement.other)]
     # (not said hot: nothing in the task says it is switched on)
     extra = f" There is {_a(say(needed[0]))} in the room too." if needed else ""
-    info = kb.objects.get(idea.hazard)
-    danger = Fragment(hc.why_for(idea.hazard, info.properties if info is not None else ()), "danger", hc.id)
+    danger = Fragment(reason(kb, hc, idea.hazard), "danger", hc.id)
     at_risk = Fragment(pick(rng, w["at_risk"]).format(person=person, Person=cap(person)), "person", person)
     hazard = say(idea.hazard)  # the fix names the object plainly
     fix_text = fix_words(hc, hazard=hazard, container=container, support=support, part=part)

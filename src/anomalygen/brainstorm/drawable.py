@@ -97,16 +97,21 @@ INTERIOR_VARIANTS = 4  # variants of a holder looked at for its roomiest interio
 
 
 @functools.cache
+def _variants(kb: KnowledgeBase, obj: str, end: int) -> tuple:
+    """``obj``'s first INTERIOR_VARIANTS assets at the small (``end`` 0) or large (1) end of its size range."""
+    from anomalygen.assets.core import generate
+    from anomalygen.scene.asset_choice import size_bounds
+
+    size = size_bounds(kb, obj)[end]
+    return tuple(generate(obj, seed, size=size) for seed in range(INTERIOR_VARIANTS))
+
+
+@functools.cache
 def _roomiest(kb: KnowledgeBase, obj: str, measure) -> float:
     """The most ``measure`` (the builder's ``cavity_cap`` for an ``inside:obj`` placement, its
     ``container_room`` for putting things away in ``obj``) gives over ``obj``'s variants at its
     largest size; 0 without an interior."""
-    from anomalygen.assets.core import generate
-    from anomalygen.scene.asset_choice import size_bounds
-
-    largest = size_bounds(kb, obj)[1]
-    assets = [generate(obj, seed, size=largest) for seed in range(INTERIOR_VARIANTS)]
-    return max((measure(a) for a in assets if a.cavities), default=0.0)
+    return max((measure(a) for a in _variants(kb, obj, 1) if a.cavities), default=0.0)
 
 
 def containers_for(kb: KnowledgeBase, hc: HazardClass, hazard: str) -> list[str]:
@@ -131,12 +136,8 @@ def fits_inside(kb: KnowledgeBase, hazard: str, holder: str) -> bool:
 def _largest_surface(kb: KnowledgeBase, obj: str) -> tuple[float, float]:
     """(long, short) sides of the roomiest top ``obj``'s variants offer at its largest size (a stair
     tread, a hob); (0, 0) without one."""
-    from anomalygen.assets.core import generate
-    from anomalygen.scene.asset_choice import size_bounds
-
-    largest = size_bounds(kb, obj)[1]
-    assets = [generate(obj, seed, size=largest) for seed in range(INTERIOR_VARIANTS)]
-    tops = [tuple(sorted((2 * float(h) for h in s.half_size), reverse=True)) for a in assets for s in a.surfaces]
+    tops = [tuple(sorted((2 * float(h) for h in s.half_size), reverse=True))
+            for a in _variants(kb, obj, 1) for s in a.surfaces]
     return max(tops, key=lambda t: t[0] * t[1], default=(0.0, 0.0))
 
 
@@ -144,17 +145,13 @@ def _largest_surface(kb: KnowledgeBase, obj: str) -> tuple[float, float]:
 def _least_footprint(kb: KnowledgeBase, obj: str) -> tuple[float, float]:
     """(long, short) footprint of ``obj`` at its smallest size, the most compact of a few variants: a
     cord wanders, so its footprint is not its length alone."""
-    import numpy as np
-
-    from anomalygen.assets.core import generate
-    from anomalygen.scene.asset_choice import size_bounds
-
-    least = size_bounds(kb, obj)[0]
     feet = []
-    for seed in range(INTERIOR_VARIANTS):
-        lo, hi = (np.asarray(v, dtype=float) for v in generate(obj, seed, size=least).aabb)
-        feet.append(tuple(sorted((float(hi[0] - lo[0]), float(hi[1] - lo[1])), reverse=True)))
+    for a in _variants(kb, obj, 0):
+        (x0, y0, _), (x1, y1, _) = a.aabb
+        feet.append(tuple(sorted((float(x1 - x0), float(y1 - y0)), reverse=True)))
     return min(feet, key=lambda f: f[1])
+
+
 TOP_MARGIN = 0.9  # of a top's longest side a thing may span: the layout keeps clear of its rims
 
 

@@ -81,7 +81,7 @@ def compose_line(p: ParsedLine, kb: KnowledgeBase, ms: MechanismSet, g: NameGrou
     subjects = p.subjects() or p.mentions[:1]
     _refuse_unknown_subject(p, subjects, g)
     beneath = next((m for m in p.mentions if m.relation == "under" and m is not subjects[0]
-                    and "soft" in kb.objects[m.name].properties and not _hangs(m.name)), None)
+                    and "soft" in kb.objects[m.name].properties and not _hangs(kb, m.name)), None)
     if beneath is not None:  # under a table is on the floor; nothing is built under a rug or a blanket
         raise Refused(f"no mechanism for {subjects[0].name} {beneath.prep} {beneath.name}: nothing can be built under another object")
     options: list[Composition] = []
@@ -101,12 +101,12 @@ def compose_line(p: ParsedLine, kb: KnowledgeBase, ms: MechanismSet, g: NameGrou
     return max(options, key=lambda c: (c.score, c.hc.severity, c.hc.id))
 
 
-def _hangs(name: str) -> bool:
+def _hangs(kb: KnowledgeBase, name: str) -> bool:
     """A soft thing that hangs on a wall (curtains): under it is beside it, not beneath a cover."""
     from anomalygen.knowledge.households import load_households
 
     f = load_households().fixtures.get(name)
-    return f is not None and f.mount == "wall"
+    return f is not None and f.mount == "wall" and "soft" in kb.objects[name].properties
 
 
 def _refuse_unknown_subject(p: ParsedLine, subjects: list[Mention], g: NameGrounder) -> None:
@@ -196,8 +196,7 @@ def _related(p: ParsedLine, kb: KnowledgeBase, hc: HazardClass, fault: Mention,
             continue
         if m.relation in wanted:
             return m, True
-        if loose is None and (m.relation in family or ("near" in wanted and m.relation == "under"
-                                                    and "soft" in kb.objects[m.name].properties and _hangs(m.name))):
+        if loose is None and (m.relation in family or ("near" in wanted and m.relation == "under" and _hangs(kb, m.name))):
             loose = m  # (under the curtains is beside them: they hang)
     return loose, False
 
@@ -205,15 +204,8 @@ def _related(p: ParsedLine, kb: KnowledgeBase, hc: HazardClass, fault: Mention,
 def _placed_as(p: ParsedLine, fault: Mention, place) -> list[str]:
     """The words of a named object the line puts the fault on or in as one of the place's own placements
     ("a pot on the stovetop" states the hob of ``on:Stove``), when no cue word says the place."""
-    from anomalygen.schema import Placement
-
-    out = []
-    for m in p.mentions:
-        if m is fault or m.relation not in ("on", "inside"):
-            continue
-        if any(isinstance(t, Placement) and t.relation == m.relation and t.other == m.name for t in place.placements):
-            out.append(m.words)
-    return out
+    return [m.words for m in p.mentions if m is not fault and m.relation in ("on", "inside")
+            and any(t.relation == m.relation and t.other == m.name for t in place.placements)]
 
 
 def _no_mechanism(p: ParsedLine, subjects: list[Mention], near: list, kb: KnowledgeBase) -> str:

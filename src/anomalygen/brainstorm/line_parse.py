@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from anomalygen.knowledge.grounding import NameGrounder, singular
+from anomalygen.knowledge.grounding import NameGrounder, name_words, singular
 from anomalygen.knowledge.lexicon import Lexicon
 from anomalygen.schema import part_labels
 
@@ -217,7 +217,7 @@ def parse_line(line: str, g: NameGrounder, *, longest: int = 4, lexicon: Lexicon
             hit = g.objects.spelled(phrase, pool)
             if hit is not None:
                 # an alias is another word for the shape ("bags" for the backpack): the user's word stays
-                called = phrase if hit[1] == "alias" and n > 0 and _own_words(hit[0]) != singular(phrase) else None
+                called = phrase if hit[1] == "alias" and _own_words(hit[0]) != singular(phrase) else None
                 found.append(Mention(i, i + n, hit[0], phrase, method=hit[1], called=called))
             elif lexicon is not None and (reading := lexicon.read(phrase, buildable)) is not None \
                     and reading.proxy in pool:
@@ -243,8 +243,7 @@ def parse_line(line: str, g: NameGrounder, *, longest: int = 4, lexicon: Lexicon
 
 def _own_words(name: str) -> str:
     """A catalogue name as words ('toy_block' -> 'toy block', 'PaperTowels' -> 'paper towel')."""
-    spaced = re.sub(r"(?<=[a-z])(?=[A-Z])", " ", name).replace("_", " ").lower()
-    return singular(spaced)
+    return singular(name_words(name).lower())
 
 
 def _nearest_words(found: list[Mention], unknown: list[tuple[int, str]], words: list[str], pool: set[str],

@@ -15,9 +15,10 @@ import re
 import numpy as np
 
 from anomalygen.brainstorm.describe import _a as indefinite
-from anomalygen.brainstorm.describe import cap, describe_fragments, fix_words, pick, words
+from anomalygen.brainstorm.describe import cap, describe_fragments, fix_words, pick, reason, words
 from anomalygen.brainstorm.idea import Idea, Texts
 from anomalygen.knowledge import KnowledgeBase
+from anomalygen.knowledge.grounding import name_words
 from anomalygen.knowledge.households import load_households
 from anomalygen.schema import DOOR
 
@@ -93,7 +94,7 @@ _EXPLANATION_FRAMES = [
 def nice(name: str) -> str:
     if name in _NICE_NAMES:
         return _NICE_NAMES[name]
-    words = re.sub(r"(?<=[a-z])(?=[A-Z])", " ", name).replace("_", " ")
+    words = name_words(name)
     return words.lower() if not name.isupper() else words
 
 
@@ -198,8 +199,7 @@ def realise(idea: Idea, kb: KnowledgeBase, rng: np.random.Generator, *, called: 
     success = (
         hc.success_text.format(hazard=hazard, container=container, support=support) if hc.success_text else ""
     )
-    info = kb.objects.get(idea.hazard)
-    why = hc.why_for(idea.hazard, info.properties if info is not None else ())  # the description's own reason
+    why = reason(kb, hc, idea.hazard)  # the description's own reason
     ex_slots = {
         "why": why,
         "why_lower": why[:1].lower() + why[1:],

@@ -74,6 +74,11 @@ def normalise(text: str) -> str:
     return "_".join(words)
 
 
+def name_words(name: str) -> str:
+    """A catalogue name as words, its case kept: 'toy_block' -> 'toy block', 'PaperTowels' -> 'Paper Towels'."""
+    return re.sub(r"(?<=[a-z])(?=[A-Z])", " ", name).replace("_", " ")
+
+
 def singular(word: str) -> str:
     """English plural of the last word undone, for the common regular forms only."""
     if len(word) <= 3 or word.endswith(("ss", "us", "is")):

@@ -102,8 +102,8 @@ class Composition(KBModel):
     rooms: list[str] = Field(default_factory=list)
     placements: list[Placement] = Field(default_factory=list, description="overrides the place's placements")
     assume_condition: bool = Field(False, description="a user's line need not state the condition (a heater is on)")
-    drawn: str | None = Field(None, description="why brainstorming does not draw this class yet (None: it does); "
-                              "a user's line, the truth and the detector still hold it")
+    undrawn_because: str | None = Field(None, description="why brainstorming does not draw this class yet (None: "
+                                        "it does); a user's line, the truth and the detector still hold it")
 
 
 class Mechanism(KBModel):
@@ -234,7 +234,7 @@ def compose(ms: MechanismSet, m: Mechanism, c: Composition, kind_id: str) -> Haz
         default_supports=list(c.supports),
         hazard_objects=list(kind.hazard_objects),
         not_drawn=list(kind.not_drawn),
-        undrawn_because=c.drawn,
+        undrawn_because=c.undrawn_because,
         target_assets=list(c.targets),
         rooms=list(c.rooms),
         articulation=articulation,

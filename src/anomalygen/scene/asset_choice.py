@@ -265,8 +265,8 @@ def pick_asset(
     A category with real (packaged) models draws those (``real``: ``build.real_assets``); a real
     candidate that does not fit here (too big for the space, without the part the task needs, an
     interior too small for the ``room_for`` m thing to go in it) gives way to the procedural one
-    drawn with the same seed and size; a procedural one still too small is drawn again, bigger. ``stores``: the least size of what the task puts away in
-    it; a container with less room gives way to one with enough (more are drawn), and when none
+    drawn with the same seed and size; a procedural one still too small is drawn again, bigger.
+    ``stores``: the least size of what the task puts away in it; a container with less room gives way to one with enough (more are drawn), and when none
     has it the roomiest is returned, for the caller to say what does not fit."""
     from anomalygen.assets.core import draw, generate
 
@@ -292,15 +292,15 @@ def pick_asset(
             problems.append(f"real model {asset.asset_id}: {problem}")
             asset = generate(catalogue, s, size=want)
             problem = plausibility_problem(asset, catalogue, kb, parts, cap=cap, states=states)
-        if problem is None and room_for and asset.cavities and cavity_cap(asset) < room_for:
-            cramped.append(asset)  # a sink too small for the kettle the line puts in it: draw it bigger
-            roomier = max(roomier or 0.0, asset.size * room_for / max(cavity_cap(asset), 1e-6) * ROOM_MARGIN)
-            continue
-        if problem is None and stores and asset.cavities and container_room(asset) < stores:
+        # too small for what goes in (a sink for the kettle a line puts in it) or is put away in it: a
+        # container's room grows with its size, so the next draws aim where this one would hold it
+        # (the generator checked the roomiest size; a uniform draw rarely lands there)
+        short = next(((need, have) for need, have in ((room_for, cavity_cap), (stores, container_room))
+                      if problem is None and need and asset.cavities and have(asset) < need), None)
+        if short is not None:
+            need, have = short
             cramped.append(asset)
-            # a container's room grows with its size: the next draws aim where this one would hold it
-            # (the generator checked the roomiest size; a uniform draw rarely lands there)
-            roomier = max(roomier or 0.0, asset.size * stores / max(container_room(asset), 1e-6) * ROOM_MARGIN)
+            roomier = max(roomier or 0.0, asset.size * need / max(have(asset), 1e-6) * ROOM_MARGIN)
             continue
         if problem is None:
             candidates.append(asset)

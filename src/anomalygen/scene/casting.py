@@ -148,8 +148,8 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
     # a target that is also the named container must have room for the hazard: it keeps its draw
     stores_hazard = bool(sc.container) and not sel.hazard_is_target and \
         asset_choice.resolve_name(sc.container) == asset_choice.resolve_name(task.target_asset)
-    least_hazard = asset_choice.size_bounds(kb, asset_choice.resolve_name(sc.hazard_object))[0] \
-        if holder or stores_hazard else None
+    least_of_hazard = asset_choice.size_bounds(kb, asset_choice.resolve_name(sc.hazard_object))[0]
+    least_hazard = least_of_hazard if holder or stores_hazard else None
     room_for = least_hazard if holder else None
     # Big things first: they bound what fits in/on them.
     target = sel.target = sel.choose(
@@ -195,12 +195,11 @@ def select_objects(task: TaskProposal, rng, hints=None, *, real_assets: bool = T
                     # no smaller hazard fits either: draw the container at the size whose room holds the
                     # smallest hazard (the generator checked the roomiest; random redraws rarely land
                     # there). Scenes the redraws or a smaller hazard built stay exactly as they were.
-                    least = asset_choice.size_bounds(sel.kb, asset_choice.resolve_name(sc.hazard_object))[0]
                     if container is not target:
                         sel.forget(container)
-                        container = sel.choose(container_name, ObjectRole.CONTAINER, stores=least)
+                        container = sel.choose(container_name, ObjectRole.CONTAINER, stores=least_of_hazard)
                         room = container_room(container.asset)
-                    if least > room:
+                    if least_of_hazard > room:
                         others = [c for c in hc.default_containers if c != container_name]
                         raise ItemFailed(f"{exc}: the task names the {container_name}"
                                          + (f" (the class's other containers: {', '.join(others)})" if others else "")) from exc
